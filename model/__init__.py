@@ -1,0 +1,13 @@
+"""Float and fixed-point models of the RVSM spike-camera pixel array.
+
+Submodules, one concept each:
+
+- :mod:`kernels` -- normalised DoG / Gauss receptive fields and the scale ladders.
+- :mod:`scene` -- a scene (frames + ``steps_per_frame``) and its per-step brightness.
+- :mod:`scene_library` / :mod:`scene_io` -- built-in synthetic scenes and file loaders.
+- :mod:`noise` -- dark current and fixed-pattern threshold noise (SPEC section 3).
+- :mod:`samplers` -- the float FSM / RVSM samplers (SPEC section 2).
+- :mod:`spike_files` -- ``.npz`` spike files and the spike camera's ``.dat`` layout.
+- :mod:`reconstruction`, :mod:`metrics` -- TFI/TFP, the RVSM inverse, PSNR/SSIM, robustness.
+- :mod:`fixed` -- the bit-accurate fixed-point twin (SPEC section 5).
+"""

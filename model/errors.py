@@ -1,0 +1,9 @@
+"""The one exception type users see: a message that says what is wrong and how to fix it."""
+
+
+class RvsmError(Exception):
+    """A user-facing error (bad input, bad configuration, missing tool).
+
+    The CLI prints ``rvsm: error: <message>`` on one line and exits non-zero; the message
+    must name what is wrong and, where possible, how to fix it.
+    """

@@ -1,0 +1,190 @@
+"""The integer heart of the hardware contract (SPEC section 5), on plain integer arrays.
+
+This is what one pixel-array step does in hardware, with no configuration object in the
+way, so the fixed twin (:mod:`rvsm.model.fixed.twin`) and the RTL tests share one model:
+
+1. ``sum[s, y, x] = sum_{di,dj} weights[s][di, dj] * codes[y+di, x+dj]`` -- exact integer
+   weighted sum over the receptive field; codes outside the array are 0.
+2. ``shifted = sum >> shift`` -- arithmetic right shift, i.e. floor division by
+   ``2**shift`` (rounds toward minus infinity: ``-5 >> 1 == -3``).
+3. ``acc = clamp(acc + shifted, -2**(W-1), 2**(W-1) - 1)`` -- W-bit signed, saturating.
+4. fire ``+1`` if ``acc >= thr``; else, for signed models, ``-1`` if ``acc <= -thr``;
+   ``thr`` is the accumulator's own integer threshold, ``1 <= thr <= 2**(W-1) - 1``.
+5. reset a firing accumulator: ``"zero"`` sets ``acc = 0``; ``"subtract"`` sets
+   ``acc -= thr`` after +1 and ``acc += thr`` after -1.
+
+All arithmetic is ``int64``; widths are checked so nothing can overflow it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import RvsmError
+
+RESET_MODES = ("zero", "subtract")
+
+
+def accumulator_range(accumulator_bits: int) -> tuple[int, int]:
+    """``(lo, hi)`` of a signed ``accumulator_bits``-wide two's-complement register."""
+    return -(1 << (accumulator_bits - 1)), (1 << (accumulator_bits - 1)) - 1
+
+
+def integer_receptive_sums(codes: np.ndarray, weights: Sequence[np.ndarray]) -> np.ndarray:
+    """Exact weighted sums of ADC codes over each receptive field, zero outside the array.
+
+    ``codes`` is ``(B, H, W)`` non-negative integers; ``weights`` ``S`` odd square integer
+    arrays ``(2L+1, 2L+1)``; returns ``(B, S, H, W) int64``.
+    """
+    codes = np.asarray(codes, dtype=np.int64)
+    b, h, w = codes.shape
+    out = np.zeros((b, len(weights), h, w), dtype=np.int64)
+    for s, kernel in enumerate(weights):
+        kernel = np.asarray(kernel, dtype=np.int64)
+        half = kernel.shape[0] // 2
+        padded = np.zeros((b, h + 2 * half, w + 2 * half), dtype=np.int64)
+        padded[:, half:half + h, half:half + w] = codes
+        target = out[:, s]
+        for di in range(2 * half + 1):
+            for dj in range(2 * half + 1):
+                wt = int(kernel[di, dj])
+                if wt:
+                    target += wt * padded[:, di:di + h, dj:dj + w]
+    return out
+
+
+def arithmetic_shift(values: np.ndarray, shift: int) -> np.ndarray:
+    """``values >> shift`` (floor of ``values / 2**shift``), as a hardware ``>>>`` does."""
+    return np.right_shift(np.asarray(values, dtype=np.int64), int(shift))
+
+
+class FixedIntegrator:
+    """W-bit saturating accumulators with integer thresholds: ``(S, H, W)`` of them.
+
+    ``step(sums)`` takes one step's shifted sums ``(S, H, W) int64`` and returns spikes
+    ``(S, H, W) int8``. ``saturated`` counts, per scale, the accumulator-steps at which
+    the pre-saturation value left the representable range.
+    """
+
+    def __init__(
+        self,
+        thresholds: np.ndarray,
+        accumulator_bits: int,
+        signed: bool,
+        reset: str = "zero",
+    ):
+        if not 2 <= accumulator_bits <= 62:
+            raise RvsmError(f"accumulator_bits must be 2..62, got {accumulator_bits}")
+        if reset not in RESET_MODES:
+            raise RvsmError(f"reset must be one of {RESET_MODES}, got {reset!r}")
+        self.lo, self.hi = accumulator_range(accumulator_bits)
+        thr = np.asarray(thresholds, dtype=np.int64)
+        if thr.ndim != 3:
+            raise RvsmError(f"thresholds must be (S, H, W), got shape {thr.shape}")
+        if thr.min() < 1 or thr.max() > self.hi:
+            raise RvsmError(
+                f"integer thresholds must lie in 1..{self.hi} for {accumulator_bits}-bit "
+                f"accumulators, got {thr.min()}..{thr.max()}"
+            )
+        self.thr = thr
+        self.signed = signed
+        self.reset = reset
+        self.acc = np.zeros_like(thr)
+        self.saturated = np.zeros(thr.shape[0], dtype=np.int64)
+
+    def step(self, sums: np.ndarray) -> np.ndarray:
+        """Add ``sums (S, H, W) int64``, saturate, compare, reset; return spikes int8."""
+        acc = self.acc
+        acc += sums
+        over = (acc > self.hi) | (acc < self.lo)
+        self.saturated += over.sum(axis=(1, 2))
+        np.clip(acc, self.lo, self.hi, out=acc)
+        pos = acc >= self.thr
+        spikes = pos.astype(np.int8)
+        if self.signed:
+            neg = acc <= -self.thr
+            spikes -= (neg & ~pos).astype(np.int8)
+        if self.reset == "zero":
+            acc[spikes != 0] = 0
+        else:
+            acc -= self.thr * spikes
+        return spikes
+
+
+def run_integer_array(
+    codes: np.ndarray,
+    weights: Sequence[np.ndarray],
+    shift: int,
+    thresholds: np.ndarray,
+    accumulator_bits: int,
+    signed: bool,
+    reset: str = "zero",
+    block_steps: int = 32,
+) -> np.ndarray:
+    """Spikes ``(T, S, H, W) int8`` of the whole contract on ``codes (T, H, W)``.
+
+    This is the bit-accurate model the RTL is checked against.
+    """
+    codes = np.asarray(codes)
+    if codes.ndim != 3:
+        raise RvsmError(f"ADC codes must be (T, H, W), got shape {codes.shape}")
+    integrator = FixedIntegrator(thresholds, accumulator_bits, signed, reset)
+    t_total = codes.shape[0]
+    spikes = np.zeros((t_total, len(weights)) + codes.shape[1:], dtype=np.int8)
+    for t0 in range(0, t_total, block_steps):
+        t1 = min(t0 + block_steps, t_total)
+        sums = arithmetic_shift(integer_receptive_sums(codes[t0:t1], weights), shift)
+        for b in range(t1 - t0):
+            spikes[t0 + b] = integrator.step(sums[b])
+    return spikes
+
+
+@dataclass(frozen=True)
+class ArrayContract:
+    """The integer parameters of one pixel array: everything the RTL is built from.
+
+    ``weights`` holds, per scale, the integer kernel as a tuple of row tuples (hashable, so
+    a contract can key a cache of generated RTL). Thresholds are *not* part of it: they are
+    loaded at run time through the configuration interface (fixed-pattern noise lives
+    there), each in ``1 .. 2**(accumulator_bits-1) - 1``.
+    """
+
+    height: int
+    width: int
+    adc_bits: int
+    weights: tuple[tuple[tuple[int, ...], ...], ...]
+    shift: int
+    accumulator_bits: int
+    signed: bool
+    reset: str = "zero"
+
+    @property
+    def num_scales(self) -> int:
+        """S, accumulators per pixel."""
+        return len(self.weights)
+
+    @property
+    def weight_arrays(self) -> list[np.ndarray]:
+        """The kernels as ``(2L+1, 2L+1) int64`` arrays."""
+        return [np.array(k, dtype=np.int64) for k in self.weights]
+
+    @property
+    def threshold_bits(self) -> int:
+        """Width of an unsigned threshold register: ``accumulator_bits - 1``."""
+        return self.accumulator_bits - 1
+
+    def sum_range(self, scale: int) -> tuple[int, int]:
+        """``(lo, hi)`` of scale ``scale``'s per-step weighted sum before the shift."""
+        k = self.weight_arrays[scale]
+        full = (1 << self.adc_bits) - 1
+        return int(k[k < 0].sum()) * full, int(k[k > 0].sum()) * full
+
+    def run(self, codes: np.ndarray, thresholds: np.ndarray) -> np.ndarray:
+        """Spikes ``(T, S, H, W) int8`` for ``codes (T, H, W)`` and ``thresholds (S, H, W)``."""
+        return run_integer_array(
+            codes, self.weight_arrays, self.shift, thresholds,
+            self.accumulator_bits, self.signed, self.reset,
+        )

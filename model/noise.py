@@ -1,0 +1,90 @@
+"""Sensor noise (SPEC section 3, paper eqs. 13-15), drawn from seeded numpy Generators.
+
+- Dark current ``I_dark ~ N(e1, (b1 k)^2)`` per step and pixel, added to the brightness
+  before any weighting (and, in the fixed twin, before the ADC).
+- Fixed pattern per accumulator: offset ``V_OS ~ N(e2, (b2 k)^2)`` and gain
+  ``theta ~ N(e3, (b3 k)^2)``; the accumulator's threshold is ``theta * phi + V_OS``.
+
+Streams (all from ``numpy.random.SeedSequence(seed)``): child 0 feeds the fixed pattern,
+with one grandchild per scale index (so ``dog1`` and ``dog4`` share scale 0's pattern);
+child 1 feeds the dark current, drawn step after step in row-major order, so FSM and every
+RVSM ladder with the same seed see the same dark current, whatever the block size.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .errors import RvsmError
+
+MAX_SCALES = 4
+
+
+@dataclass(frozen=True)
+class NoiseParams:
+    """Noise intensity ``k``, the SPEC defaults for the e/b constants, and the seed."""
+
+    k: float = 1.0
+    seed: int = 0
+    e1: float = 2.0
+    b1: float = 0.75
+    e2: float = 0.0
+    b2: float = 3.0
+    e3: float = 1.0
+    b3: float = 0.0275
+
+    def __post_init__(self) -> None:
+        for name in ("k", "e1", "b1", "e2", "b2", "e3", "b3"):
+            value = getattr(self, name)
+            if not np.isfinite(value):
+                raise RvsmError(f"noise parameter {name} must be finite, got {value!r}")
+        for name in ("k", "b1", "b2", "b3"):
+            if getattr(self, name) < 0:
+                raise RvsmError(f"noise parameter {name} must be >= 0, got {getattr(self, name)}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
+                or self.seed < 0:
+            raise RvsmError(f"noise seed must be an integer >= 0, got {self.seed!r}")
+
+    def to_dict(self) -> dict:
+        """Plain-JSON form, for spike-file metadata."""
+        return {key: (int(v) if key == "seed" else float(v)) for key, v in asdict(self).items()}
+
+
+class NoiseSource:
+    """Seeded noise for one array of ``(H, W)`` pixels and ``S`` accumulators per pixel."""
+
+    def __init__(self, params: NoiseParams, shape: tuple[int, int], num_scales: int):
+        if not 1 <= num_scales <= MAX_SCALES:
+            raise RvsmError(f"num_scales must be 1..{MAX_SCALES}, got {num_scales}")
+        self.params = params
+        self.shape = (int(shape[0]), int(shape[1]))
+        self.num_scales = int(num_scales)
+        fixed_seq, dark_seq = np.random.SeedSequence(params.seed).spawn(2)
+        self._scale_seqs = fixed_seq.spawn(MAX_SCALES)[: self.num_scales]
+        self._dark = np.random.Generator(np.random.PCG64(dark_seq))
+
+    def fixed_pattern(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(theta, v_os)``, each ``(S, H, W) float64``; the same on every call."""
+        p = self.params
+        theta = np.empty((self.num_scales,) + self.shape)
+        v_os = np.empty_like(theta)
+        for s, seq in enumerate(self._scale_seqs):
+            rng = np.random.Generator(np.random.PCG64(seq))
+            v_os[s] = rng.normal(p.e2, p.b2 * p.k, self.shape)
+            theta[s] = rng.normal(p.e3, p.b3 * p.k, self.shape)
+        return theta, v_os
+
+    def thresholds(self, phi: np.ndarray) -> np.ndarray:
+        """Per-accumulator thresholds ``theta * phi_s + V_OS``: ``(S, H, W) float64``.
+
+        ``phi`` is ``(S,)``, the nominal threshold of each scale (8-bit brightness units).
+        """
+        theta, v_os = self.fixed_pattern()
+        return theta * np.asarray(phi, dtype=np.float64)[:, None, None] + v_os
+
+    def dark_current(self, num_steps: int) -> np.ndarray:
+        """The next ``num_steps`` steps of dark current: ``(B, H, W) float64`` brightness."""
+        p = self.params
+        return self._dark.normal(p.e1, p.b1 * p.k, (num_steps,) + self.shape)

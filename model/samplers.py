@@ -1,0 +1,211 @@
+"""The float reference samplers: FSM and RVSM-DoG / RVSM-Gauss (SPEC section 2).
+
+Every model integrates per step, then compares, then resets; the spike of step ``t`` is
+decided from the accumulation that includes step ``t``. FSM is the one-scale case with a
+1x1 kernel of weight 1 that only fires +1.
+
+Speed: receptive-field sums are linear, so the frames are filtered once and the per-step
+drive is interpolated between filtered frames (SPEC section 1's formula applied after the
+filter); only the dark current, new every step, is filtered per step, in blocks. The
+per-step loop then runs over whole ``(S, H, W)`` arrays.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import RvsmError
+from .filtering import receptive_field_sums
+from .kernels import ModelSpec, model_spec
+from .noise import NoiseParams, NoiseSource
+from .scene import Scene, interpolate
+
+RESET_MODES = ("zero", "subtract")
+DEFAULT_PHI = 400.0
+DEFAULT_BLOCK_STEPS = 32
+
+
+@dataclass(frozen=True)
+class SamplerConfig:
+    """Everything that decides a float sampler's spikes besides the scene.
+
+    ``phi`` is the nominal threshold in 8-bit brightness units; ``scale_phi`` optionally
+    overrides it per scale (length S); ``reset`` is ``"zero"`` (the paper) or
+    ``"subtract"``; ``noise`` is ``None`` for a noiseless sensor.
+    """
+
+    model: str = "dog4"
+    phi: float = DEFAULT_PHI
+    scale_phi: tuple[float, ...] | None = None
+    reset: str = "zero"
+    noise: NoiseParams | None = None
+
+    def __post_init__(self) -> None:
+        spec = model_spec(self.model)
+        object.__setattr__(self, "model", spec.name)
+        if isinstance(self.phi, bool) or not np.isfinite(self.phi) or self.phi <= 0:
+            raise RvsmError(f"threshold phi must be a finite number > 0, got {self.phi!r}")
+        if self.scale_phi is not None:
+            values = tuple(float(v) for v in self.scale_phi)
+            if len(values) != spec.num_scales:
+                raise RvsmError(
+                    f"{spec.name} has {spec.num_scales} scale(s) but "
+                    f"{len(values)} per-scale thresholds were given"
+                )
+            if not all(np.isfinite(v) and v > 0 for v in values):
+                raise RvsmError(f"per-scale thresholds must be finite and > 0, got {values}")
+            object.__setattr__(self, "scale_phi", values)
+        if self.reset not in RESET_MODES:
+            raise RvsmError(f"reset must be one of {RESET_MODES}, got {self.reset!r}")
+
+    @property
+    def spec(self) -> ModelSpec:
+        """The parsed model (family, scales, kernels)."""
+        return model_spec(self.model)
+
+    @property
+    def phis(self) -> np.ndarray:
+        """Nominal threshold per scale, ``(S,) float64``."""
+        if self.scale_phi is not None:
+            return np.array(self.scale_phi, dtype=np.float64)
+        return np.full(self.spec.num_scales, float(self.phi))
+
+    def to_dict(self) -> dict:
+        """Plain-JSON form, for spike-file metadata."""
+        return {
+            "model": self.model,
+            "phi": float(self.phi),
+            "scale_phi": list(self.scale_phi) if self.scale_phi is not None else None,
+            "reset": self.reset,
+            "noise": self.noise.to_dict() if self.noise is not None else None,
+        }
+
+
+@dataclass
+class SpikeTrain:
+    """Sampler output: ``spikes (T, S, H, W) int8`` in {-1, 0, 1} and its thresholds.
+
+    ``thresholds`` is ``(S, H, W) float64``, the per-accumulator thresholds actually used
+    (fixed-pattern noise included).
+    """
+
+    spikes: np.ndarray
+    thresholds: np.ndarray
+    config: SamplerConfig
+    meta: dict = field(default_factory=dict)
+
+
+def accumulator_thresholds(config: SamplerConfig, shape: tuple[int, int]) -> np.ndarray:
+    """Per-accumulator thresholds ``(S, H, W) float64``: nominal, or with fixed pattern.
+
+    Thresholds are clipped at 0; at a zero threshold the +1 comparison wins.
+    """
+    phis = config.phis
+    if config.noise is None:
+        thr = np.broadcast_to(phis[:, None, None], (len(phis),) + tuple(shape)).copy()
+    else:
+        thr = NoiseSource(config.noise, shape, len(phis)).thresholds(phis)
+    return np.maximum(thr, 0.0)
+
+
+def step_drive_blocks(scene: Scene, config: SamplerConfig, block_steps: int):
+    """Yield ``(t0, t1, drive)`` with ``drive (B, S, H, W) float64``: per-step input of
+    every accumulator (receptive-field sum of brightness plus filtered dark current)."""
+    kernels = config.spec.kernels()
+    filtered = receptive_field_sums(scene.frames, kernels)  # (F, S, H, W)
+    noise = (
+        NoiseSource(config.noise, scene.shape, len(kernels)) if config.noise else None
+    )
+    for t0, t1 in scene.blocks(block_steps):
+        f, a = scene.frame_weights(t0, t1)
+        drive = interpolate(filtered, f, a)
+        if noise is not None:
+            drive += receptive_field_sums(noise.dark_current(t1 - t0), kernels)
+        yield t0, t1, drive
+
+
+class Integrator:
+    """The per-step integrate / compare / fire / reset state of ``S x H x W`` accumulators.
+
+    ``thresholds`` is ``(S, H, W)``; ``signed`` models fire -1 at ``acc <= -thr``.
+    """
+
+    def __init__(self, thresholds: np.ndarray, signed: bool, reset: str):
+        self.thr = np.ascontiguousarray(thresholds, dtype=np.float64)
+        self.neg_thr = -self.thr
+        self.signed = signed
+        self.reset = reset
+        self.acc = np.zeros_like(self.thr)
+        self._pos = np.empty(self.thr.shape, dtype=bool)
+        self._neg = np.empty(self.thr.shape, dtype=bool)
+        # +1 wins where a threshold is 0 and both comparisons hold.
+        self._zero_thr = bool(np.any(self.thr == 0))
+
+    def step(self, drive: np.ndarray, out: np.ndarray) -> None:
+        """Integrate one step's ``drive (S, H, W)`` and write spikes into ``out (S, H, W)
+        int8``."""
+        acc, pos, neg = self.acc, self._pos, self._neg
+        acc += drive
+        np.greater_equal(acc, self.thr, out=pos)
+        if self.signed:
+            np.less_equal(acc, self.neg_thr, out=neg)
+            if self._zero_thr:
+                neg &= ~pos
+            np.subtract(pos.view(np.int8), neg.view(np.int8), out=out)
+        else:
+            out[...] = pos.view(np.int8)
+        if self.reset == "zero":
+            np.copyto(acc, 0.0, where=pos)
+            if self.signed:
+                np.copyto(acc, 0.0, where=neg)
+        else:
+            np.subtract(acc, self.thr, out=acc, where=pos)
+            if self.signed:
+                np.add(acc, self.thr, out=acc, where=neg)
+
+
+def sample(
+    scene: Scene,
+    config: SamplerConfig,
+    block_steps: int = DEFAULT_BLOCK_STEPS,
+    progress: bool = False,
+) -> SpikeTrain:
+    """Run a float sampler over a whole scene.
+
+    Returns a :class:`SpikeTrain` with ``spikes (T, S, H, W) int8`` (S = 1 for FSM).
+    """
+    spec = config.spec
+    thresholds = accumulator_thresholds(config, scene.shape)
+    integrator = Integrator(thresholds, spec.signed, config.reset)
+    spikes = np.zeros((scene.num_steps, spec.num_scales) + scene.shape, dtype=np.int8)
+    bar = _progress_bar(scene.num_steps, f"{spec.name} {scene.name}", progress)
+    for t0, t1, drive in step_drive_blocks(scene, config, block_steps):
+        for b in range(t1 - t0):
+            integrator.step(drive[b], spikes[t0 + b])
+        bar.update(t1 - t0)
+    bar.close()
+    return SpikeTrain(spikes, thresholds, config, sampling_meta(scene, config))
+
+
+def sampling_meta(scene: Scene, config: SamplerConfig) -> dict:
+    """Metadata needed to reproduce a spike train (goes into the spike file's ``meta``)."""
+    h, w = scene.shape
+    return {
+        "kind": "float",
+        "scene": scene.name,
+        "height": h,
+        "width": w,
+        "steps_per_frame": scene.steps_per_frame,
+        "hold": scene.hold,
+        "num_steps": scene.num_steps,
+        **config.to_dict(),
+    }
+
+
+def _progress_bar(total: int, desc: str, enabled: bool):
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, desc=desc, unit="step", disable=not enabled, leave=False)
+

@@ -1,0 +1,1 @@
+"""Simulation front end: the rvsm CLI, experiments, cocotb runners and design sweeps."""

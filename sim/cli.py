@@ -1,0 +1,55 @@
+"""The ``rvsm`` command line.
+
+Every module in :mod:`rvsm.sim.commands` exposes ``register(subparsers)``, which adds its
+sub-command(s) and sets ``func(args) -> int`` on them. Errors a user can fix are raised as
+:class:`~rvsm.model.errors.RvsmError` and printed here on one line, with exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import pkgutil
+import sys
+
+from rvsm.model.errors import RvsmError
+
+from . import commands
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full ``rvsm`` argument parser, with every discovered sub-command."""
+    parser = argparse.ArgumentParser(
+        prog="rvsm",
+        description="RVSM spike-camera digital twin: float model, fixed-point twin, "
+        "Amaranth RTL and cocotb verification.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
+        module = importlib.import_module(f"{commands.__name__}.{info.name}")
+        module.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``rvsm`` console script; returns the process exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.func(args) or 0)
+    except RvsmError as exc:
+        print(f"rvsm: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("rvsm: interrupted; finished results are kept, partial files removed",
+              file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
