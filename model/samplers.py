@@ -12,6 +12,7 @@ per-step loop then runs over whole ``(S, H, W)`` arrays.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,7 +21,7 @@ from .errors import RvsmError
 from .filtering import receptive_field_sums
 from .kernels import ModelSpec, model_spec
 from .noise import NoiseParams, NoiseSource
-from .scene import Scene, interpolate
+from .scene import Scene
 
 RESET_MODES = ("zero", "subtract")
 DEFAULT_PHI = 400.0
@@ -110,20 +111,40 @@ def accumulator_thresholds(config: SamplerConfig, shape: tuple[int, int]) -> np.
     return np.maximum(thr, 0.0)
 
 
-def step_drive_blocks(scene: Scene, config: SamplerConfig, block_steps: int):
-    """Yield ``(t0, t1, drive)`` with ``drive (B, S, H, W) float64``: per-step input of
-    every accumulator (receptive-field sum of brightness plus filtered dark current)."""
+def iter_step_drives(
+    scene: Scene, config: SamplerConfig, block_steps: int = DEFAULT_BLOCK_STEPS
+) -> Iterator[tuple[int, np.ndarray]]:
+    """Yield ``(t, drive)`` for every step: ``drive (S, H, W) float64`` is the input of
+    every accumulator at step ``t`` (receptive-field sum of brightness plus filtered dark
+    current). The array is a reused buffer: consume it before the next iteration.
+
+    Frames are filtered once; a step between frames is ``(1 - a) KF[f] + a KF[f+1]``
+    (SPEC section 1's interpolation applied after the linear filter). Dark current is
+    drawn and filtered in blocks of ``block_steps``.
+    """
     kernels = config.spec.kernels()
     filtered = receptive_field_sums(scene.frames, kernels)  # (F, S, H, W)
-    noise = (
-        NoiseSource(config.noise, scene.shape, len(kernels)) if config.noise else None
-    )
+    noise = NoiseSource(config.noise, scene.shape, len(kernels)) if config.noise else None
+    buf = np.empty(filtered.shape[1:])
+    tmp = np.empty_like(buf)
     for t0, t1 in scene.blocks(block_steps):
         f, a = scene.frame_weights(t0, t1)
-        drive = interpolate(filtered, f, a)
-        if noise is not None:
-            drive += receptive_field_sums(noise.dark_current(t1 - t0), kernels)
-        yield t0, t1, drive
+        dark = (
+            receptive_field_sums(noise.dark_current(t1 - t0), kernels)
+            if noise is not None else None
+        )
+        for b in range(t1 - t0):
+            if a[b] == 0.0:
+                drive = filtered[f[b]]
+            else:
+                np.multiply(filtered[f[b]], 1.0 - a[b], out=buf)
+                np.multiply(filtered[f[b] + 1], a[b], out=tmp)
+                buf += tmp
+                drive = buf
+            if dark is not None:
+                np.add(drive, dark[b], out=buf)
+                drive = buf
+            yield t0 + b, drive
 
 
 class Integrator:
@@ -140,30 +161,35 @@ class Integrator:
         self.acc = np.zeros_like(self.thr)
         self._pos = np.empty(self.thr.shape, dtype=bool)
         self._neg = np.empty(self.thr.shape, dtype=bool)
+        self._fired = np.empty(self.thr.shape, dtype=bool)
         # +1 wins where a threshold is 0 and both comparisons hold.
         self._zero_thr = bool(np.any(self.thr == 0))
 
     def step(self, drive: np.ndarray, out: np.ndarray) -> None:
         """Integrate one step's ``drive (S, H, W)`` and write spikes into ``out (S, H, W)
         int8``."""
-        acc, pos, neg = self.acc, self._pos, self._neg
+        acc = self.acc
         acc += drive
+        if not self.signed:
+            fired = out.view(bool)  # int8 0/1 and bool share a layout: compare in place
+            np.greater_equal(acc, self.thr, out=fired)
+            if self.reset == "zero":
+                np.copyto(acc, 0.0, where=fired)
+            else:
+                np.subtract(acc, self.thr, out=acc, where=fired)
+            return
+        pos, neg = self._pos, self._neg
         np.greater_equal(acc, self.thr, out=pos)
-        if self.signed:
-            np.less_equal(acc, self.neg_thr, out=neg)
-            if self._zero_thr:
-                neg &= ~pos
-            np.subtract(pos.view(np.int8), neg.view(np.int8), out=out)
-        else:
-            out[...] = pos.view(np.int8)
+        np.less_equal(acc, self.neg_thr, out=neg)
+        if self._zero_thr:
+            neg &= ~pos
+        np.subtract(pos.view(np.int8), neg.view(np.int8), out=out)
         if self.reset == "zero":
-            np.copyto(acc, 0.0, where=pos)
-            if self.signed:
-                np.copyto(acc, 0.0, where=neg)
+            np.logical_or(pos, neg, out=self._fired)
+            np.copyto(acc, 0.0, where=self._fired)
         else:
             np.subtract(acc, self.thr, out=acc, where=pos)
-            if self.signed:
-                np.add(acc, self.thr, out=acc, where=neg)
+            np.add(acc, self.thr, out=acc, where=neg)
 
 
 def sample(
@@ -181,10 +207,10 @@ def sample(
     integrator = Integrator(thresholds, spec.signed, config.reset)
     spikes = np.zeros((scene.num_steps, spec.num_scales) + scene.shape, dtype=np.int8)
     bar = _progress_bar(scene.num_steps, f"{spec.name} {scene.name}", progress)
-    for t0, t1, drive in step_drive_blocks(scene, config, block_steps):
-        for b in range(t1 - t0):
-            integrator.step(drive[b], spikes[t0 + b])
-        bar.update(t1 - t0)
+    for t, drive in iter_step_drives(scene, config, block_steps):
+        integrator.step(drive, spikes[t])
+        if (t + 1) % block_steps == 0 or t + 1 == scene.num_steps:
+            bar.update(bar.total and (t + 1) - bar.n)
     bar.close()
     return SpikeTrain(spikes, thresholds, config, sampling_meta(scene, config))
 
@@ -200,6 +226,7 @@ def sampling_meta(scene: Scene, config: SamplerConfig) -> dict:
         "steps_per_frame": scene.steps_per_frame,
         "hold": scene.hold,
         "num_steps": scene.num_steps,
+        "phis": [float(v) for v in config.phis],
         **config.to_dict(),
     }
 

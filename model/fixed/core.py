@@ -37,8 +37,21 @@ def integer_receptive_sums(codes: np.ndarray, weights: Sequence[np.ndarray]) -> 
     """Exact weighted sums of ADC codes over each receptive field, zero outside the array.
 
     ``codes`` is ``(B, H, W)`` non-negative integers; ``weights`` ``S`` odd square integer
-    arrays ``(2L+1, 2L+1)``; returns ``(B, S, H, W) int64``.
+    arrays ``(2L+1, 2L+1)``; returns ``(B, S, H, W) int64``. Kernels with the 8-fold
+    symmetry of the DoG / Gauss templates take a faster path that first sums the codes
+    of each symmetry orbit (shared by all scales); the result is the same integers as
+    :func:`integer_receptive_sums_direct`.
     """
+    kernels = [np.asarray(k, dtype=np.int64) for k in weights]
+    if all(_is_symmetric(k) for k in kernels):
+        return _symmetric_sums(np.asarray(codes, dtype=np.int64), kernels)
+    return integer_receptive_sums_direct(codes, kernels)
+
+
+def integer_receptive_sums_direct(
+    codes: np.ndarray, weights: Sequence[np.ndarray]
+) -> np.ndarray:
+    """Tap-by-tap reference of :func:`integer_receptive_sums` (any kernel)."""
     codes = np.asarray(codes, dtype=np.int64)
     b, h, w = codes.shape
     out = np.zeros((b, len(weights), h, w), dtype=np.int64)
@@ -56,9 +69,74 @@ def integer_receptive_sums(codes: np.ndarray, weights: Sequence[np.ndarray]) -> 
     return out
 
 
+def _is_symmetric(k: np.ndarray) -> bool:
+    return (
+        k.ndim == 2 and k.shape[0] == k.shape[1] and k.shape[0] % 2 == 1
+        and np.array_equal(k, k.T) and np.array_equal(k, k[::-1]) and np.array_equal(k, k[:, ::-1])
+    )
+
+
+def _symmetric_sums(codes: np.ndarray, kernels: list[np.ndarray]) -> np.ndarray:
+    """Sum codes per orbit ``{(+-a, +-b), (+-b, +-a)}`` once, then weight per scale."""
+    bsz, h, w = codes.shape
+    halves = [k.shape[0] // 2 for k in kernels]
+    big = max(halves)
+    padded = np.zeros((bsz, h + 2 * big, w + 2 * big), dtype=np.int64)
+    padded[:, big:big + h, big:big + w] = codes
+    # rows[b][:, y', x] = codes at (y', x - b) + (y', x + b), padded rows kept.
+    rows = []
+    for dj in range(big + 1):
+        r = padded[:, :, big - dj:big - dj + w].copy()
+        if dj:
+            r += padded[:, :, big + dj:big + dj + w]
+        rows.append(r)
+
+    def cols(x: np.ndarray, di: int) -> np.ndarray:
+        c = x[:, big - di:big - di + h].copy()
+        if di:
+            c += x[:, big + di:big + di + h]
+        return c
+
+    out = np.zeros((bsz, len(kernels), h, w), dtype=np.int64)
+    tmp = np.empty((bsz, h, w), dtype=np.int64)
+    for a in range(big + 1):
+        for b in range(a + 1):
+            users = [
+                (s, int(k[halves[s] + a, halves[s] + b]))
+                for s, k in enumerate(kernels) if halves[s] >= a
+            ]
+            users = [(s, wt) for s, wt in users if wt]
+            if not users:
+                continue
+            orbit = cols(rows[b], a)
+            if a != b:
+                orbit += cols(rows[a], b)
+            for s, wt in users:
+                np.multiply(orbit, wt, out=tmp)
+                out[:, s] += tmp
+    return out
+
+
 def arithmetic_shift(values: np.ndarray, shift: int) -> np.ndarray:
     """``values >> shift`` (floor of ``values / 2**shift``), as a hardware ``>>>`` does."""
     return np.right_shift(np.asarray(values, dtype=np.int64), int(shift))
+
+
+def bit_lengths(values: np.ndarray) -> np.ndarray:
+    """Bits of ``|v|`` (0 for 0, ``k`` for ``2**(k-1) <= |v| < 2**k``), ``int64``.
+
+    Exact for ``|v| < 2**53``; used only for the profiling histograms.
+    """
+    _, exponent = np.frexp(np.abs(np.asarray(values, dtype=np.int64)).astype(np.float64))
+    return exponent.astype(np.int64)
+
+
+def bit_length_histogram(values: np.ndarray) -> np.ndarray:
+    """Per scale (axis ``-3``), counts of :func:`bit_lengths`: ``(S, 64) int64``."""
+    v = np.asarray(values)
+    v = np.moveaxis(v.reshape((-1,) + v.shape[-3:]), 1, 0).reshape(v.shape[-3], -1)
+    bits = np.minimum(bit_lengths(v), 63)
+    return np.stack([np.bincount(row, minlength=64) for row in bits])
 
 
 class FixedIntegrator:
@@ -66,7 +144,10 @@ class FixedIntegrator:
 
     ``step(sums)`` takes one step's shifted sums ``(S, H, W) int64`` and returns spikes
     ``(S, H, W) int8``. ``saturated`` counts, per scale, the accumulator-steps at which
-    the pre-saturation value left the representable range.
+    the pre-saturation value left the representable range. With ``track=True`` it also
+    keeps, per scale, ``acc_min`` / ``acc_max`` of the pre-saturation values and, with
+    ``histogram=True``, ``acc_hist (S, 64)``: counts of :func:`bit_lengths` of them.
+    Tracking observes only; it never changes the spikes.
     """
 
     def __init__(
@@ -75,6 +156,8 @@ class FixedIntegrator:
         accumulator_bits: int,
         signed: bool,
         reset: str = "zero",
+        track: bool = False,
+        histogram: bool = False,
     ):
         if not 2 <= accumulator_bits <= 62:
             raise RvsmError(f"accumulator_bits must be 2..62, got {accumulator_bits}")
@@ -94,11 +177,21 @@ class FixedIntegrator:
         self.reset = reset
         self.acc = np.zeros_like(thr)
         self.saturated = np.zeros(thr.shape[0], dtype=np.int64)
+        self.track = track or histogram
+        num_scales = thr.shape[0]
+        self.acc_min = np.full(num_scales, np.iinfo(np.int64).max, dtype=np.int64)
+        self.acc_max = np.full(num_scales, np.iinfo(np.int64).min, dtype=np.int64)
+        self.acc_hist = np.zeros((num_scales, 64), dtype=np.int64) if histogram else None
 
     def step(self, sums: np.ndarray) -> np.ndarray:
         """Add ``sums (S, H, W) int64``, saturate, compare, reset; return spikes int8."""
         acc = self.acc
         acc += sums
+        if self.track:
+            np.minimum(self.acc_min, acc.min(axis=(1, 2)), out=self.acc_min)
+            np.maximum(self.acc_max, acc.max(axis=(1, 2)), out=self.acc_max)
+            if self.acc_hist is not None:
+                self.acc_hist += bit_length_histogram(acc)
         over = (acc > self.hi) | (acc < self.lo)
         self.saturated += over.sum(axis=(1, 2))
         np.clip(acc, self.lo, self.hi, out=acc)

@@ -1,0 +1,117 @@
+"""Spike files: the project's ``.npz`` format and the spike camera's ``.dat`` layout.
+
+``.npz``: ``spikes`` -- ``(T, S, H, W) int8`` in {-1, 0, 1} (S = 1 for FSM) -- and
+``meta`` -- a JSON string with every parameter needed to reproduce the file.
+
+``.dat`` (FSM only, as the camera writes it): no header; step after step, each step
+``H*W/8`` bytes holding one bit per pixel in row-major order, 8 pixels per byte, least
+significant bit first. The camera stores rows bottom-up; ``flip=True`` flips vertically on
+both export and import (SpikeCV's loaders do).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from .atomic import atomic_path
+from .errors import RvsmError
+
+
+def save_spikes(path: str | os.PathLike, spikes: np.ndarray, meta: dict) -> None:
+    """Write ``spikes (T, S, H, W) int8`` and ``meta`` to an ``.npz`` file, atomically."""
+    spikes = _check_spikes(np.asarray(spikes), str(path))
+    text = json.dumps(meta, sort_keys=True)
+    with atomic_path(path) as tmp, open(tmp, "wb") as handle:
+        np.savez_compressed(handle, spikes=spikes, meta=np.array(text))
+
+
+def load_spikes(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
+    """Read an ``.npz`` spike file: ``(spikes (T, S, H, W) int8, meta dict)``."""
+    path = Path(path)
+    if not path.is_file():
+        raise RvsmError(f"spike file {path} does not exist")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            missing = {"spikes", "meta"} - set(data.files)
+            if missing:
+                raise RvsmError(
+                    f"{path} is not an rvsm spike file: missing {', '.join(sorted(missing))}"
+                )
+            spikes = data["spikes"]
+            meta_text = str(data["meta"])
+    except RvsmError:
+        raise
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
+        raise RvsmError(
+            f"{path} is not a readable .npz spike file (truncated or corrupt?): {exc}"
+        ) from None
+    try:
+        meta = json.loads(meta_text)
+    except json.JSONDecodeError as exc:
+        raise RvsmError(f"{path}: 'meta' is not valid JSON ({exc})") from None
+    if not isinstance(meta, dict):
+        raise RvsmError(f"{path}: 'meta' must be a JSON object")
+    return _check_spikes(spikes, str(path)), meta
+
+
+def _check_spikes(spikes: np.ndarray, source: str) -> np.ndarray:
+    if spikes.ndim != 4:
+        raise RvsmError(f"{source}: spikes must have shape (T, S, H, W), got {spikes.shape}")
+    if not np.issubdtype(spikes.dtype, np.integer):
+        raise RvsmError(f"{source}: spikes must be integers, got dtype {spikes.dtype}")
+    if spikes.size and (spikes.min() < -1 or spikes.max() > 1):
+        raise RvsmError(f"{source}: spikes must hold only -1, 0 and 1")
+    return spikes.astype(np.int8, copy=False)
+
+
+def export_dat(path: str | os.PathLike, spikes: np.ndarray, flip: bool = False) -> None:
+    """Write FSM spikes ``(T, H, W)`` or ``(T, 1, H, W)`` of 0/1 in the camera's layout."""
+    spikes = np.asarray(spikes)
+    if spikes.ndim == 4:
+        if spikes.shape[1] != 1:
+            raise RvsmError(
+                f".dat holds one bit per pixel (FSM); these spikes have {spikes.shape[1]} "
+                "scales"
+            )
+        spikes = spikes[:, 0]
+    if spikes.ndim != 3:
+        raise RvsmError(f".dat export needs spikes (T, H, W), got shape {spikes.shape}")
+    if spikes.size and (spikes.min() < 0 or spikes.max() > 1):
+        raise RvsmError(".dat holds only 0/1 spikes; RVSM's -1 spikes cannot be exported")
+    t, h, w = spikes.shape
+    if (h * w) % 8:
+        raise RvsmError(f".dat needs H*W divisible by 8 (8 pixels per byte), got {h}x{w}")
+    frames = spikes[:, ::-1] if flip else spikes
+    packed = np.packbits(frames.reshape(t, h * w).astype(bool), axis=1, bitorder="little")
+    with atomic_path(path) as tmp:
+        packed.tofile(tmp)
+
+
+def import_dat(
+    path: str | os.PathLike, height: int, width: int, flip: bool = False
+) -> np.ndarray:
+    """Read a camera ``.dat`` file into spikes ``(T, 1, H, W) int8``."""
+    path = Path(path)
+    if not path.is_file():
+        raise RvsmError(f".dat file {path} does not exist")
+    if height < 1 or width < 1 or (height * width) % 8:
+        raise RvsmError(
+            f".dat size {height}x{width} invalid: H*W must be positive and divisible by 8"
+        )
+    step_bytes = height * width // 8
+    raw = np.fromfile(path, dtype=np.uint8)
+    if raw.size == 0 or raw.size % step_bytes:
+        raise RvsmError(
+            f"{path} is truncated or not {height}x{width}: {raw.size} bytes is not a whole "
+            f"number of steps of {step_bytes} bytes; check --size"
+        )
+    bits = np.unpackbits(raw.reshape(-1, step_bytes), axis=1, bitorder="little")
+    frames = bits.reshape(-1, height, width)
+    if flip:
+        frames = frames[:, ::-1]
+    return np.ascontiguousarray(frames[:, None]).astype(np.int8)

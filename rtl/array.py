@@ -1,0 +1,121 @@
+"""The fully parallel RVSM pixel array, built from one :class:`ArrayContract`.
+
+Architecture (one clock domain ``sync``, synchronous reset ``rst``)::
+
+    codes[H*W*N] --> per (scale, pixel): receptive weighted sum (constant shift-and-add,
+                     :mod:`rvsm.rtl.receptive_sum`) --> PixelCell (shift, saturate,
+                     compare, fire, reset; threshold register) --> spike_pos / spike_neg
+    cfg_we/cfg_addr/cfg_data --> address decode --> one cell's threshold register
+
+Bit ordering of the flat ports (all little-endian, index 0 = LSB):
+
+* ``codes``: pixel ``(y, x)`` at bits ``[(y*W + x)*N +: N]`` (unsigned ADC code);
+* ``spike_pos`` / ``spike_neg``: accumulator ``a = (s*H + y)*W + x`` at bit ``a``;
+* ``cfg_addr``: the same accumulator index ``a``; ``cfg_data`` the threshold
+  (``1 .. 2**(W-1)-1``), written when ``cfg_we`` is high at a clock edge.
+
+Timing: ``codes`` are sampled at a rising edge where ``strobe`` is high (one contract
+step per strobe; strobes may be back to back); the spikes of that step are on
+``spike_pos``/``spike_neg`` with ``valid`` high :attr:`RvsmArray.latency` cycles later
+and hold until the next strobe. ``clear`` (synchronous, priority over ``strobe``) zeroes
+every accumulator and spike but keeps the thresholds: a restart of the stream.
+
+The bit-accurate model of this component is :meth:`ArrayContract.run`.
+"""
+
+from __future__ import annotations
+
+from amaranth.hdl import Module, Signal, unsigned
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from rvsm.model.fixed.core import ArrayContract
+
+from .pixel_cell import PixelCell
+from .receptive_sum import sum_width, weighted_sum
+
+__all__ = ["RvsmArray", "accumulator_index"]
+
+
+def accumulator_index(contract: ArrayContract, scale: int, row: int, col: int) -> int:
+    """Flat index of accumulator ``(scale, row, col)``: ``(scale*H + row)*W + col``."""
+    return (scale * contract.height + row) * contract.width + col
+
+
+class RvsmArray(wiring.Component):
+    """``S x H x W`` accumulators over an ``H x W`` ADC-code input, from a contract.
+
+    Ports: ``codes`` In(H*W*N), ``strobe`` In(1), ``clear`` In(1), ``cfg_we`` In(1),
+    ``cfg_addr`` In(addr_bits), ``cfg_data`` In(W-1), ``spike_pos`` Out(S*H*W),
+    ``spike_neg`` Out(S*H*W), ``valid`` Out(1). See the module docstring for ordering.
+    """
+
+    #: Clock cycles from the strobe edge sampling ``codes`` to valid spike outputs.
+    LATENCY = PixelCell.LATENCY
+
+    def __init__(self, contract: ArrayContract):
+        self.contract = contract
+        c = contract
+        self.num_accumulators = c.num_scales * c.height * c.width
+        self.addr_bits = max(1, (self.num_accumulators - 1).bit_length())
+        super().__init__({
+            "codes": In(unsigned(c.height * c.width * c.adc_bits)),
+            "strobe": In(1),
+            "clear": In(1),
+            "cfg_we": In(1),
+            "cfg_addr": In(unsigned(self.addr_bits)),
+            "cfg_data": In(unsigned(c.threshold_bits)),
+            "spike_pos": Out(unsigned(self.num_accumulators)),
+            "spike_neg": Out(unsigned(self.num_accumulators)),
+            "valid": Out(1),
+        })
+
+    @property
+    def latency(self) -> int:
+        """Clock cycles from the strobe edge sampling ``codes`` to valid spike outputs."""
+        return self.LATENCY
+
+    def sum_bits(self, scale: int) -> int:
+        """Signed width of scale ``scale``'s exact weighted sum."""
+        return sum_width(*self.contract.sum_range(scale))
+
+    def elaborate(self, platform: object) -> Module:
+        """Weighted sums, cells, threshold address decode, valid pipeline."""
+        m = Module()
+        c = self.contract
+        h, w, n = c.height, c.width, c.adc_bits
+        pix = [[self.codes[(y * w + x) * n:(y * w + x + 1) * n] for x in range(w)]
+               for y in range(h)]
+
+        valid_pipe = [Signal(name=f"valid_d{i}") for i in range(self.latency)]
+        go = self.strobe & ~self.clear
+        for i, stage in enumerate(valid_pipe):
+            m.d.sync += stage.eq(go if i == 0 else valid_pipe[i - 1])
+        m.d.comb += self.valid.eq(valid_pipe[-1])
+
+        for s, kernel in enumerate(c.weights):
+            lo, hi = c.sum_range(s)
+            half = len(kernel) // 2
+            for y in range(h):
+                for x in range(w):
+                    taps, wts = [], []
+                    for di, row in enumerate(kernel):
+                        for dj, wt in enumerate(row):
+                            yy, xx = y + di - half, x + dj - half
+                            if wt and 0 <= yy < h and 0 <= xx < w:
+                                taps.append(pix[yy][xx])
+                                wts.append(wt)
+                    a = accumulator_index(c, s, y, x)
+                    cell = PixelCell(sum_width(lo, hi), c.shift, c.accumulator_bits,
+                                     c.signed, c.reset)
+                    m.submodules[f"cell_s{s}_y{y}_x{x}"] = cell
+                    m.d.comb += [
+                        cell.sum_in.eq(weighted_sum(taps, wts, lo, hi)),
+                        cell.strobe.eq(self.strobe),
+                        cell.clear.eq(self.clear),
+                        cell.thr_we.eq(self.cfg_we & (self.cfg_addr == a)),
+                        cell.thr_data.eq(self.cfg_data),
+                        self.spike_pos[a].eq(cell.spike_pos),
+                        self.spike_neg[a].eq(cell.spike_neg),
+                    ]
+        return m

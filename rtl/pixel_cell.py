@@ -1,0 +1,106 @@
+"""One RVSM accumulator: threshold register, W-bit saturating add, compare, fire, reset.
+
+The cell is independent of how its input sum is produced, so the same cell serves the
+fully parallel :class:`~rvsm.rtl.array.RvsmArray` and a later column-streaming array.
+Per strobe it implements steps 2..5 of the contract (:mod:`rvsm.model.fixed.core`)::
+
+    shifted = sum_in >>> shift                         (arithmetic, floor)
+    sat     = clamp(acc + shifted, -2**(W-1), 2**(W-1)-1)
+    pos     = sat >= thr;  neg = signed and not pos and sat <= -thr
+    acc    <= 0 | sat - thr*pos + thr*neg | sat         (reset "zero" / "subtract" / none)
+    spike_pos, spike_neg <= pos, neg                    (registered; LATENCY = 1)
+
+Control, all synchronous: ``clear`` (priority) zeroes the accumulator and the spike
+outputs and keeps the threshold; ``thr_we`` loads ``thr_data`` into the threshold
+register (any time; it takes effect from the next strobe). The domain reset returns the
+threshold to its ``init`` value ``2**(W-1) - 1``.
+"""
+
+from __future__ import annotations
+
+from amaranth.hdl import Module, Mux, Signal, signed, unsigned
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+__all__ = ["PixelCell"]
+
+
+class PixelCell(wiring.Component):
+    """The accumulator of one (scale, pixel).
+
+    Parameters: ``sum_bits`` (signed width of ``sum_in``), ``shift``, ``accumulator_bits``
+    (W), ``signed_model`` (fire -1 spikes), ``reset`` (``"zero"`` or ``"subtract"``).
+
+    Ports: ``sum_in`` In(signed(sum_bits)); ``strobe``, ``clear``, ``thr_we`` In(1);
+    ``thr_data`` In(W-1); ``spike_pos``, ``spike_neg`` Out(1), registered, valid
+    :attr:`LATENCY` cycles after the strobe; ``acc`` Out(signed(W)) for observation.
+    """
+
+    #: Clock cycles from the strobe edge that samples ``sum_in`` to valid spike outputs.
+    LATENCY = 1
+
+    def __init__(
+        self,
+        sum_bits: int,
+        shift: int,
+        accumulator_bits: int,
+        signed_model: bool,
+        reset: str = "zero",
+    ):
+        if reset not in ("zero", "subtract"):
+            raise ValueError(f"reset must be 'zero' or 'subtract', got {reset!r}")
+        self.sum_bits = sum_bits
+        self.shift = shift
+        self.accumulator_bits = accumulator_bits
+        self.signed_model = signed_model
+        self.reset = reset
+        super().__init__({
+            "sum_in": In(signed(sum_bits)),
+            "strobe": In(1),
+            "clear": In(1),
+            "thr_we": In(1),
+            "thr_data": In(unsigned(accumulator_bits - 1)),
+            "spike_pos": Out(1),
+            "spike_neg": Out(1),
+            "acc": Out(signed(accumulator_bits)),
+        })
+
+    @property
+    def acc_range(self) -> tuple[int, int]:
+        """``(lo, hi)`` of the W-bit signed accumulator."""
+        w = self.accumulator_bits
+        return -(1 << (w - 1)), (1 << (w - 1)) - 1
+
+    def elaborate(self, platform: object) -> Module:
+        """Registers and next-state logic of the cell."""
+        m = Module()
+        lo, hi = self.acc_range
+        w = self.accumulator_bits
+        thr = Signal(unsigned(w - 1), init=hi)
+        acc = Signal(signed(w))
+        m.d.comb += self.acc.eq(acc)
+
+        shifted = self.sum_in >> self.shift if self.shift else self.sum_in
+        total = Signal(signed(max(w, len(shifted)) + 1))
+        m.d.comb += total.eq(acc + shifted)
+        sat = Signal(signed(w))
+        m.d.comb += sat.eq(Mux(total > hi, hi, Mux(total < lo, lo, total)))
+
+        pos = Signal()
+        neg = Signal()
+        m.d.comb += pos.eq(sat >= thr)
+        if self.signed_model:
+            m.d.comb += neg.eq(~pos & (sat <= -thr))
+
+        if self.reset == "zero":
+            after = Mux(pos | neg, 0, sat)
+        else:
+            after = Mux(pos, sat - thr, Mux(neg, sat + thr, sat))
+
+        with m.If(self.thr_we):
+            m.d.sync += thr.eq(self.thr_data)
+        with m.If(self.clear):
+            m.d.sync += [acc.eq(0), self.spike_pos.eq(0), self.spike_neg.eq(0)]
+        with m.Elif(self.strobe):
+            m.d.sync += [acc.eq(after), self.spike_pos.eq(pos), self.spike_neg.eq(neg)]
+        return m

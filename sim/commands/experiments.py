@@ -1,0 +1,131 @@
+"""``rvsm table`` (paper Table 1 / Fig. 6) and ``rvsm robustness`` (paper Fig. 8)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from rvsm.model.atomic import atomic_path, write_text_atomic
+from rvsm.model.errors import RvsmError
+from rvsm.model.samplers import DEFAULT_PHI
+
+from .. import experiments as ex
+
+# Defaults of ``rvsm table``: the built-in scenes' full 250 x 400 canvas and 41 frames
+# (400 steps) take ~TABLE_MINUTES on a 2-core machine; see docs/reproduction.md.
+TABLE_SIZE = (250, 400)
+TABLE_FRAMES = 41
+TABLE_STEPS_PER_FRAME = 10
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``"HxW"`` -> ``(H, W)``, both >= 8."""
+    try:
+        h, w = (int(v) for v in str(text).lower().split("x"))
+    except ValueError:
+        raise RvsmError(f"size must look like HxW (e.g. 250x400), got {text!r}") from None
+    if h < 8 or w < 8:
+        raise RvsmError(f"size must be at least 8x8 (SSIM needs 7x7), got {h}x{w}")
+    return h, w
+
+
+def parse_floats(text: str) -> list[float]:
+    """``"0,0.5,1"`` -> ``[0.0, 0.5, 1.0]`` (each >= 0)."""
+    try:
+        values = [float(v) for v in str(text).split(",") if v.strip()]
+    except ValueError:
+        raise RvsmError(f"expected comma-separated numbers, got {text!r}") from None
+    if not values or any(v < 0 for v in values):
+        raise RvsmError(f"noise intensities must be a non-empty list of numbers >= 0: {text!r}")
+    return values
+
+
+def _positive(name: str, value: int) -> int:
+    if value < 1:
+        raise RvsmError(f"{name} must be >= 1, got {value}")
+    return value
+
+
+def save_figure(fig, path: Path) -> None:
+    """Write a matplotlib figure atomically (format from the suffix)."""
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp)
+
+
+def cmd_table(args: argparse.Namespace) -> int:
+    """Run the quality table and write table.md, table.csv and fig6.png."""
+    names = [n.strip() for item in (args.scenes or []) for n in item.split(",") if n.strip()]
+    scenes = ex.load_scenes(
+        names or None,
+        parse_size(args.size),
+        _positive("--frames", args.frames),
+        _positive("--steps-per-frame", args.steps_per_frame),
+    )
+    result = ex.run_table(scenes, seed=args.seed, phi=args.phi, progress=not args.quiet)
+    out = Path(args.output)
+    h, w = scenes[0].shape
+    note = (
+        f"\n{len(scenes)} scenes at {h}x{w}, {scenes[0].num_frames} frames x "
+        f"{scenes[0].steps_per_frame} steps/frame ({scenes[0].num_steps} steps), "
+        f"phi={args.phi:g}, noise NoiseParams(k=1, seed={args.seed}); "
+        f"{len(result.rows)} runs in {result.seconds:.0f} s.\n"
+    )
+    write_text_atomic(out / "table.md", ex.table_markdown(result) + note)
+    write_text_atomic(out / "table.csv", ex.table_csv(result))
+    save_figure(ex.table_figure(result), out / "fig6.png")
+    print(f"wrote {out / 'table.md'}, table.csv, fig6.png ({result.seconds:.0f} s)")
+    return 0
+
+
+def cmd_robustness(args: argparse.Namespace) -> int:
+    """Run the robustness sweep and write robustness.csv, robustness.json, fig8.png."""
+    size = parse_size(args.size)
+    result = ex.run_robustness(
+        parse_floats(args.ks), size, _positive("--steps", args.steps), seed=args.seed,
+        phi=args.phi, progress=not args.quiet,
+    )
+    out = Path(args.output)
+    write_text_atomic(out / "robustness.csv", ex.robustness_csv(result))
+    write_text_atomic(out / "robustness.json", json.dumps(result.rows, indent=1) + "\n")
+    save_figure(ex.robustness_figure(result), out / "fig8.png")
+    print(f"wrote {out / 'robustness.csv'}, robustness.json, fig8.png "
+          f"({result.seconds:.0f} s)")
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add the ``table`` and ``robustness`` sub-commands."""
+    p = subparsers.add_parser(
+        "table", help="paper Table 1 / Fig. 6: quality of every model on the built-in scenes",
+        description="Sample every built-in scene with FSM, One..Four DoG and One..Four Gauss, "
+        "without and with noise (k=1), reconstruct, match brightness and score MSE/PSNR/SSIM.",
+    )
+    p.add_argument("--scenes", nargs="+", help="scene names (default: all built-in scenes)")
+    p.add_argument("--size", default="x".join(map(str, TABLE_SIZE)),
+                   help="HxW (default %(default)s)")
+    p.add_argument("--frames", type=int, default=TABLE_FRAMES, help="frames (default %(default)s)")
+    p.add_argument("--steps-per-frame", type=int, default=TABLE_STEPS_PER_FRAME,
+                   help="sampling steps per frame (default %(default)s)")
+    p.add_argument("--seed", type=int, default=0, help="noise seed (default %(default)s)")
+    p.add_argument("--phi", type=float, default=DEFAULT_PHI, help="threshold (default %(default)s)")
+    p.add_argument("-o", "--output", default="out/table",
+                   help="output folder (default %(default)s)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_table)
+
+    p = subparsers.add_parser(
+        "robustness", help="paper Fig. 8: noise spikes of a black scene vs noise intensity k",
+        description="Black scene, sweep the noise intensity k, count spikes of FSM, "
+        "One..Four DoG and Four Gauss: ASS, ASAS and ASASS per scale.",
+    )
+    p.add_argument("--ks", default=",".join(f"{k:g}" for k in ex.DEFAULT_KS),
+                   help="comma-separated noise intensities (default %(default)s)")
+    p.add_argument("--size", default="100x100", help="HxW (default %(default)s)")
+    p.add_argument("--steps", type=int, default=1000, help="steps T (default %(default)s)")
+    p.add_argument("--seed", type=int, default=0, help="noise seed (default %(default)s)")
+    p.add_argument("--phi", type=float, default=DEFAULT_PHI, help="threshold (default %(default)s)")
+    p.add_argument("-o", "--output", default="out/robustness",
+                   help="output folder (default %(default)s)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_robustness)

@@ -1,0 +1,157 @@
+"""Fixed-point twin commands: ``config new|check``, ``stimulus``, ``profile``, ``cost``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from rvsm.model.errors import RvsmError
+
+from ..cli_args import add_scene_arguments, load_scene_from_args, parse_size_arg
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``config``, ``stimulus``, ``profile`` and ``cost``."""
+    p = sub.add_parser("config", help="fixed-point design points (TOML)",
+                       description="Write or check a fixed-point design point (SPEC section 5).")
+    cfg = p.add_subparsers(dest="config_command", metavar="ACTION", required=True)
+    q = cfg.add_parser("new", help="print the documented default design point as TOML")
+    q.add_argument("-o", "--output", help="write to this file instead of stdout")
+    q.add_argument("--size", metavar="HxW", help="array size (default 250x400)")
+    q.set_defaults(func=run_config_new)
+    q = cfg.add_parser("check", help="validate a design point and print its integers")
+    q.add_argument("point", help="design point .toml")
+    q.set_defaults(func=run_config_check)
+
+    p = sub.add_parser("stimulus", help="RTL stimulus: ADC codes, thresholds, expected spikes",
+                       description="Run the fixed twin and save what a testbench needs: "
+                       "codes (T,H,W) uint16, thresholds (S,H,W) int64, spikes (T,S,H,W) "
+                       "int8, weights and the contract (.npz).")
+    _common(p)
+    p.add_argument("--steps", type=int, default=None, help="keep only the first N steps")
+    p.add_argument("-o", "--output", required=True, help="output stimulus .npz")
+    p.set_defaults(func=run_stimulus)
+
+    p = sub.add_parser("profile", help="quantisation profile (saturation, ranges, weights)",
+                       description="Print per-scale saturation counts, observed sum and "
+                       "accumulator ranges against the representable ones and the weight "
+                       "quantisation error; write an hls4ml-style numerical plot.")
+    _common(p)
+    p.add_argument("--plot", default="fixed-profile.png",
+                   help="plot file (default fixed-profile.png; '' for none)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=run_profile)
+
+    p = sub.add_parser("cost", help="what quantisation costs: fixed vs float spikes and PSNR",
+                       description="Run the float model and the fixed twin on the same scene, "
+                       "seed and noise; report spike agreement and PSNR/SSIM of both.")
+    _common(p)
+    p.add_argument("--method", default="auto", choices=("auto", "tfi", "tfp", "rvsm"))
+    p.add_argument("--match", default="gain", choices=("gain", "affine"))
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=run_cost)
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    add_scene_arguments(p)
+    p.add_argument("--fixed", required=True, metavar="POINT.toml", help="design point")
+
+
+def _point_and_scene(args: argparse.Namespace):
+    from rvsm.model.fixed.config import load_design_point
+
+    point = load_design_point(args.fixed)
+    size = parse_size_arg(args.size)
+    if size is not None:
+        point = point.with_size(*size)
+    scene = load_scene_from_args(args, size=point.shape)
+    if scene.shape != point.shape:
+        raise RvsmError(
+            f"scene {scene.name!r} is {scene.shape[0]}x{scene.shape[1]} but the design point "
+            f"is {point.height}x{point.width}; pass --size {scene.shape[0]}x{scene.shape[1]}"
+        )
+    return point, scene
+
+
+def run_config_new(args: argparse.Namespace) -> int:
+    """``rvsm config new``."""
+    from rvsm.model.fixed.config import default_design_point, design_point_toml
+    from rvsm.model.fixed.config import save_design_point
+
+    point = default_design_point()
+    size = parse_size_arg(args.size)
+    if size is not None:
+        point = point.with_size(*size)
+    if args.output:
+        save_design_point(args.output, point)
+        print(f"wrote {args.output}", file=sys.stderr)
+    else:
+        sys.stdout.write(design_point_toml(point))
+    return 0
+
+
+def run_config_check(args: argparse.Namespace) -> int:
+    """``rvsm config check``."""
+    from rvsm.model.fixed.config import load_design_point
+
+    p = load_design_point(args.point)
+    c = p.contract()
+    print(f"{args.point}: valid design point, {p.model} on {p.height}x{p.width}")
+    print(f"  ADC {p.adc_bits} bits, {p.adc_gain:.6g} codes per brightness unit "
+          f"({p.adc_rounding}, {p.adc_clip})")
+    print(f"  weights {p.weight_bits} bits / {p.weight_frac_bits} fraction "
+          f"({p.weight_rounding}); shift {p.shift}; accumulator {p.accumulator_bits} bits")
+    for s, t in enumerate(p.nominal_thresholds()):
+        lo, hi = c.sum_range(s)
+        print(f"  scale {s}: threshold {int(t)} LSBs (phi {p.phis[s]:g}), "
+              f"per-step sum {lo}..{hi}, kernel {len(c.weights[s])}x{len(c.weights[s])}")
+    return 0
+
+
+def run_stimulus(args: argparse.Namespace) -> int:
+    """``rvsm stimulus``."""
+    from rvsm.model.fixed.stimulus import make_stimulus, save_stimulus
+
+    point, scene = _point_and_scene(args)
+    stim = make_stimulus(scene, point, progress=True, num_steps=args.steps)
+    save_stimulus(args.output, stim)
+    t, s, h, w = stim.spikes.shape
+    print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}, "
+          f"{int((stim.spikes != 0).sum())} expected spikes")
+    return 0
+
+
+def run_profile(args: argparse.Namespace) -> int:
+    """``rvsm profile``."""
+    from rvsm.model.atomic import atomic_path
+    from rvsm.model.fixed.profile import format_profile, profile_figure, profile_report
+    from rvsm.model.fixed.twin import simulate_fixed
+
+    point, scene = _point_and_scene(args)
+    run = simulate_fixed(scene, point, progress=True, histograms=True)
+    report = profile_report(run)
+    if args.plot:
+        fig = profile_figure(run)
+        with atomic_path(args.plot) as tmp:
+            fig.savefig(tmp, dpi=110)
+        report["plot"] = str(Path(args.plot))
+    if args.json:
+        print(json.dumps(report))
+    else:
+        print(format_profile(report))
+        if args.plot:
+            print(f"\nwrote {args.plot}")
+    return 0
+
+
+def run_cost(args: argparse.Namespace) -> int:
+    """``rvsm cost``."""
+    from rvsm.model.fixed.cost import format_cost, quantisation_cost
+
+    point, scene = _point_and_scene(args)
+    result = quantisation_cost(scene, point, method=args.method, match=args.match,
+                               progress=not args.json)
+    print(json.dumps(result) if args.json else format_cost(result))
+    return 0

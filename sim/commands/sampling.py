@@ -1,0 +1,168 @@
+"""``rvsm simulate``, ``rvsm evaluate`` and ``rvsm dat``: spike files in and out."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+
+from rvsm.model.errors import RvsmError
+from rvsm.model.samplers import DEFAULT_PHI, RESET_MODES, SamplerConfig, sample
+from rvsm.model.spike_files import export_dat, import_dat, load_spikes, save_spikes
+
+from ..cli_args import (
+    add_noise_arguments,
+    add_scene_arguments,
+    load_scene_from_args,
+    noise_from_args,
+    parse_size_arg,
+    scene_from_meta,
+    scene_meta,
+)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``simulate``, ``evaluate`` and ``dat``."""
+    p = sub.add_parser("simulate", help="sample a scene into a spike file (.npz)",
+                       description="Sample a scene with a float model or a fixed-point "
+                       "design point and write spikes (T,S,H,W) int8 plus meta to .npz.")
+    add_scene_arguments(p)
+    p.add_argument("--model", default=None,
+                   help="fsm, dog1..dog4 or gauss1..gauss4 (default dog4)")
+    p.add_argument("--phi", type=float, default=None, help=f"threshold (default {DEFAULT_PHI:g})")
+    p.add_argument("--scale-phi", default=None, metavar="P1,P2,..",
+                   help="per-scale thresholds, comma-separated")
+    p.add_argument("--reset", choices=RESET_MODES, default=None, help="reset mode (default zero)")
+    add_noise_arguments(p)
+    p.add_argument("--fixed", metavar="POINT.toml",
+                   help="run the bit-accurate fixed-point twin of this design point instead")
+    p.add_argument("-o", "--output", required=True, help="output .npz spike file")
+    p.add_argument("--dat", metavar="FILE.dat", help="also export FSM spikes as camera .dat")
+    p.add_argument("--flip", action="store_true", help="flip vertically in the .dat file")
+    p.set_defaults(func=run_simulate)
+
+    p = sub.add_parser("evaluate", help="reconstruct a spike file and score it",
+                       description="Reconstruct spikes (TFI for FSM, the RVSM inverse "
+                       "otherwise), match brightness and print MSE, PSNR and SSIM.")
+    p.add_argument("spikes", help=".npz spike file")
+    p.add_argument("scene", nargs="?", default=None,
+                   help="scene to score against (default: the one in the file's meta)")
+    p.add_argument("--method", default="auto", choices=("auto", "tfi", "tfp", "rvsm"))
+    p.add_argument("--match", default="gain", choices=("gain", "affine"),
+                   help="brightness matching before scoring")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=run_evaluate)
+
+    p = sub.add_parser("dat", help="convert FSM spikes to/from the camera's .dat layout")
+    dat_sub = p.add_subparsers(dest="dat_command", metavar="ACTION", required=True)
+    q = dat_sub.add_parser("export", help=".npz (FSM) -> .dat")
+    q.add_argument("spikes", help=".npz spike file")
+    q.add_argument("-o", "--output", required=True, help="output .dat")
+    q.add_argument("--flip", action="store_true", help="flip vertically (camera row order)")
+    q.set_defaults(func=run_dat_export)
+    q = dat_sub.add_parser("import", help=".dat -> .npz")
+    q.add_argument("dat", help="camera .dat file")
+    q.add_argument("--size", required=True, metavar="HxW", help="sensor size, e.g. 250x400")
+    q.add_argument("--flip", action="store_true", help="flip vertically (camera row order)")
+    q.add_argument("-o", "--output", required=True, help="output .npz")
+    q.set_defaults(func=run_dat_import)
+
+
+def _float_config(args: argparse.Namespace) -> SamplerConfig:
+    scale_phi = None
+    if args.scale_phi:
+        try:
+            scale_phi = tuple(float(v) for v in args.scale_phi.split(","))
+        except ValueError:
+            raise RvsmError(
+                f"--scale-phi must be comma-separated numbers, got {args.scale_phi!r}"
+            ) from None
+    return SamplerConfig(
+        model=args.model or "dog4",
+        phi=DEFAULT_PHI if args.phi is None else args.phi,
+        scale_phi=scale_phi,
+        reset=args.reset or "zero",
+        noise=noise_from_args(args),
+    )
+
+
+def run_simulate(args: argparse.Namespace) -> int:
+    """``rvsm simulate``."""
+    if args.dat and not args.dat.endswith(".dat"):
+        raise RvsmError(f"--dat expects a .dat path, got {args.dat!r}")
+    if args.fixed:
+        given = [f"--{n.replace('_', '-')}" for n in
+                 ("model", "phi", "scale_phi", "reset", "noise", "k", "seed")
+                 if getattr(args, n) is not None]
+        if given:
+            raise RvsmError(f"{', '.join(given)} come(s) from the design point with --fixed; "
+                            "edit the TOML instead")
+        from rvsm.model.fixed.config import load_design_point
+        from rvsm.model.fixed.twin import simulate_fixed
+
+        point = load_design_point(args.fixed)
+        size = parse_size_arg(args.size)
+        if size is not None:
+            point = point.with_size(*size)
+        scene = load_scene_from_args(args, size=(point.height, point.width))
+        run = simulate_fixed(scene, point, progress=True)
+        spikes, meta = run.spikes, dict(run.meta)
+    else:
+        config = _float_config(args)
+        scene = load_scene_from_args(args)
+        train = sample(scene, config, progress=True)
+        spikes, meta = train.spikes, dict(train.meta)
+    meta.update(scene_meta(args, scene))
+    if args.dat:
+        export_dat(args.dat, spikes, flip=args.flip)
+    save_spikes(args.output, spikes, meta)
+    t, s, h, w = spikes.shape
+    print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}, "
+          f"{int(np.count_nonzero(spikes))} spikes ({int((spikes < 0).sum())} negative)")
+    return 0
+
+
+def run_evaluate(args: argparse.Namespace) -> int:
+    """``rvsm evaluate``."""
+    from rvsm.model.evaluation import evaluate_spikes
+
+    spikes, meta = load_spikes(args.spikes)
+    scene = scene_from_meta(meta, override=args.scene)
+    if spikes.shape[0] != scene.num_steps or spikes.shape[2:] != scene.shape:
+        raise RvsmError(
+            f"spikes {spikes.shape} do not fit scene {scene.name!r} "
+            f"({scene.num_steps} steps, {scene.shape[0]}x{scene.shape[1]})"
+        )
+    model = meta.get("model")
+    phis = meta.get("phis")
+    if model is None or phis is None:
+        raise RvsmError("the spike file's meta lacks 'model' or 'phis'; re-run rvsm simulate")
+    result = evaluate_spikes(spikes, scene, model, np.asarray(phis, dtype=np.float64),
+                             method=args.method, match=args.match)
+    if args.json:
+        print(json.dumps({**result, "model": model, "scene": scene.name}, default=float))
+    else:
+        print(f"{scene.name} {model}: MSE {result['mse']:.2f}  PSNR {result['psnr']:.2f} dB  "
+              f"SSIM {result['ssim']:.3f}  ({result['num_scored']} steps scored after "
+              f"{result['warmup']} warm-up steps, {result['method']})")
+    return 0
+
+
+def run_dat_export(args: argparse.Namespace) -> int:
+    """``rvsm dat export``."""
+    spikes, _ = load_spikes(args.spikes)
+    export_dat(args.output, spikes, flip=args.flip)
+    print(f"wrote {args.output}: {spikes.shape[0]} steps of {spikes.shape[2]}x{spikes.shape[3]}")
+    return 0
+
+
+def run_dat_import(args: argparse.Namespace) -> int:
+    """``rvsm dat import``."""
+    h, w = parse_size_arg(args.size)
+    spikes = import_dat(args.dat, h, w, flip=args.flip)
+    meta = {"kind": "camera", "model": "fsm", "phis": [DEFAULT_PHI], "source": str(args.dat),
+            "height": h, "width": w, "num_steps": int(spikes.shape[0])}
+    save_spikes(args.output, spikes, meta)
+    print(f"wrote {args.output}: {spikes.shape[0]} steps of {h}x{w}")
+    return 0

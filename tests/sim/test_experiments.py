@@ -1,0 +1,61 @@
+"""Smoke tests of ``rvsm table`` / ``rvsm robustness`` at tiny sizes."""
+
+from __future__ import annotations
+
+import csv
+
+import pytest
+
+from rvsm.model.kernels import MODEL_NAMES
+from rvsm.sim import experiments as ex
+from rvsm.sim.cli import main
+
+
+def test_table_cli_tiny(tmp_path):
+    out = tmp_path / "table"
+    rc = main(["table", "--scenes", "character,flyball", "--size", "24x32", "--frames", "3",
+               "--steps-per-frame", "6", "-q", "-o", str(out)])
+    assert rc == 0
+    for name in ("table.md", "table.csv", "fig6.png"):
+        assert (out / name).stat().st_size > 0
+    rows = list(csv.DictReader((out / "table.csv").open()))
+    assert len(rows) == 2 * 2 * len(MODEL_NAMES)
+    md = (out / "table.md").read_text().splitlines()
+    header = [c.strip() for c in md[0].strip("|").split("|")]
+    assert header == ["Metric", "Method", "character", "character(N)", "flyball", "flyball(N)"]
+    body = [line for line in md[2:] if line.startswith("|")]
+    assert len(body) == 3 * len(MODEL_NAMES)
+    labels = [c.strip() for c in (line.strip("|").split("|")[1] for line in body)]
+    assert labels[:9] == ["FSM", "One DoG", "Two DoG", "Three DoG", "Four DoG",
+                          "One Gauss", "Two Gauss", "Three Gauss", "Four Gauss"]
+    for line in md[2:2 + len(MODEL_NAMES)]:  # at least one bold per column block overall
+        assert line.count("|") == len(header) + 1
+    assert sum("**" in line for line in body) >= 3
+
+
+def test_robustness_cli_tiny(tmp_path):
+    out = tmp_path / "rob"
+    rc = main(["robustness", "--ks", "0,2", "--size", "12x12", "--steps", "300", "-q",
+               "-o", str(out)])
+    assert rc == 0
+    for name in ("robustness.csv", "robustness.json", "fig8.png"):
+        assert (out / name).stat().st_size > 0
+    rows = list(csv.DictReader((out / "robustness.csv").open()))
+    assert len(rows) == 2 * len(ex.ROBUST_MODELS)
+    # k = 0: dark current exactly 2 per step, threshold 400 -> FSM fires every 200 steps
+    fsm0 = next(r for r in rows if r["model"] == "fsm" and float(r["k"]) == 0)
+    assert float(fsm0["asas"]) == pytest.approx(1 / 300)
+
+
+def test_run_robustness_returns_indices():
+    res = ex.run_robustness(ks=[1.0], size=(10, 10), num_steps=200, models=["dog4"])
+    (row,) = res.rows
+    assert len(row["asass"]) == 4
+    assert row["asas"] == pytest.approx(row["ass"] / (10 * 10 * 4))
+
+
+def test_bad_arguments_are_user_errors(capsys):
+    assert main(["table", "--size", "big", "-q"]) == 2
+    assert main(["table", "--scenes", "nope", "--size", "24x32", "-q"]) == 2
+    assert main(["robustness", "--ks", "a,b", "-q"]) == 2
+    assert "rvsm: error:" in capsys.readouterr().err
