@@ -149,7 +149,8 @@ def run_stimulus(
     t0 = time.perf_counter()
     with contextlib.suppress(SystemExit), _environ(_sim_env(sb.sim)):
         runner.test(
-            test_module=TB_MODULE, hdl_toplevel=sb.top, build_dir=sb.build_dir,
+            test_module=TB_MODULE, hdl_toplevel=sb.top, hdl_toplevel_lang="verilog",
+            build_dir=sb.build_dir,
             test_dir=test_dir, extra_env=extra, waves=waves, plusargs=plusargs,
             results_xml=str(test_dir / "results.xml"), timescale=("1ns", "1ps"),
             log_file=log,
