@@ -80,7 +80,7 @@ def weighted_sum(
         group = _tree_add([x.as_unsigned()[:width] for x in groups[w]], width)
         for shift, d in csd_digits(abs(w)):
             term = (group << shift)[:width]
-            ((pos if (d > 0) == (w > 0) else neg)).append(term)
+            (pos if (d > 0) == (w > 0) else neg).append(term)
     total = (_tree_add(pos, width) - _tree_add(neg, width))[:width]
     return total.as_signed()
 

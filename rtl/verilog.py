@@ -195,7 +195,8 @@ def yosys_stats(verilog_path: str | os.PathLike, top: str = DEFAULT_TOP) -> dict
     if exe is None:
         raise RvsmError("yosys not found; install it with `apt-get install yosys`")
     t0 = time.perf_counter()
-    script = f"read_verilog {verilog_path}; synth -flatten -top {top}; tee -q -o /dev/stdout stat -json"
+    script = (f"read_verilog {verilog_path}; synth -flatten -top {top}; "
+              "tee -q -o /dev/stdout stat -json")
     proc = subprocess.run([exe, "-q", "-p", script], capture_output=True, text=True)
     if proc.returncode != 0:
         raise RvsmError(f"yosys failed on {verilog_path}: {proc.stderr.strip()[-2000:]}")

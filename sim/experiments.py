@@ -332,7 +332,7 @@ def robustness_figure(result: RobustnessResult) -> Figure:
         ax.set_title(f"{title}  (black {h}x{w}, T={result.num_steps})", fontsize=9)
         ax.set_xlabel("noise intensity k")
         ax.set_ylabel(ylabel, fontsize=8)
-        ax.set_yscale("symlog", linthresh=1e-5)
+        ax.set_yscale("log", nonpositive="mask")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=6)
     fig.tight_layout()

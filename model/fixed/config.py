@@ -18,13 +18,18 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-import tomllib
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import tomli_w
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
 
 from ..atomic import write_text_atomic
 from ..errors import RvsmError
@@ -249,7 +254,8 @@ class DesignPoint:
 
     def to_threshold_lsbs(self, values: np.ndarray) -> np.ndarray:
         """Map thresholds in brightness units to integer accumulator LSBs (unclamped)."""
-        x = np.asarray(values, dtype=np.float64) * self.threshold_scale
+        x = np.clip(np.asarray(values, dtype=np.float64) * self.threshold_scale,
+                    -(2.0**62), 2.0**62)  # keep the int64 cast defined for absurd phi
         if self.threshold_rounding == "ceil":
             return np.ceil(x).astype(np.int64)
         if self.threshold_rounding == "truncate":

@@ -118,16 +118,15 @@ def profile_figure(run: FixedRun):
     fig = Figure(figsize=(11, 1.2 + 0.9 * p.num_scales * 2), layout="constrained")
     ax_w, ax_a = fig.subplots(1, 2)
     # Left: weights.
-    labels, data = [], []
-    for s, k in enumerate(p.spec.kernels()):
-        a = np.abs(k[k != 0])
-        labels.append(f"scale {s} weights")
-        data.append(np.log2(a))
-    pos = np.arange(len(data))
+    kernels = p.spec.kernels()
     ax_w.axvspan(-p.weight_frac_bits, p.weight_bits - 1 - p.weight_frac_bits,
                  color="0.85", zorder=0, label="representable")
-    ax_w.boxplot(data, positions=pos, vert=False, whis=(0, 100), widths=0.6)
-    ax_w.set_yticks(pos, labels)
+    for i, k in enumerate(kernels):
+        lg = np.log2(np.abs(k[k != 0]))
+        q = np.percentile(lg, [0, 25, 50, 75, 100])
+        _draw_box(ax_w, i, q[1], q[2], q[3], q[0], q[4])
+    ax_w.set_yticks(np.arange(len(kernels)), [f"scale {s} weights" for s in range(len(kernels))])
+    ax_w.set_ylim(-0.7, len(kernels) - 0.3)
     ax_w.set_xlabel("log2 |weight|")
     ax_w.set_title(f"weights: {p.weight_bits} bits, {p.weight_frac_bits} fraction")
     ax_w.legend(loc="lower right", fontsize="small")
@@ -146,14 +145,10 @@ def profile_figure(run: FixedRun):
         if hist is not None and hist.sum() > 0:
             q = _hist_quantiles(hist, (0.25, 0.5, 0.75))
             low = _hist_quantiles(hist, (0.0,))[0]
-            ax_a.add_patch(matplotlib.patches.Rectangle(
-                (q[0], i - 0.3), max(q[2] - q[0], 0.05), 0.6, fill=False, color="C0"))
-            ax_a.plot([q[1], q[1]], [i - 0.3, i + 0.3], color="C1")
-            ax_a.plot([low, q[0]], [i, i], color="C0")
-            ax_a.plot([q[2], np.log2(peak)], [i, i], color="C0")
+            _draw_box(ax_a, i, q[0], q[1], q[2], low, np.log2(peak))
         else:
             ax_a.plot([0, np.log2(peak)], [i, i], color="C0")
-        ax_a.plot([np.log2(peak)], [i], "|", color="C0", markersize=12)
+            ax_a.plot([np.log2(peak)], [i], "|", color="C0", markersize=12)
         if thr is not None:
             ax_a.plot([np.log2(thr)], [i], "|", color="red", markersize=14, mew=2)
     ax_a.set_yticks(np.arange(len(rows)), [r[0] for r in rows])
@@ -163,6 +158,17 @@ def profile_figure(run: FixedRun):
     ax_w.invert_yaxis()
     ax_a.invert_yaxis()
     return fig
+
+
+def _draw_box(ax, y: float, q1: float, med: float, q3: float, lo: float, hi: float) -> None:
+    """A horizontal box (q1..q3, median line) with whiskers lo..hi at height ``y``."""
+    from matplotlib.patches import Rectangle
+
+    ax.add_patch(Rectangle((q1, y - 0.3), max(q3 - q1, 0.05), 0.6, fill=False, color="C0"))
+    ax.plot([med, med], [y - 0.3, y + 0.3], color="C1")
+    ax.plot([lo, q1], [y, y], color="C0")
+    ax.plot([q3, hi], [y, y], color="C0")
+    ax.plot([lo, hi], [y, y], "|", color="C0", markersize=10)
 
 
 def _hist_quantiles(hist: np.ndarray, qs: tuple[float, ...]) -> list[float]:

@@ -24,8 +24,13 @@ from ..samplers import DEFAULT_BLOCK_STEPS, _progress_bar
 from ..scene import Scene
 from .adc import adc_codes
 from .config import DesignPoint
-from .core import ArrayContract, FixedIntegrator, arithmetic_shift, bit_length_histogram
-from .core import integer_receptive_sums
+from .core import (
+    ArrayContract,
+    FixedIntegrator,
+    arithmetic_shift,
+    bit_length_histogram,
+    integer_receptive_sums,
+)
 
 
 @dataclass

@@ -13,7 +13,7 @@ from rvsm.model.samplers import DEFAULT_PHI
 from .. import experiments as ex
 
 # Defaults of ``rvsm table``: the built-in scenes' full 250 x 400 canvas and 41 frames
-# (400 steps) take ~TABLE_MINUTES on a 2-core machine; see docs/reproduction.md.
+# (400 steps): 108 runs in ~6.5 min on a 2-core machine; see docs/reproduction.md.
 TABLE_SIZE = (250, 400)
 TABLE_FRAMES = 41
 TABLE_STEPS_PER_FRAME = 10

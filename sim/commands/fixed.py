@@ -77,8 +77,7 @@ def _point_and_scene(args: argparse.Namespace):
 
 def run_config_new(args: argparse.Namespace) -> int:
     """``rvsm config new``."""
-    from rvsm.model.fixed.config import default_design_point, design_point_toml
-    from rvsm.model.fixed.config import save_design_point
+    from rvsm.model.fixed.config import default_design_point, design_point_toml, save_design_point
 
     point = default_design_point()
     size = parse_size_arg(args.size)

@@ -111,6 +111,7 @@ def test_noisy_thresholds_fold_fixed_pattern_and_clamp():
                                 "datapath.accumulator_bits to >= 20"]),
     ({"scale_phi": (400.0, 400.0, 400.0, 900.0), "accumulator_bits": 20},
      ["threshold.scale_phi", "scale 3"]),
+    ({"phi": 1e30}, ["threshold.phi", "cannot hold"]),
     ({"phi": 0.0001, "threshold_rounding": "truncate"}, ["threshold.phi", "maps to 0"]),
 ])
 def test_refusals_name_field_and_range(changes, words):

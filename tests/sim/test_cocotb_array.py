@@ -1,0 +1,178 @@
+"""cocotb regressions: generated Verilog vs the fixed twin, on Icarus and Verilator.
+
+One build per (contract, simulator) is shared by many stimuli (the build cache of
+:mod:`rvsm.sim.runner`). Default: a border-heavy dog4 3x5 array and a 4x4 FSM array on
+both simulators, every model on Icarus, the checker-can-fail proof and tool errors.
+``-m slow`` (``make regress``): every model on both shapes and simulators, longer streams.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rvsm.model.errors import RvsmError
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.weights import quantise_model
+from rvsm.model.kernels import MODEL_NAMES
+from rvsm.sim.runner import check_simulator
+from rvsm.sim.verify import expected_spikes, run_rtl
+
+SIMS = ["icarus", "verilator"]
+
+
+def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int = 10,
+                   shift: int = 1, reset: str = "subtract") -> ArrayContract:
+    """A small contract from a model's quantised kernels (4-bit ADC)."""
+    ks = quantise_model(model, frac_bits, "round-half-up")
+    weights = tuple(tuple(tuple(int(v) for v in row) for row in k) for k in ks)
+    return ArrayContract(h, w, 4, weights, shift, acc_bits, model != "fsm", reset)
+
+
+@pytest.fixture(scope="session")
+def work(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One work folder (and build cache) for the whole session."""
+    return tmp_path_factory.mktemp("cocotb")
+
+
+def stimuli(c: ArrayContract, seed: int, steps: int = 60) -> dict[str, tuple]:
+    """Named (codes, thresholds, clear_before) cases for one contract."""
+    rng = np.random.default_rng(seed)
+    s, h, w = c.num_scales, c.height, c.width
+    full = (1 << c.adc_bits) - 1
+    top = (1 << c.threshold_bits) - 1
+    rand = rng.integers(0, full + 1, (steps, h, w))
+    thr = rng.integers(1, top // 4, (s, h, w))
+    extremes = np.concatenate([np.zeros((steps // 3, h, w), int),
+                               np.full((steps // 3, h, w), full),
+                               rng.choice([0, full], (steps - 2 * (steps // 3), h, w))])
+    # fixed-pattern thresholds spanning 1..top: the top rail only fires when saturated
+    fpn = np.clip(np.round(top / 8 * (1 + 0.5 * rng.standard_normal((s, h, w)))), 1, top)
+    fpn.reshape(-1)[:: max(1, fpn.size // 3)] = top
+    fpn.reshape(-1)[1] = 1
+    return {
+        "random": (rand, thr, ()),
+        "extremes": (extremes, thr, ()),
+        "fixed_pattern": (rand, fpn.astype(np.int64), ()),
+        "clear_mid_stream": (rand, thr, (steps // 3, steps // 2 + 1)),
+    }
+
+
+def exact_threshold_case(c: ArrayContract) -> tuple[np.ndarray, np.ndarray]:
+    """Constant codes with thresholds equal to the first shifted sums: fire exactly."""
+    codes = np.full((6, c.height, c.width), 5)
+    sums = _shifted_sums(c, codes[:1])[0]
+    thr = np.clip(np.abs(sums), 1, (1 << c.threshold_bits) - 1)
+    return codes, thr
+
+
+def _shifted_sums(c: ArrayContract, codes: np.ndarray) -> np.ndarray:
+    from rvsm.model.fixed.core import arithmetic_shift, integer_receptive_sums
+
+    return arithmetic_shift(integer_receptive_sums(codes, c.weight_arrays), c.shift)
+
+
+def check_all(c: ArrayContract, sim: str, work: Path, seed: int, steps: int = 60) -> None:
+    """Every stimulus of :func:`stimuli` plus exact thresholds: zero mismatches."""
+    spikes = {1: 0, -1: 0}
+    cases = dict(stimuli(c, seed, steps))
+    codes, thr = exact_threshold_case(c)
+    cases["exact_threshold"] = (codes, thr, ())
+    for name, (codes, thr, clears) in cases.items():
+        r = run_rtl(c, codes, thr, sim, clear_before=clears, work_dir=work, name=name)
+        assert r["mismatches"] == 0, (name, r["first_mismatch"])
+        assert r["compared"] == codes.shape[0] * c.num_scales * c.height * c.width
+        want = expected_spikes(c, codes, thr, clears)
+        spikes[1] += int((want == 1).sum())
+        spikes[-1] += int((want == -1).sum())
+    assert spikes[1] > 0
+    if c.signed:
+        assert spikes[-1] > 0
+
+
+@pytest.mark.parametrize("sim", SIMS)
+def test_dog4_border_array(sim: str, work: Path) -> None:
+    """dog4 on 3x5: 9x9 kernels mostly outside the array, 10-bit accumulators."""
+    check_all(model_contract("dog4", 3, 5), sim, work, seed=11)
+
+
+@pytest.mark.parametrize("sim", SIMS)
+def test_fsm_square_array(sim: str, work: Path) -> None:
+    """FSM (unsigned, zero reset) on 4x4 with 6-bit accumulators: the rail is hit."""
+    c = model_contract("fsm", 4, 4, frac_bits=0, acc_bits=6, shift=0, reset="zero")
+    check_all(c, sim, work, seed=12)
+
+
+@pytest.mark.parametrize("model", MODEL_NAMES)
+def test_every_model_icarus(model: str, work: Path) -> None:
+    c = model_contract(model, 3, 5)
+    rng = np.random.default_rng(13)
+    codes = rng.integers(0, 16, (40, 3, 5))
+    thr = rng.integers(1, 120, (c.num_scales, 3, 5))
+    r = run_rtl(c, codes, thr, "icarus", work_dir=work, name=f"model_{model}")
+    assert r["mismatches"] == 0, r["first_mismatch"]
+
+
+def test_checker_catches_wrong_expectation(work: Path) -> None:
+    """A deliberately wrong expectation is reported, named, and a waveform is kept."""
+    c = model_contract("dog4", 3, 5)
+    rng = np.random.default_rng(14)
+    codes = rng.integers(0, 16, (30, 3, 5))
+    thr = rng.integers(1, 60, (c.num_scales, 3, 5))
+    wrong = expected_spikes(c, codes, thr)
+    step, scale, row, col = 17, 2, 1, 4
+    good = int(wrong[step, scale, row, col])
+    wrong[step, scale, row, col] = 1 if good != 1 else -1
+    r = run_rtl(c, codes, thr, "icarus", expected=wrong, work_dir=work, name="wrong")
+    assert r["mismatches"] == 1
+    assert r["first_mismatch"] == {"step": step, "scale": scale, "row": row, "column": col,
+                                   "expected": int(wrong[step, scale, row, col]),
+                                   "got": good}
+    assert r["waves"] and Path(r["waves"]).exists()
+
+
+def test_missing_simulator_is_one_clear_line(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("PATH", "/nonexistent")
+    with pytest.raises(RvsmError, match="apt-get install iverilog"):
+        check_simulator("icarus")
+
+
+def test_cli_verify_design_point(work: Path, tmp_path: Path,
+                                 capsys: pytest.CaptureFixture) -> None:
+    """``rvsm verify SCENE --fixed point.toml --json`` on a small dog1 point."""
+    import json
+
+    from rvsm.model.fixed.config import default_design_point, save_design_point
+    from rvsm.sim.cli import main
+
+    point = tmp_path / "p.toml"
+    save_design_point(point, default_design_point().with_size(4, 6))
+    rc = main(["verify", "coin", "--fixed", str(point), "--sim", "icarus", "--steps", "40",
+               "--size", "4x6", "--json", "--work", str(work)])
+    out = json.loads(capsys.readouterr().out)
+    assert rc == 0
+    assert out["simulator"] == "icarus" and out["mismatches"] == 0
+    assert out["compared"] == 40 * 4 * 4 * 6
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.parametrize("shape", [(4, 4), (3, 5)])
+@pytest.mark.parametrize("model", MODEL_NAMES)
+def test_every_model_both_shapes(model: str, shape: tuple[int, int], sim: str,
+                                 work: Path) -> None:
+    check_all(model_contract(model, *shape), sim, work, seed=21, steps=300)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sim", SIMS)
+def test_long_stream_8x12(sim: str, work: Path) -> None:
+    c = model_contract("dog2", 8, 12, frac_bits=8, acc_bits=14, shift=2, reset="zero")
+    check_all(c, sim, work, seed=22, steps=2000)
+
+
+def test_tools_present() -> None:
+    assert shutil.which("iverilog"), "apt-get install iverilog"
