@@ -18,6 +18,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+from rvsm import rtl as rtl_pkg
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.rtl.verilog import DEFAULT_TOP, verilator_env, write_outputs
@@ -62,8 +63,11 @@ def check_simulator(sim: str) -> None:
 
 
 def contract_digest(contract: ArrayContract) -> str:
-    """Short stable digest of a contract (keys the build cache)."""
-    return hashlib.sha256(f"{_BUILD_VERSION}:{contract!r}".encode()).hexdigest()[:16]
+    """Short digest of the contract and the RTL sources (keys the build cache)."""
+    h = hashlib.sha256(f"{_BUILD_VERSION}:{contract!r}".encode())
+    for src in sorted(Path(rtl_pkg.__file__).parent.glob("*.py")):
+        h.update(src.read_bytes())
+    return h.hexdigest()[:16]
 
 
 @contextlib.contextmanager
@@ -97,14 +101,18 @@ def _runner(sim: str):  # noqa: ANN202 - cocotb_tools has no public base type ex
 def build(
     contract: ArrayContract, sim: str, build_root: str | os.PathLike, top: str = DEFAULT_TOP
 ) -> SimBuild:
-    """Generate (or reuse) the Verilog and build it for ``sim``; cached per contract."""
+    """Generate (or reuse) the Verilog and build it for ``sim``; cached per contract.
+
+    A build happens in a private folder renamed into place when done, so concurrent
+    processes (pytest-xdist workers) can share ``build_root`` safely.
+    """
     check_simulator(sim)
-    root = Path(build_root).resolve() / f"{sim}-{contract_digest(contract)}"
-    stamp = root / "build.json"
-    if stamp.exists():
-        meta = json.loads(stamp.read_text())
-        return SimBuild(sim, root / "sim_build", top, root / f"{top}.v",
-                        meta["generate_seconds"], meta["build_seconds"], True)
+    final = Path(build_root).resolve() / f"{sim}-{contract_digest(contract)}-{top}"
+    cached = _cached(final, sim, top)
+    if cached is not None:
+        return cached
+    root = final.with_name(f"{final.name}.tmp{os.getpid()}")
+    shutil.rmtree(root, ignore_errors=True)
     root.mkdir(parents=True, exist_ok=True)
     paths, gen = write_outputs(contract, root, top)
     sim_build = root / "sim_build"
@@ -123,9 +131,27 @@ def build(
         tail = log.read_text()[-3000:] if log.exists() else str(exc)
         raise RvsmError(f"{sim} build failed ({exc}); see {log}:\n{tail}") from exc
     build_seconds = time.perf_counter() - t0
-    stamp.write_text(json.dumps({"generate_seconds": gen.seconds,
-                                 "build_seconds": build_seconds}))
-    return SimBuild(sim, sim_build, top, paths["verilog"], gen.seconds, build_seconds, False)
+    (root / "build.json").write_text(json.dumps({"generate_seconds": gen.seconds,
+                                                 "build_seconds": build_seconds}))
+    try:
+        os.rename(root, final)
+    except OSError:  # another process finished the same build first
+        shutil.rmtree(root, ignore_errors=True)
+    done = _cached(final, sim, top)
+    if done is None:
+        raise RvsmError(f"{sim} build folder {final} vanished")
+    return SimBuild(sim, done.build_dir, top, done.verilog, gen.seconds, build_seconds,
+                    False)
+
+
+def _cached(root: Path, sim: str, top: str) -> SimBuild | None:
+    """The finished build in ``root``, if any."""
+    stamp = root / "build.json"
+    if not stamp.exists():
+        return None
+    meta = json.loads(stamp.read_text())
+    return SimBuild(sim, root / "sim_build", top, root / f"{top}.v",
+                    meta["generate_seconds"], meta["build_seconds"], True)
 
 
 def run_stimulus(

@@ -34,8 +34,16 @@ def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int
 
 @pytest.fixture(scope="session")
 def work(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """One work folder (and build cache) for the whole session."""
+    """One work folder per worker, with a build cache shared by pytest-xdist workers."""
     return tmp_path_factory.mktemp("cocotb")
+
+
+@pytest.fixture(scope="session")
+def builds(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Build cache shared by every xdist worker of this session (safe: atomic renames)."""
+    base = tmp_path_factory.getbasetemp()
+    root = base.parent if base.name.startswith("popen-gw") else base
+    return root / "rvsm-builds"
 
 
 def stimuli(c: ArrayContract, seed: int, steps: int = 60) -> dict[str, tuple]:
@@ -75,14 +83,16 @@ def _shifted_sums(c: ArrayContract, codes: np.ndarray) -> np.ndarray:
     return arithmetic_shift(integer_receptive_sums(codes, c.weight_arrays), c.shift)
 
 
-def check_all(c: ArrayContract, sim: str, work: Path, seed: int, steps: int = 60) -> None:
+def check_all(c: ArrayContract, sim: str, work: Path, builds: Path, seed: int,
+              steps: int = 60) -> None:
     """Every stimulus of :func:`stimuli` plus exact thresholds: zero mismatches."""
     spikes = {1: 0, -1: 0}
     cases = dict(stimuli(c, seed, steps))
     codes, thr = exact_threshold_case(c)
     cases["exact_threshold"] = (codes, thr, ())
     for name, (codes, thr, clears) in cases.items():
-        r = run_rtl(c, codes, thr, sim, clear_before=clears, work_dir=work, name=name)
+        r = run_rtl(c, codes, thr, sim, clear_before=clears, work_dir=work, name=name,
+                    build_root=builds)
         assert r["mismatches"] == 0, (name, r["first_mismatch"])
         assert r["compared"] == codes.shape[0] * c.num_scales * c.height * c.width
         want = expected_spikes(c, codes, thr, clears)
@@ -94,29 +104,30 @@ def check_all(c: ArrayContract, sim: str, work: Path, seed: int, steps: int = 60
 
 
 @pytest.mark.parametrize("sim", SIMS)
-def test_dog4_border_array(sim: str, work: Path) -> None:
+def test_dog4_border_array(sim: str, work: Path, builds: Path) -> None:
     """dog4 on 3x5: 9x9 kernels mostly outside the array, 10-bit accumulators."""
-    check_all(model_contract("dog4", 3, 5), sim, work, seed=11)
+    check_all(model_contract("dog4", 3, 5), sim, work, builds, seed=11)
 
 
 @pytest.mark.parametrize("sim", SIMS)
-def test_fsm_square_array(sim: str, work: Path) -> None:
+def test_fsm_square_array(sim: str, work: Path, builds: Path) -> None:
     """FSM (unsigned, zero reset) on 4x4 with 6-bit accumulators: the rail is hit."""
     c = model_contract("fsm", 4, 4, frac_bits=0, acc_bits=6, shift=0, reset="zero")
-    check_all(c, sim, work, seed=12)
+    check_all(c, sim, work, builds, seed=12)
 
 
 @pytest.mark.parametrize("model", MODEL_NAMES)
-def test_every_model_icarus(model: str, work: Path) -> None:
+def test_every_model_icarus(model: str, work: Path, builds: Path) -> None:
     c = model_contract(model, 3, 5)
     rng = np.random.default_rng(13)
     codes = rng.integers(0, 16, (40, 3, 5))
     thr = rng.integers(1, 120, (c.num_scales, 3, 5))
-    r = run_rtl(c, codes, thr, "icarus", work_dir=work, name=f"model_{model}")
+    r = run_rtl(c, codes, thr, "icarus", work_dir=work, name=f"model_{model}",
+                build_root=builds)
     assert r["mismatches"] == 0, r["first_mismatch"]
 
 
-def test_checker_catches_wrong_expectation(work: Path) -> None:
+def test_checker_catches_wrong_expectation(work: Path, builds: Path) -> None:
     """A deliberately wrong expectation is reported, named, and a waveform is kept."""
     c = model_contract("dog4", 3, 5)
     rng = np.random.default_rng(14)
@@ -126,7 +137,8 @@ def test_checker_catches_wrong_expectation(work: Path) -> None:
     step, scale, row, col = 17, 2, 1, 4
     good = int(wrong[step, scale, row, col])
     wrong[step, scale, row, col] = 1 if good != 1 else -1
-    r = run_rtl(c, codes, thr, "icarus", expected=wrong, work_dir=work, name="wrong")
+    r = run_rtl(c, codes, thr, "icarus", expected=wrong, work_dir=work, name="wrong",
+                build_root=builds)
     assert r["mismatches"] == 1
     assert r["first_mismatch"] == {"step": step, "scale": scale, "row": row, "column": col,
                                    "expected": int(wrong[step, scale, row, col]),
@@ -163,15 +175,15 @@ def test_cli_verify_design_point(work: Path, tmp_path: Path,
 @pytest.mark.parametrize("shape", [(4, 4), (3, 5)])
 @pytest.mark.parametrize("model", MODEL_NAMES)
 def test_every_model_both_shapes(model: str, shape: tuple[int, int], sim: str,
-                                 work: Path) -> None:
-    check_all(model_contract(model, *shape), sim, work, seed=21, steps=300)
+                                 work: Path, builds: Path) -> None:
+    check_all(model_contract(model, *shape), sim, work, builds, seed=21, steps=300)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("sim", SIMS)
-def test_long_stream_8x12(sim: str, work: Path) -> None:
+def test_long_stream_8x12(sim: str, work: Path, builds: Path) -> None:
     c = model_contract("dog2", 8, 12, frac_bits=8, acc_bits=14, shift=2, reset="zero")
-    check_all(c, sim, work, seed=22, steps=2000)
+    check_all(c, sim, work, builds, seed=22, steps=2000)
 
 
 def test_tools_present() -> None:
