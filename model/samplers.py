@@ -206,11 +206,10 @@ def sample(
     thresholds = accumulator_thresholds(config, scene.shape)
     integrator = Integrator(thresholds, spec.signed, config.reset)
     spikes = np.zeros((scene.num_steps, spec.num_scales) + scene.shape, dtype=np.int8)
-    bar = _progress_bar(scene.num_steps, f"{spec.name} {scene.name}", progress)
+    bar = progress_bar(scene.num_steps, f"{spec.name} {scene.name}", progress)
     for t, drive in iter_step_drives(scene, config, block_steps):
         integrator.step(drive, spikes[t])
-        if (t + 1) % block_steps == 0 or t + 1 == scene.num_steps:
-            bar.update(bar.total and (t + 1) - bar.n)
+        bar.update(1)
     bar.close()
     return SpikeTrain(spikes, thresholds, config, sampling_meta(scene, config))
 
@@ -231,7 +230,8 @@ def sampling_meta(scene: Scene, config: SamplerConfig) -> dict:
     }
 
 
-def _progress_bar(total: int, desc: str, enabled: bool):
+def progress_bar(total: int, desc: str, enabled: bool):
+    """A tqdm bar over ``total`` steps (a silent no-op bar when ``enabled`` is False)."""
     from tqdm.auto import tqdm
 
     return tqdm(total=total, desc=desc, unit="step", disable=not enabled, leave=False)

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..noise import NoiseSource
-from ..samplers import DEFAULT_BLOCK_STEPS, _progress_bar
+from ..samplers import DEFAULT_BLOCK_STEPS, progress_bar, sampling_meta
 from ..scene import Scene
 from .adc import adc_codes
 from .config import DesignPoint
@@ -126,7 +126,7 @@ def simulate_fixed(
     sum_min, sum_max = np.full(s_count, big), np.full(s_count, small)
     sh_min, sh_max = np.full(s_count, big), np.full(s_count, small)
     sum_hist = np.zeros((s_count, 64), dtype=np.int64) if histograms else None
-    bar = _progress_bar(t_total, f"fixed {point.model} {scene.name}", progress)
+    bar = progress_bar(t_total, f"fixed {point.model} {scene.name}", progress)
     for t0, t1, codes in code_blocks(scene, point, noise, block_steps):
         if codes_out is not None:
             codes_out[t0:t1] = codes
@@ -159,18 +159,11 @@ def fixed_meta(
     scene: Scene, point: DesignPoint, thresholds: np.ndarray, stats: FixedStats
 ) -> dict:
     """Spike-file metadata: the float sampler's keys plus the design point and counters."""
-    h, w = point.shape
-    cfg = point.sampler_config()
     return {
+        **sampling_meta(scene, point.sampler_config()),
         "kind": "fixed",
-        "scene": scene.name,
-        "height": h,
-        "width": w,
-        "steps_per_frame": scene.steps_per_frame,
-        "hold": scene.hold,
-        "num_steps": scene.num_steps,
-        **cfg.to_dict(),
-        "phis": [float(v) for v in point.phis],
+        "height": point.shape[0],
+        "width": point.shape[1],
         "design_point": point.to_dict(),
         "nominal_thresholds": [int(v) for v in point.nominal_thresholds()],
         "threshold_min": int(thresholds.min()),
