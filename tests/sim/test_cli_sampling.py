@@ -120,3 +120,28 @@ def test_output_files_get_a_normal_mode(tmp_path, capsys):
     target = tmp_path / "m.npz"
     assert _run(capsys, "simulate", "coin", *SMALL, "--model", "fsm", "-o", target)[0] == 0
     assert target.stat().st_mode & 0o044  # readable by group/others under a usual umask
+
+
+def test_simulate_fixed_then_evaluate(tmp_path, capsys):
+    point = tmp_path / "p.toml"
+    assert _run(capsys, "config", "new", "-o", point)[0] == 0
+    spikes = tmp_path / "fx.npz"
+    code, out, err = _run(capsys, "simulate", "coin", *SMALL, "--fixed", point, "-o", spikes)
+    assert code == 0, err
+    from rvsm.model.spike_files import load_spikes
+
+    data, meta = load_spikes(spikes)
+    assert data.shape == (24, 4, 24, 32) and meta["kind"] == "fixed"
+    assert (meta["height"], meta["width"]) == (24, 32)
+    code, out, err = _run(capsys, "evaluate", spikes, "--json")
+    assert code == 0, err
+    assert json.loads(out)["psnr"] > 10
+
+
+def test_simulate_fixed_refuses_float_options(tmp_path, capsys):
+    point = tmp_path / "p.toml"
+    assert _run(capsys, "config", "new", "-o", point)[0] == 0
+    code, _, err = _run(capsys, "simulate", "coin", *SMALL, "--fixed", point, "--model", "fsm",
+                        "-o", tmp_path / "x.npz")
+    assert code == 2 and "--model" in err and "design point" in err
+    assert not (tmp_path / "x.npz").exists()
