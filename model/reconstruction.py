@@ -21,6 +21,7 @@ import numpy as np
 from .errors import RvsmError
 from .filtering import adjoint_sums
 from .kernels import ModelSpec, model_spec
+from .spike_files import single_scale_spikes
 
 METHODS = ("auto", "tfi", "tfp", "rvsm")
 MATCH_MODES = ("gain", "affine")
@@ -44,18 +45,8 @@ def _as_steps(steps: Sequence[int] | np.ndarray | None, num_steps: int) -> np.nd
 
 
 def _single_scale(spikes: np.ndarray) -> np.ndarray:
-    """``(T, H, W)`` or ``(T, 1, H, W)`` spikes -> ``(T, H, W)``."""
-    arr = np.asarray(spikes)
-    if arr.ndim == 4:
-        if arr.shape[1] != 1:
-            raise RvsmError(
-                f"TFI/TFP need single-scale (FSM) spikes, got {arr.shape[1]} scales; "
-                "use method='rvsm'"
-            )
-        arr = arr[:, 0]
-    if arr.ndim != 3:
-        raise RvsmError(f"spikes must be (T, H, W) or (T, 1, H, W), got shape {arr.shape}")
-    return arr
+    """``(T, H, W)`` or ``(T, 1, H, W)`` spikes -> ``(T, H, W)`` (TFI/TFP are FSM-only)."""
+    return single_scale_spikes(spikes, "TFI/TFP (use method='rvsm' for RVSM spikes)")
 
 
 def last_spike_index(spikes: np.ndarray) -> np.ndarray:

@@ -69,18 +69,28 @@ def _check_spikes(spikes: np.ndarray, source: str) -> np.ndarray:
     return spikes.astype(np.int8, copy=False)
 
 
+def single_scale_spikes(spikes: np.ndarray, purpose: str) -> np.ndarray:
+    """``(T, H, W)`` or ``(T, 1, H, W)`` spikes -> ``(T, H, W)``; refuses several scales.
+
+    ``purpose`` names what needs one bit per pixel, for the error message.
+    """
+    arr = np.asarray(spikes)
+    if arr.ndim == 4:
+        if arr.shape[1] != 1:
+            raise RvsmError(
+                f"{purpose} needs single-scale (FSM) spikes; these have {arr.shape[1]} scales"
+            )
+        arr = arr[:, 0]
+    if arr.ndim != 3:
+        raise RvsmError(
+            f"{purpose} needs spikes (T, H, W) or (T, 1, H, W), got shape {arr.shape}"
+        )
+    return arr
+
+
 def export_dat(path: str | os.PathLike, spikes: np.ndarray, flip: bool = False) -> None:
     """Write FSM spikes ``(T, H, W)`` or ``(T, 1, H, W)`` of 0/1 in the camera's layout."""
-    spikes = np.asarray(spikes)
-    if spikes.ndim == 4:
-        if spikes.shape[1] != 1:
-            raise RvsmError(
-                f".dat holds one bit per pixel (FSM); these spikes have {spikes.shape[1]} "
-                "scales"
-            )
-        spikes = spikes[:, 0]
-    if spikes.ndim != 3:
-        raise RvsmError(f".dat export needs spikes (T, H, W), got shape {spikes.shape}")
+    spikes = single_scale_spikes(spikes, ".dat (one bit per pixel)")
     if spikes.size and (spikes.min() < 0 or spikes.max() > 1):
         raise RvsmError(".dat holds only 0/1 spikes; RVSM's -1 spikes cannot be exported")
     t, h, w = spikes.shape
