@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..cli_args import load_scene_from_args
-from ..demo import DEMO_MODELS, DEMO_SCENE, run_float_demo
+from ..demo import DEMO_MODELS, DEMO_RTL_SIZE, DEMO_RTL_STEPS, DEMO_SCENE, run_float_demo
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,6 +23,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--steps-per-frame", type=int, default=None, metavar="M")
     p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
     p.add_argument("-o", "--output", default="out", help="output folder (default out/)")
+    p.add_argument("--sim", choices=("verilator", "icarus", "none"), default="verilator",
+                   help="simulator for the RTL check of the default design point "
+                   "(default verilator; none skips it)")
     p.set_defaults(func=run_demo, hold=False)
 
 
@@ -39,4 +42,19 @@ def run_demo(args: argparse.Namespace) -> int:
         print(f"{r.model:8s} {r.spikes:9d} {r.psnr:7.2f} {r.ssim:6.3f} {r.seconds:5.1f}s")
     print(f"wrote {out}/metrics.md, metrics.csv, and per model .npz spikes and .png "
           "reconstructions")
+    if args.sim == "none":
+        return 0
+    from ..demo import run_rtl_demo
+
+    h, w = DEMO_RTL_SIZE
+    print(f"RTL: default design point at {h}x{w}, Verilog + {DEMO_RTL_STEPS}-step "
+          f"spike-for-spike check on {args.sim} (the first build takes a few minutes)")
+    result = run_rtl_demo(args.scene, out / "rtl", sim=args.sim)
+    print(f"RTL: wrote {result['verilog']} (generated in {result['generate_seconds']:.1f} s); "
+          f"{result['simulator']}: {result['compared']} spikes compared, "
+          f"{result['mismatches']} mismatches")
+    if result["mismatches"]:
+        first = result["first_mismatch"]
+        print(f"RTL: FIRST MISMATCH {first}; waveform {result['waves']}")
+        return 1
     return 0
