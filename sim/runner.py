@@ -2,8 +2,8 @@
 
 One build per (contract, simulator) is cached under ``build_root/<sim>-<digest>/`` and
 reused by every stimulus (``run_stimulus``), so a Verilator compile is paid once.
-Builds always include wave support (Icarus: an FST dump module, Verilator:
-``--trace``); dumping is only switched on per run (``waves=True``).
+Icarus builds always include the FST dump module; Verilator builds get ``--trace``
+only when waves are asked for (a second cached build), since tracing doubles the C++.
 """
 
 from __future__ import annotations
@@ -17,11 +17,15 @@ import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rvsm import rtl as rtl_pkg
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.rtl.verilog import DEFAULT_TOP, verilator_env, write_outputs
+from rvsm.rtl.verilog import DEFAULT_TOP, GeneratedVerilog, verilator_env, write_outputs
+
+if TYPE_CHECKING:
+    from cocotb_tools.runner import Runner
 
 __all__ = ["SIMULATORS", "SimBuild", "build", "check_simulator", "run_stimulus"]
 
@@ -29,7 +33,9 @@ SIMULATORS = ("icarus", "verilator")
 TB_MODULE = "rvsm.sim.cocotb_tb.tb_array"
 #: Verilator flags for Amaranth's netlist (warnings are the lint's job, not the build's).
 VERILATOR_BUILD_ARGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style", "-O2")
-_BUILD_VERSION = "1"  # bump when the RTL or the build flags change
+#: Expose only the top-level ports to VPI in Verilator builds (see :func:`_runner`).
+VERILATOR_PUBLIC_TOP_ONLY = True
+_BUILD_VERSION = "3"  # bump when the RTL or the build flags change
 
 
 @dataclass(frozen=True)
@@ -43,6 +49,7 @@ class SimBuild:
     generate_seconds: float
     build_seconds: float
     cached: bool
+    waves: bool = False
 
 
 def check_simulator(sim: str) -> None:
@@ -92,29 +99,55 @@ def _sim_env(sim: str) -> dict[str, str]:
     return {k: env[k] for k in ("VERILATOR_ROOT", "PATH", "MAKEFLAGS")}
 
 
-def _runner(sim: str):  # noqa: ANN202 - cocotb_tools has no public base type export
-    from cocotb_tools.runner import get_runner
+def _runner(sim: str) -> Runner:
+    """A fresh cocotb runner for ``sim``.
 
-    return get_runner(sim)
+    For Verilator, cocotb's ``--public-flat-rw`` (every signal of every cell visible to
+    VPI) is replaced by ``--public-depth 1`` (the top-level ports only, all the testbench
+    touches): the C++ of a 16x16 array shrinks by an order of magnitude.
+    """
+    from cocotb_tools.runner import Verilator, get_runner
+
+    if sim != "verilator":
+        return get_runner(sim)
+
+    class TopOnlyVerilator(Verilator):
+        def _build_command(self) -> list:
+            cmds = super()._build_command()
+            first = list(cmds[0])
+            if VERILATOR_PUBLIC_TOP_ONLY and "--public-flat-rw" in first:
+                i = first.index("--public-flat-rw")
+                first[i:i + 1] = ["--public-depth", "1"]
+            return [first, *cmds[1:]]
+
+    return TopOnlyVerilator()
 
 
 def build(
-    contract: ArrayContract, sim: str, build_root: str | os.PathLike, top: str = DEFAULT_TOP
+    contract: ArrayContract, sim: str, build_root: str | os.PathLike,
+    top: str = DEFAULT_TOP, waves: bool = False,
 ) -> SimBuild:
     """Generate (or reuse) the Verilog and build it for ``sim``; cached per contract.
 
+    Icarus builds always carry the FST dump module (cheap); Verilator builds carry
+    ``--trace`` only when ``waves`` (a separate cached build: tracing doubles the C++).
     A build happens in a private folder renamed into place when done, so concurrent
-    processes (pytest-xdist workers) can share ``build_root`` safely.
+    processes (pytest-xdist workers) can share ``build_root`` safely. The Verilog of a
+    contract already generated for another build is reused, not regenerated.
     """
     check_simulator(sim)
-    final = Path(build_root).resolve() / f"{sim}-{contract_digest(contract)}-{top}"
-    cached = _cached(final, sim, top)
+    traced = waves or sim == "icarus"
+    digest = contract_digest(contract)
+    suffix = "-trace" if (traced and sim == "verilator") else ""
+    base = Path(build_root).resolve()
+    final = base / f"{sim}-{digest}-{top}{suffix}"
+    cached = _cached(final, sim, top, traced)
     if cached is not None:
         return cached
     root = final.with_name(f"{final.name}.tmp{os.getpid()}")
     shutil.rmtree(root, ignore_errors=True)
     root.mkdir(parents=True, exist_ok=True)
-    paths, gen = write_outputs(contract, root, top)
+    paths, gen = _reuse_verilog(base, digest, top, root) or write_outputs(contract, root, top)
     sim_build = root / "sim_build"
     runner = _runner(sim)
     t0 = time.perf_counter()
@@ -124,7 +157,7 @@ def build(
         with _environ(_sim_env(sim)):
             runner.build(
                 sources=[paths["verilog"]], hdl_toplevel=top, build_dir=sim_build,
-                build_args=build_args, waves=True, timescale=("1ns", "1ps"),
+                build_args=build_args, waves=traced, timescale=("1ns", "1ps"),
                 always=True, log_file=log,
             )
     except (SystemExit, Exception) as exc:  # the runner exits on a failed command
@@ -137,21 +170,39 @@ def build(
         os.rename(root, final)
     except OSError:  # another process finished the same build first
         shutil.rmtree(root, ignore_errors=True)
-    done = _cached(final, sim, top)
+    done = _cached(final, sim, top, traced)
     if done is None:
         raise RvsmError(f"{sim} build folder {final} vanished")
     return SimBuild(sim, done.build_dir, top, done.verilog, gen.seconds, build_seconds,
-                    False)
+                    False, traced)
 
 
-def _cached(root: Path, sim: str, top: str) -> SimBuild | None:
+def _cached(root: Path, sim: str, top: str, traced: bool) -> SimBuild | None:
     """The finished build in ``root``, if any."""
     stamp = root / "build.json"
     if not stamp.exists():
         return None
     meta = json.loads(stamp.read_text())
     return SimBuild(sim, root / "sim_build", top, root / f"{top}.v",
-                    meta["generate_seconds"], meta["build_seconds"], True)
+                    meta["generate_seconds"], meta["build_seconds"], True, traced)
+
+
+def _reuse_verilog(
+    base: Path, digest: str, top: str, root: Path
+) -> tuple[dict[str, Path], GeneratedVerilog] | None:
+    """Copy an already generated Verilog of the same contract digest into ``root``."""
+    for other in sorted(base.glob(f"*-{digest}-{top}*")):
+        meta_path = other / f"{top}.ports.json"
+        if other == root or not (other / f"{top}.v").exists() or not meta_path.exists():
+            continue
+        paths = {}
+        for key, name in (("verilog", f"{top}.v"), ("ports_json", f"{top}.ports.json"),
+                          ("ports_md", f"{top}.ports.md")):
+            paths[key] = root / name
+            shutil.copyfile(other / name, paths[key])
+        meta = json.loads(meta_path.read_text())
+        return paths, GeneratedVerilog("", top, meta["latency"], meta["generation_seconds"])
+    return None
 
 
 def run_stimulus(
@@ -163,6 +214,8 @@ def run_stimulus(
     The result has ``compared``, ``mismatches``, ``first_mismatch`` (or None),
     ``stream_seconds`` and ``simulator``; ``waves`` the dump path when kept.
     """
+    if waves and not sb.waves:
+        raise RvsmError("this build has no wave support; build it with waves=True")
     test_dir = Path(test_dir).resolve()
     test_dir.mkdir(parents=True, exist_ok=True)
     result_path = test_dir / "result.json"

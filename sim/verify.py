@@ -92,7 +92,8 @@ def run_rtl(
     if expected is None:
         expected = expected_spikes(contract, codes, thresholds, clear_before)
     work = Path(work_dir)
-    sb = build(contract, sim, work / "builds" if build_root is None else build_root)
+    root = work / "builds" if build_root is None else Path(build_root)
+    sb = build(contract, sim, root, waves=waves)
     run_dir = work / sim / name
     stim = write_stimulus(run_dir / "stimulus.npz", contract, codes, thresholds, expected,
                           clear_before)
@@ -104,7 +105,8 @@ def run_rtl(
         stim2 = write_stimulus(again_dir / "stimulus.npz", contract, codes[:upto],
                                thresholds, expected[:upto],
                                [t for t in clear_before if t < upto])
-        result["waves"] = run_stimulus(sb, stim2, again_dir, waves=True)["waves"]
+        sbw = build(contract, sim, root, waves=True)
+        result["waves"] = run_stimulus(sbw, stim2, again_dir, waves=True)["waves"]
     result.update(
         build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
         build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),
