@@ -18,12 +18,29 @@ from rvsm.model.fixed.config import (
 )
 
 
+# The widths the numbers in these tests were worked out for (8-bit ADC, 12/10 weights,
+# 21-bit accumulator), pinned so that the tests do not move with the project default.
+WIDE = {"adc_bits": 8, "weight_bits": 12, "weight_frac_bits": 10, "accumulator_bits": 21}
+
+
+def wide_point(**changes) -> DesignPoint:
+    """The default design point at the ``WIDE`` widths, with ``changes``."""
+    return dataclasses.replace(default_design_point(), **{**WIDE, **changes})
+
+
 def test_default_point_matches_the_brief():
     p = default_design_point()
     assert (p.height, p.width, p.model, p.phi, p.reset, p.noise) == (
         250, 400, "dog4", 400.0, "zero", False)
     assert p.noise_k == 1.0 and p.seed == 0
-    assert list(p.nominal_thresholds()) == [400 * 1024] * 4
+    # docs/design-space.md: ADC 7 bits, weights 11/9, shift 0, 18-bit accumulator.
+    assert (p.adc_bits, p.weight_bits, p.weight_frac_bits, p.shift, p.accumulator_bits) == (
+        7, 11, 9, 0, 18)
+    # ceil(400 * 127/255 * 2**9) = ceil(101998.43...)
+    assert list(p.nominal_thresholds()) == [101999] * 4
+    for model in ("fsm", "dog1", "gauss1", "gauss4"):  # weight 1.0 fits: 512 <= 1023
+        dataclasses.replace(p, model=model).contract()
+    assert list(wide_point().nominal_thresholds()) == [400 * 1024] * 4
     c = p.contract()
     assert c.num_scales == 4 and c.signed and c.accumulator_bits == p.accumulator_bits
     assert [len(k) for k in c.weights] == [3, 5, 7, 9]
@@ -66,7 +83,7 @@ def test_threshold_mapping_is_ceil_by_default():
 
 def test_noisy_thresholds_fold_fixed_pattern_and_clamp():
     p = DesignPoint(height=16, width=16, model="dog2", noise=True, noise_k=40.0, seed=3,
-                    accumulator_bits=20)
+                    **{**WIDE, "accumulator_bits": 20})
     thr = p.integer_thresholds()
     assert thr.shape == (2, 16, 16) and thr.dtype == np.int64
     assert thr.min() >= 1 and thr.max() <= 2**19 - 1
@@ -116,13 +133,13 @@ def test_noisy_thresholds_fold_fixed_pattern_and_clamp():
 ])
 def test_refusals_name_field_and_range(changes, words):
     with pytest.raises(RvsmError) as info:
-        dataclasses.replace(default_design_point(), **changes)
+        wide_point(**changes)
     for word in words:
         assert word in str(info.value), str(info.value)
 
 
 def test_refused_at_load_time(tmp_path):
-    text = design_point_toml(default_design_point()).replace("accumulator_bits = 21",
+    text = design_point_toml(wide_point()).replace("accumulator_bits = 21",
                                                              "accumulator_bits = 19")
     path = tmp_path / "bad.toml"
     path.write_text(text)

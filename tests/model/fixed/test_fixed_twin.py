@@ -55,10 +55,12 @@ def test_determinism_and_seed(scene):
 
 
 def test_saturation_counted_with_narrow_accumulator(scene):
-    run = simulate_fixed(scene, _point(accumulator_bits=20))
+    wide = {"adc_bits": 8, "weight_bits": 12, "weight_frac_bits": 10}
+    run = simulate_fixed(scene, _point(accumulator_bits=20, **wide))
     # scale 0's sum reaches 240465 per step: thr 409600 + that > 2**19 - 1
     assert run.stats.saturated[0] > 0 and run.stats.acc_max[0] > 2**19 - 1
-    assert list(simulate_fixed(scene, _point()).stats.saturated) == [0, 0, 0, 0]
+    assert list(simulate_fixed(scene, _point(accumulator_bits=21, **wide)).stats.saturated) \
+        == [0, 0, 0, 0]
 
 
 def test_scene_size_follows_scene(scene):
@@ -114,7 +116,8 @@ def test_stimulus_round_trip(tmp_path, scene):
 
 
 def test_profile_report_and_figure(scene):
-    run = simulate_fixed(scene, _point(accumulator_bits=20), histograms=True)
+    run = simulate_fixed(scene, _point(accumulator_bits=20, adc_bits=8, weight_bits=12,
+                                       weight_frac_bits=10), histograms=True)
     rep = profile_report(run)
     s0 = rep["scales"][0]
     assert s0["saturated"] == int(run.stats.saturated[0]) > 0
@@ -137,11 +140,11 @@ def test_cost_keys(scene):
 def test_cli(tmp_path, capsys):
     assert main(["config", "new"]) == 0
     text = capsys.readouterr().out
-    assert "[datapath]" in text and "accumulator_bits = 21" in text
+    assert "[datapath]" in text and "accumulator_bits = 18" in text
     point = tmp_path / "p.toml"
     assert main(["config", "new", "-o", str(point), "--size", "24x32"]) == 0
     assert main(["config", "check", str(point)]) == 0
-    assert "409600" in capsys.readouterr().out
+    assert "101999" in capsys.readouterr().out
     common = ["character", "--fixed", str(point), "--frames", "4"]
     assert main(["stimulus", *common, "-o", str(tmp_path / "s.npz")]) == 0
     assert load_stimulus(tmp_path / "s.npz").check()

@@ -1,0 +1,96 @@
+"""``rvsm sweep``: fixed-point design sweeps (run, resume, report).
+
+``rvsm sweep SWEEP.toml`` (or ``rvsm sweep run SWEEP.toml``) computes what is missing into
+a SQLite database; ``rvsm sweep report RESULTS.sqlite`` writes a markdown report and plots.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from rvsm.model.errors import RvsmError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``sweep``."""
+    p = sub.add_parser(
+        "sweep", help="fixed-point design sweeps on Dask (resumable) and their reports",
+        description="rvsm sweep [run] SWEEP.toml [-o RESULTS.sqlite] [--workers N] "
+        "[--scheduler ADDRESS]: run every design point x scene of a sweep file, skipping "
+        "rows already in the database. rvsm sweep report RESULTS.sqlite [-o DIR]: markdown "
+        "report, PSNR-cost and Pareto plots. See docs/design-space.md.",
+    )
+    p.add_argument("target", metavar="SWEEP.toml | run | report",
+                   help="a sweep file, or the action `run` / `report`")
+    p.add_argument("path", nargs="?", metavar="FILE",
+                   help="the sweep file (run) or the results database (report)")
+    p.add_argument("-o", "--output", default=None,
+                   help="run: results database (default SWEEP.sqlite beside the sweep "
+                   "file); report: output folder (default RESULTS-report)")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local Dask worker processes (default: one per core; 0 = in this "
+                   "process, no Dask)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on an existing Dask cluster, e.g. tcp://host:8786")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--tolerance", type=float, default=0.1,
+                   help="report: PSNR cost bound in dB for the recommendation (default 0.1)")
+    p.set_defaults(func=run_sweep_command)
+
+
+def run_sweep_command(args: argparse.Namespace) -> int:
+    """Dispatch ``rvsm sweep FILE``, ``rvsm sweep run FILE`` and ``rvsm sweep report DB``."""
+    if args.target == "report":
+        if not args.path:
+            raise RvsmError("rvsm sweep report needs the results database: "
+                            "rvsm sweep report RESULTS.sqlite [-o DIR]")
+        return _report(args)
+    if args.target == "run":
+        if not args.path:
+            raise RvsmError("rvsm sweep run needs a sweep file: rvsm sweep run SWEEP.toml")
+        sweep_file = args.path
+    else:
+        if args.path:
+            raise RvsmError(f"unexpected argument {args.path!r}; use rvsm sweep SWEEP.toml "
+                            "[-o RESULTS.sqlite] or rvsm sweep report RESULTS.sqlite")
+        sweep_file = args.target
+    return _run(args, sweep_file)
+
+
+def _run(args: argparse.Namespace, sweep_file: str) -> int:
+    from ..sweep_run import run_sweep
+    from ..sweep_spec import load_sweep
+
+    if args.workers is not None and args.workers < 0:
+        raise RvsmError(f"--workers must be >= 0, got {args.workers}")
+    spec = load_sweep(sweep_file)
+    db = Path(args.output) if args.output else Path(sweep_file).with_suffix(".sqlite")
+    print(f"sweep {sweep_file}: {len(spec.designs)} design point(s) x "
+          f"{len(spec.run.scenes)} scene(s) x {len(spec.run.noise)} noise x "
+          f"{len(spec.run.seeds)} seed(s) at {spec.run.size[0]}x{spec.run.size[1]}, "
+          f"{spec.run.steps} steps -> {db}")
+    summary = run_sweep(spec, db, workers=args.workers, scheduler=args.scheduler,
+                        progress=not args.no_progress)
+    print(summary.format())
+    for e in summary.errors[:10]:
+        print(f"  failed: {e}")
+    if summary.errors:
+        print("rerun the same command to retry the failed rows")
+        return 1
+    print(f"report: rvsm sweep report {db}")
+    return 0
+
+
+def _report(args: argparse.Namespace) -> int:
+    from ..sweep_report import write_report
+
+    db = Path(args.path)
+    out = Path(args.output) if args.output else db.with_name(db.stem + "-report")
+    files, rec = write_report(db, out, tolerance=args.tolerance)
+    for f in files:
+        print(f"wrote {f}")
+    if rec is not None:
+        print(f"recommended (worst PSNR cost <= {args.tolerance} dB on every scene): "
+              f"{rec['label']}")
+    return 0

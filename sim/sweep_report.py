@@ -1,0 +1,324 @@
+"""Sweep reports: per-design aggregates, Pareto front, figures and a markdown report.
+
+A *design* is one combination of axis values; its rows are its scenes x noise x seeds.
+Its PSNR cost is the worst deviation from the float model, ``max |psnr_float -
+psnr_fixed|`` over those rows, in dB (a fixed point that beats the float model by 1 dB
+does not model it either);
+its hardware cost is yosys cells per pixel of the RTL synthesised at the sweep's
+``[hardware] size`` (or, without synthesis, the proxy ``adc.bits + weights.bits +
+datapath.accumulator_bits`` bits). Figures are returned as matplotlib Figures; only
+:func:`write_report` writes files.
+"""
+
+from __future__ import annotations
+
+import os
+from collections import defaultdict
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rvsm.model.atomic import atomic_path, write_text_atomic
+from rvsm.model.errors import RvsmError
+from rvsm.model.fixed.config import FIELD_PATH, parse_design_point
+
+from .sweep_spec import PATH_FIELD
+from .sweep_store import open_existing
+
+PROXY_LABEL = "adc + weight + accumulator bits (proxy: no synthesis)"
+
+
+@dataclass
+class DesignSummary:
+    """Aggregate of one design over its rows (costs in dB, hardware per pixel)."""
+
+    design_id: str
+    axes: dict[str, Any]
+    values: dict[str, Any]
+    toml: str
+    model: str
+    rows: list[dict[str, Any]]
+    worst_cost: float
+    worst_signed: float
+    mean_cost: float
+    worst_ssim_cost: float
+    min_agreement: float
+    max_saturation: float
+    cells_per_pixel: float | None
+    ff_per_pixel: float | None
+    proxy_bits: int
+    complete: bool = True
+
+    @property
+    def hw(self) -> float:
+        """Hardware cost used for the Pareto front (cells/pixel, else the bit proxy)."""
+        return self.cells_per_pixel if self.cells_per_pixel is not None else self.proxy_bits
+
+    @property
+    def label(self) -> str:
+        """Swept fields with their resolved values, e.g. ``adc.bits=6, weights.bits=9``."""
+        return ", ".join(f"{k}={v}" for k, v in self.values.items())
+
+
+def summarise(rows: list[dict[str, Any]]) -> list[DesignSummary]:
+    """Group ``ok`` result rows by design; ``complete`` marks designs with every
+    (scene, noise, seed, steps, size) seen for any design."""
+    by: dict[str, list[dict]] = defaultdict(list)
+    for r in rows:
+        if r["status"] == "ok":
+            by[r["design_id"]].append(r)
+    runs = {(r["scene"], r["noise"], r["seed"], r["steps"], r["size"])
+            for rs in by.values() for r in rs}
+    out = []
+    for did, rs in by.items():
+        point = parse_design_point(rs[0]["design_toml"], f"design {did}")
+        values = {p: _value(point, p) for p in rs[0]["axes"]}
+        costs = np.array([r["psnr_cost"] for r in rs], dtype=float)
+        have = {(r["scene"], r["noise"], r["seed"], r["steps"], r["size"]) for r in rs}
+        cells = rs[0].get("cells_per_pixel")
+        out.append(DesignSummary(
+            design_id=did, axes=rs[0]["axes"], values=values, toml=rs[0]["design_toml"],
+            model=point.model, rows=rs, worst_cost=float(np.abs(costs).max()),
+            worst_signed=float(costs.max()),
+            mean_cost=float(costs.mean()),
+            worst_ssim_cost=float(max(r["ssim_cost"] for r in rs)),
+            min_agreement=float(min(r["agreement"] for r in rs)),
+            max_saturation=float(max(r["max_saturation_rate"] for r in rs)),
+            cells_per_pixel=None if cells is None else float(cells),
+            ff_per_pixel=None if rs[0].get("ff_per_pixel") is None
+            else float(rs[0]["ff_per_pixel"]),
+            proxy_bits=point.adc_bits + point.weight_bits + point.accumulator_bits,
+            complete=have >= runs,
+        ))
+    if any(d.cells_per_pixel is None for d in out):  # mixed: compare like with like
+        for d in out:
+            d.cells_per_pixel = None
+    return sorted(out, key=lambda d: (d.hw, d.worst_cost))
+
+
+def _value(point, path: str) -> Any:
+    v = getattr(point, PATH_FIELD[path])
+    return list(v) if isinstance(v, tuple) else v
+
+
+def pareto_mask(hw: list[float] | np.ndarray, cost: list[float] | np.ndarray) -> np.ndarray:
+    """True where a point is not dominated, minimising both ``hw`` and ``cost``: j
+    dominates i when ``hw[j] <= hw[i]``, ``cost[j] <= cost[i]`` and one is strict."""
+    x, y = np.asarray(hw, dtype=float), np.asarray(cost, dtype=float)
+    keep = np.ones(x.size, dtype=bool)
+    for i in range(x.size):
+        dom = (x <= x[i]) & (y <= y[i]) & ((x < x[i]) | (y < y[i]))
+        keep[i] = not dom.any()
+    return keep
+
+
+def recommend(designs: list[DesignSummary], tolerance: float = 0.1) -> DesignSummary | None:
+    """The smallest complete design (hardware cost, then PSNR cost) whose PSNR stays within
+    ``tolerance`` dB of the float model on every run (``worst_cost`` is ``max |cost|``)."""
+    ok = [d for d in designs if d.complete and d.worst_cost <= tolerance]
+    return min(ok, key=lambda d: (d.hw, d.worst_cost), default=None)
+
+
+def width_cost_figure(designs: list[DesignSummary], tolerance: float = 0.1):
+    """PSNR cost against each swept numeric field: every design (grey dots, worst cost
+    over scenes and noise) and, per model (scale ladder), the best worst-case cost
+    reachable at each width (line). Returns a matplotlib Figure."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    paths = [p for p in (designs[0].values if designs else {})
+             if all(isinstance(d.values.get(p), (int, float)) and
+                    not isinstance(d.values.get(p), bool) for d in designs)]
+    n = max(1, len(paths))
+    fig, axs = plt.subplots(1, n, figsize=(4.2 * n, 3.6), squeeze=False)
+    for ax, path in zip(axs[0], paths, strict=False):
+        xs = [d.values[path] for d in designs]
+        ax.scatter(xs, [d.worst_cost for d in designs], s=12, color="0.75", zorder=1,
+                   label="design (worst scene)")
+        for model in sorted({d.model for d in designs}):
+            best: dict[float, float] = {}
+            for d in designs:
+                if d.model == model:
+                    x = d.values[path]
+                    best[x] = min(best.get(x, np.inf), d.worst_cost)
+            ks = sorted(best)
+            ax.plot(ks, [best[k] for k in ks], marker="o", zorder=2, label=f"{model} best")
+        ax.axhline(tolerance, color="tab:red", lw=0.8, ls="--", label=f"{tolerance} dB")
+        if min(d.worst_cost for d in designs) > 0:
+            ax.set_yscale("log")
+        ax.set_xlabel(path)
+        ax.set_ylabel("max |PSNR float - fixed| (dB)")
+        ax.grid(alpha=0.3)
+    if not paths:
+        axs[0][0].text(0.5, 0.5, "no numeric axes", ha="center", va="center")
+    axs[0][0].legend(fontsize=7)
+    fig.suptitle("PSNR deviation from float against each width (worst over scenes, noise)")
+    fig.tight_layout()
+    return fig
+
+
+def pareto_figure(designs: list[DesignSummary], tolerance: float = 0.1):
+    """Worst PSNR cost against hardware cost; the Pareto front in colour, dominated points
+    grey. Returns a matplotlib Figure."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    hw = np.array([d.hw for d in designs], dtype=float)
+    cost = np.array([d.worst_cost for d in designs], dtype=float)
+    mask = pareto_mask(hw, cost) if designs else np.zeros(0, bool)
+    ax.scatter(hw[~mask], cost[~mask], s=14, color="0.7", label="dominated")  # grey
+    order = np.argsort(hw[mask])
+    ax.plot(hw[mask][order], cost[mask][order], "o-", color="tab:blue", drawstyle="steps-post",
+            label="Pareto front")
+    front = [d for d, m in zip(designs, mask, strict=True) if m]
+    for i, d in enumerate(front, 1):  # P-numbers as in the report's Pareto table
+        ax.annotate(f"P{i}", (d.hw, max(d.worst_cost, 1e-3)), fontsize=7, xytext=(3, 3),
+                    textcoords="offset points")
+    ax.axhline(tolerance, color="tab:red", lw=0.8, ls="--", label=f"{tolerance} dB")
+    uses_cells = bool(designs) and designs[0].cells_per_pixel is not None
+    ax.set_xlabel("yosys cells per pixel" if uses_cells else PROXY_LABEL)
+    if designs and cost.min() > 0:
+        ax.set_yscale("log")
+    ax.set_ylabel("max |PSNR float - fixed| (dB)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def report_markdown(db_name: str, designs: list[DesignSummary], invalid: list[dict],
+                    errors: list[dict], sweeps: list[tuple[str, str]], tolerance: float,
+                    figures: dict[str, str]) -> str:
+    """The markdown report (``figures``: caption -> relative file name)."""
+    rec = recommend(designs, tolerance)
+    hw_sizes = sorted({r.get("hw_size") or "-" for d in designs for r in d.rows[:1]})
+    runs = sorted({(r["scene"], r["noise"], r["seed"], r["size"], r["steps"])
+                   for d in designs for r in d.rows})
+    lines = [
+        f"# Design sweep report: {db_name}", "",
+        f"Sweeps: {', '.join(f'`{p}` ({h})' for h, p in sweeps) or '-'}. "
+        f"{len(designs)} valid design(s), {len(invalid)} invalid, {len(errors)} failed row(s); "
+        f"{len(runs)} run(s) per design (scene x noise x seed): "
+        f"{', '.join(sorted({r[0] for r in runs}))}; "
+        f"sizes {', '.join(sorted({r[3] for r in runs}))}, "
+        f"steps {', '.join(str(s) for s in sorted({r[4] for r in runs}))}.",
+        "",
+        f"PSNR cost = PSNR(float) - PSNR(fixed) in dB; `worst |cost|` is the largest "
+        "deviation over a design's runs (used for the recommendation and the Pareto front), "
+        "`worst cost` the largest signed cost. Hardware "
+        f"cost = yosys cells per pixel of the RTL synthesised at {', '.join(hw_sizes)} "
+        "(see docs/design-space.md for the caveat).", "",
+    ]
+    for cap, f in figures.items():
+        lines += [f"![{cap}]({f})", ""]
+    lines += [f"## Recommended (smallest within {tolerance} dB on every run)", ""]
+    if rec is None:
+        lines += ["No complete design stays within the bound.", ""]
+    else:
+        lines += [f"**{rec.label}**: {_hw_text(rec)}, worst PSNR cost "
+                  f"{rec.worst_cost:.3f} dB.", "", "```toml", rec.toml.rstrip(), "```", "",
+                  "| scene | noise | PSNR float | PSNR fixed | PSNR cost | SSIM cost | MSE cost "
+                  "| agreement | max saturation |", "|---|---|---|---|---|---|---|---|---|"]
+        for r in sorted(rec.rows, key=lambda r: (r["scene"], r["noise"], r["seed"])):
+            lines.append(
+                f"| {r['scene']} | {'on' if r['noise'] else 'off'} | {r['psnr_float']:.3f} | "
+                f"{r['psnr_fixed']:.3f} | {r['psnr_cost']:+.3f} | {r['ssim_cost']:+.4f} | "
+                f"{r['mse_cost']:+.2f} | {100 * r['agreement']:.1f} % | "
+                f"{100 * r['max_saturation_rate']:.3f} % |")
+        lines.append("")
+    front = [d for d, m in zip(designs, pareto_mask([d.hw for d in designs],
+                                                    [d.worst_cost for d in designs]),
+                               strict=True) if m]
+    lines += ["## Pareto points", "", _table(front), ""]
+    for i, d in enumerate(front, 1):
+        lines += [f"### P{i}: {d.label}", "", "```toml", d.toml.rstrip(), "```", ""]
+    lines += ["## All designs", "", _table(designs), ""]
+    if invalid:
+        lines += ["## Invalid designs (refused by design point validation)", "",
+                  "| axes | reason |", "|---|---|"]
+        seen = set()
+        for r in invalid:
+            if r["design_id"] not in seen:
+                seen.add(r["design_id"])
+                axes = ", ".join(f"{k}={v}" for k, v in r["axes"].items())
+                lines.append(f"| {axes} | {r['error']} |")
+        lines.append("")
+    if errors:
+        lines += ["## Failed rows (rerun the sweep to retry)", ""]
+        lines += [f"- {r['design_id']} {r['scene']}: {r['error']}" for r in errors[:50]]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _hw_text(d: DesignSummary) -> str:
+    if d.cells_per_pixel is None:
+        return f"{d.proxy_bits} bits (proxy)"
+    return f"{d.cells_per_pixel:.0f} cells/pixel, {d.ff_per_pixel:.1f} flip-flops/pixel"
+
+
+def _table(designs: list[DesignSummary]) -> str:
+    head = ("| design | cells/px | FF/px | worst \\|cost\\| | worst cost | mean cost | worst SSIM "
+            "cost | min agreement | max saturation | complete |\n"
+            "|---|---|---|---|---|---|---|---|---|---|")
+    rows = [
+        f"| {d.label} | {_fmt(d.cells_per_pixel, '.0f')} | {_fmt(d.ff_per_pixel, '.1f')} | "
+        f"{d.worst_cost:.3f} dB | {d.worst_signed:+.3f} | {d.mean_cost:+.3f} | "
+        f"{d.worst_ssim_cost:+.4f} | "
+        f"{100 * d.min_agreement:.1f} % | {100 * d.max_saturation:.3f} % | "
+        f"{'yes' if d.complete else 'no'} |" for d in designs]
+    return "\n".join([head, *rows])
+
+
+def _fmt(v: float | None, spec: str) -> str:
+    return "-" if v is None else format(v, spec)
+
+
+def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: float = 0.1
+                 ) -> tuple[list[Path], dict[str, Any] | None]:
+    """Write ``report.md``, ``width-cost.png`` and ``pareto.png`` into ``out_dir``.
+
+    Returns the files written and the recommended design (``label``, ``toml``,
+    ``worst_cost``, ``cells_per_pixel``) or None.
+    """
+    import matplotlib.pyplot as plt
+
+    with open_existing(db) as store:
+        rows = store.results()
+        sweeps = list(store.db.execute("SELECT sweep_hash, path FROM sweeps"))
+    designs = summarise(rows)
+    if not designs:
+        raise RvsmError(f"{db}: no finished results yet; run the sweep first")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    figs = {"PSNR cost against each width": ("width-cost.png", width_cost_figure),
+            "Pareto front: PSNR cost against hardware cost": ("pareto.png", pareto_figure)}
+    files = []
+    for _cap, (name, make) in figs.items():
+        fig = make(designs, tolerance)
+        with atomic_path(out / name) as tmp:
+            fig.savefig(tmp, dpi=130)
+        plt.close(fig)
+        files.append(out / name)
+    text = report_markdown(
+        Path(db).name, designs, [r for r in rows if r["status"] == "invalid"],
+        [r for r in rows if r["status"] == "error"], sweeps, tolerance,
+        {cap: name for cap, (name, _) in figs.items()})
+    write_text_atomic(out / "report.md", text)
+    files.append(out / "report.md")
+    rec = recommend(designs, tolerance)
+    info = None if rec is None else {"label": rec.label, "toml": rec.toml,
+                                      "worst_cost": rec.worst_cost,
+                                      "cells_per_pixel": rec.cells_per_pixel,
+                                      "ff_per_pixel": rec.ff_per_pixel}
+    return files, info
+
+
+__all__ = ["FIELD_PATH", "DesignSummary", "pareto_figure", "pareto_mask", "recommend",
+           "report_markdown", "summarise", "width_cost_figure", "write_report"]

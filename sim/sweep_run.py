@@ -1,0 +1,272 @@
+"""Run a sweep on Dask: compute every missing row, write each as it completes.
+
+:func:`run_sweep` expands the sweep, skips every row already in the database, synthesises
+each distinct RTL not yet in ``hw_cost`` once, and runs the rest on a Dask cluster: a
+:class:`~dask.distributed.LocalCluster` of ``workers`` processes (default: one per core),
+``scheduler=ADDRESS`` for an existing cluster, or ``workers=0`` in this process without
+Dask. Only this (coordinating) process writes the database, one committed row per finished
+future, so Ctrl-C keeps everything finished. The task functions :func:`evaluate_task` and
+:func:`synthesise_task` are top-level so distributed workers can import them.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rvsm.model.errors import RvsmError
+from rvsm.model.fixed.config import DesignPoint
+
+from .sweep_spec import SweepSpec, SweepTask
+from .sweep_store import SweepStore
+
+
+@dataclass
+class SweepSummary:
+    """What a run did. Counts are rows (tasks) unless named ``hw_*`` (syntheses)."""
+
+    total: int = 0
+    already_done: int = 0
+    computed: int = 0
+    invalid: int = 0
+    errors: list[str] = field(default_factory=list)
+    hw_synthesised: int = 0
+    hw_cached: int = 0
+    seconds: float = 0.0
+    workers: int = 0
+
+    def format(self) -> str:
+        """One-paragraph summary for the CLI."""
+        return (f"sweep: {self.total} rows: {self.already_done} already done, "
+                f"{self.computed} computed, {self.invalid} invalid design(s) recorded, "
+                f"{len(self.errors)} failed; RTL: {self.hw_synthesised} synthesised, "
+                f"{self.hw_cached} cached; {self.seconds:.1f} s on {self.workers} worker(s)")
+
+
+def evaluate_task(task: SweepTask, frames: int, steps_per_frame: int, method: str = "auto",
+                  match: str = "gain") -> dict[str, Any]:
+    """Fixed vs float on one scene: :func:`~rvsm.model.fixed.cost.quantisation_cost` plus
+    ``mse_cost`` (fixed minus float, 8-bit units squared), ``saturation_rate`` (per scale,
+    saturated accumulator-steps / (steps * H * W)), ``max_saturation_rate`` and
+    ``seconds`` (wall time)."""
+    from rvsm.model.fixed.cost import quantisation_cost
+    from rvsm.model.scene_io import load_scene
+
+    t0 = time.perf_counter()
+    scene = load_scene(task.scene, size=task.size, num_frames=frames,
+                       steps_per_frame=steps_per_frame)
+    rec = quantisation_cost(scene, task.run_point(), method=method, match=match)
+    denom = max(1, rec["steps"] * rec["height"] * rec["width"])
+    rec["saturation_rate"] = [s / denom for s in rec["saturated"]]
+    rec["max_saturation_rate"] = max(rec["saturation_rate"], default=0.0)
+    rec["mse_cost"] = rec["mse_fixed"] - rec["mse_float"]
+    rec["noise"] = task.noise
+    rec["seed"] = task.seed
+    rec["seconds"] = time.perf_counter() - t0
+    return rec
+
+
+def hw_point(point: DesignPoint, size: tuple[int, int]) -> DesignPoint:
+    """The small array whose RTL is synthesised for ``point`` (noise does not change RTL)."""
+    return point.with_size(*size)
+
+
+def hw_digest(point: DesignPoint, size: tuple[int, int]) -> str:
+    """Cache key of a design's RTL at ``size``: the build digest of its contract."""
+    from .runner import contract_digest
+
+    return contract_digest(hw_point(point, size).contract())
+
+
+def synthesise_task(point: DesignPoint, size: tuple[int, int]) -> dict[str, Any]:
+    """Generate the RTL of ``point`` at ``size`` and synthesise it with yosys.
+
+    Returns ``cells``, ``flip_flops``, ``cell_types``, ``pixels``, ``size`` ("HxW"),
+    ``contract`` (repr) and ``seconds`` (generation + synthesis wall time).
+    """
+    from rvsm.rtl.verilog import generate_verilog, yosys_stats
+
+    t0 = time.perf_counter()
+    contract = hw_point(point, size).contract()
+    gen = generate_verilog(contract)
+    with tempfile.TemporaryDirectory(prefix="rvsm-sweep-") as d:
+        path = Path(d) / "array.v"
+        path.write_text(gen.text, encoding="utf-8")
+        stats = yosys_stats(path, gen.top)
+    return {"cells": stats["cells"], "flip_flops": stats["flip_flops"],
+            "cell_types": stats["cell_types"], "pixels": size[0] * size[1],
+            "size": f"{size[0]}x{size[1]}", "contract": repr(contract),
+            "seconds": time.perf_counter() - t0}
+
+
+def run_sweep(
+    spec: SweepSpec,
+    db_path: str | os.PathLike,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: bool = True,
+    on_result: Callable[[SweepSummary], None] | None = None,
+    processes: bool = True,
+) -> SweepSummary:
+    """Compute every row of ``spec`` missing from ``db_path``; see the module docstring.
+
+    ``on_result(summary)`` is called after each stored row or synthesis (tests use it to
+    interrupt). ``processes=False`` runs a local cluster's workers as threads.
+    """
+    t0 = time.perf_counter()
+    summary = SweepSummary()
+    tasks = spec.tasks()
+    summary.total = len(tasks)
+    with SweepStore(db_path) as store:
+        hw = spec.hardware
+        digests: dict[str, str] = {}
+        hw_todo: dict[str, DesignPoint] = {}
+        known = store.known_digests()
+        if hw.enabled:
+            for d in spec.designs:
+                if d.point is not None:
+                    digests[d.design_id] = hw_digest(d.point, hw.size)
+            for did, dig in digests.items():
+                if dig in known:
+                    continue
+                hw_todo.setdefault(dig, next(x.point for x in spec.designs if x.design_id == did))
+            summary.hw_cached = len(set(digests.values())) - len(hw_todo)
+        store.register(spec, tasks, digests)
+        store.attach_digests(digests)
+        done = store.done_keys()
+        pending: list[SweepTask] = []
+        for t in tasks:
+            key = (t.point_id, t.scene, int(t.noise), t.seed, t.steps, t.size_text)
+            if key in done:
+                summary.already_done += 1
+            elif t.design.point is None:
+                store.write_result(t, None, "invalid", t.design.error)
+                summary.invalid += 1
+            else:
+                pending.append(t)
+        if pending:
+            _check_scenes(spec)
+        if pending or hw_todo:
+            _execute(spec, store, pending, hw_todo, digests, summary, workers, scheduler,
+                     progress, on_result, processes)
+    summary.seconds = time.perf_counter() - t0
+    return summary
+
+
+def _check_scenes(spec: SweepSpec) -> None:
+    """Fail early, naming the field, if a scene cannot be loaded."""
+    from rvsm.model.scene_io import load_scene
+
+    for name in spec.run.scenes:
+        try:
+            load_scene(name, size=spec.run.size, num_frames=spec.run.frames,
+                       steps_per_frame=spec.run.steps_per_frame)
+        except RvsmError as exc:
+            raise RvsmError(f"{spec.source}: run.scenes: {exc}") from None
+
+
+def _execute(spec, store, pending, hw_todo, digests, summary, workers, scheduler, progress,
+             on_result, processes) -> None:
+    from tqdm import tqdm
+
+    total = len(pending) + len(hw_todo)
+    bar = tqdm(total=total, desc="sweep", unit="task", disable=not progress, smoothing=0.1)
+    run = spec.run
+    args = (run.frames, run.steps_per_frame, run.method, run.match)
+
+    def finished(kind: str, item: Any, value: Any, exc: BaseException | None) -> None:
+        if kind == "hw":
+            if exc is None:
+                store.write_hw_cost(item, value)
+                summary.hw_synthesised += 1
+            else:
+                summary.errors.append(f"synthesis of {item}: {exc}")
+        else:
+            dig = digests.get(item.design.design_id)
+            if exc is None:
+                store.write_result(item, value, "ok", hw_digest=dig)
+                summary.computed += 1
+            else:
+                msg = f"{type(exc).__name__}: {exc}"
+                store.write_result(item, None, "error", msg, hw_digest=dig)
+                summary.errors.append(f"{item.design.design_id} on {item.scene}: {msg}")
+        bar.set_postfix_str(f"{total - bar.n - 1} remaining", refresh=False)
+        bar.update(1)
+        if on_result is not None:
+            on_result(summary)
+
+    try:
+        if workers == 0 and scheduler is None:
+            summary.workers = 0
+            for dig, point in hw_todo.items():
+                _call(finished, "hw", dig, synthesise_task, point, spec.hardware.size)
+            for t in pending:
+                _call(finished, "pt", t, evaluate_task, t, *args)
+        else:
+            _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
+                  processes)
+    finally:
+        bar.close()
+
+
+def _call(finished, kind, item, fn, *args) -> None:
+    try:
+        value = fn(*args)
+    except Exception as exc:  # a failed row is recorded and retried next run
+        finished(kind, item, None, exc)
+        return
+    finished(kind, item, value, None)
+
+
+def _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
+          processes) -> None:
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout="15s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise RvsmError(f"cannot connect to the Dask scheduler {scheduler}: {exc}; "
+                            "check --scheduler (e.g. tcp://host:8786)") from None
+    else:
+        n = workers if workers is not None else (os.cpu_count() or 1)
+        if n < 1:
+            raise RvsmError(f"--workers must be >= 0, got {n}")
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=processes,
+                               dashboard_address=":0", silence_logs=logging.ERROR)
+        client = Client(cluster)
+    futures = []
+    try:
+        summary.workers = len(client.scheduler_info().get("workers", {}))
+        items = {}
+        for dig, point in hw_todo.items():
+            f = client.submit(synthesise_task, point, spec.hardware.size, key=f"hw-{dig}",
+                              priority=10)
+            items[f.key] = ("hw", dig)
+            futures.append(f)
+        for t in pending:
+            f = client.submit(evaluate_task, t, *args, key=f"pt-{t.point_id}")
+            items[f.key] = ("pt", t)
+            futures.append(f)
+        for fut in as_completed(futures):
+            kind, item = items[fut.key]
+            try:
+                value = fut.result()
+            except Exception as exc:  # recorded and retried next run
+                finished(kind, item, None, exc)
+            else:
+                finished(kind, item, value, None)
+            fut.release()
+    finally:
+        if futures:
+            client.cancel([f for f in futures if not f.done()])
+        client.close()
+        if cluster is not None:
+            cluster.close()

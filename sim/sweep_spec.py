@@ -1,0 +1,426 @@
+"""Sweep files: parse, validate and expand a fixed-point design sweep (docs/design-space.md).
+
+A sweep file (TOML) names a base design point (``[base]``), the axes to vary (``[axes]``,
+keyed by the design point's ``section.key`` names), what to run (``[run]``: scenes, size,
+frames, seeds, noise) and how to measure hardware (``[hardware]``). :func:`expand` turns it
+into :class:`SweepTask` s, one per design point x scene x noise x seed, each with a stable
+``point_id`` (SHA-256 of the canonical design point TOML, scene, steps, seed, noise and
+size), so a rerun recognises what it has already computed.
+
+Axis values: a list (``[6, 7, 8]``), an inclusive range (``{start = 6, stop = 12, step =
+2}``), or for ``weights.bits`` / ``datapath.accumulator_bits`` the strings ``"auto"`` /
+``"auto+N"`` (the smallest width that holds the quantised weights / the largest threshold,
+plus N). Linked axes move together: ``"weights.bits,weights.frac_bits" = [[8, 6], [9, 7]]``.
+A point the design point validation refuses is kept, as invalid, with the reason.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import itertools
+import json
+import math
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+from rvsm.model.errors import RvsmError
+from rvsm.model.fixed.config import (
+    FIELD_PATH,
+    MAX_ACC_BITS,
+    MAX_WEIGHT_BITS,
+    TOML_FIELDS,
+    DesignPoint,
+    _signed_bits,
+    default_design_point,
+    design_point_toml,
+    load_design_point,
+)
+from rvsm.model.fixed.weights import quantise_model
+from rvsm.model.scene_io import parse_size
+
+PATH_FIELD = {path: f for f, path in FIELD_PATH.items()}
+RUN_ONLY = ("array.height", "array.width", "noise.enabled", "noise.seed")
+AUTO_FIELDS = ("weight_bits", "accumulator_bits")
+SECTIONS = ("base", "axes", "run", "hardware")
+RUN_KEYS = ("scenes", "size", "frames", "steps_per_frame", "seeds", "noise", "method", "match")
+HARDWARE_KEYS = ("enabled", "size")
+MAX_POINTS = 100_000
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """``[run]``: scenes (built-in names or paths), twin size ``(H, W)`` pixels, frames,
+    steps per frame, seeds, noise settings, reconstruction method and matching."""
+
+    scenes: tuple[str, ...]
+    size: tuple[int, int] = (64, 96)
+    frames: int = 11
+    steps_per_frame: int = 10
+    seeds: tuple[int, ...] = (0,)
+    noise: tuple[bool, ...] = (False,)
+    method: str = "auto"
+    match: str = "gain"
+
+    @property
+    def steps(self) -> int:
+        """Simulated steps: ``(frames - 1) * steps_per_frame`` (at least one)."""
+        return max(1, (self.frames - 1) * self.steps_per_frame)
+
+
+@dataclass(frozen=True)
+class HardwareSettings:
+    """``[hardware]``: synthesise the RTL of each distinct contract at ``size`` (pixels)."""
+
+    enabled: bool = True
+    size: tuple[int, int] = (4, 4)
+
+
+@dataclass(frozen=True)
+class Design:
+    """One combination of axis values: the full design point (base array size, noise off)
+    or, when validation refused it, ``point = None`` and ``error``."""
+
+    design_id: str
+    axes: dict[str, Any]
+    point: DesignPoint | None
+    error: str | None
+    toml: str
+
+
+@dataclass(frozen=True)
+class SweepTask:
+    """One design x scene x noise x seed: what a worker computes (one results row)."""
+
+    point_id: str
+    design: Design
+    scene: str
+    noise: bool
+    seed: int
+    steps: int
+    size: tuple[int, int]
+
+    @property
+    def size_text(self) -> str:
+        """``"HxW"``."""
+        return f"{self.size[0]}x{self.size[1]}"
+
+    def run_point(self) -> DesignPoint:
+        """The design point as run: sweep size, this task's noise and seed."""
+        assert self.design.point is not None
+        return dataclasses.replace(
+            self.design.point, height=self.size[0], width=self.size[1],
+            noise=self.noise, seed=self.seed,
+        )
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A parsed, validated sweep file."""
+
+    source: str
+    text: str
+    base: DesignPoint
+    axes: tuple[tuple[tuple[str, ...], tuple[tuple[Any, ...], ...]], ...]
+    run: RunSettings
+    hardware: HardwareSettings
+    designs: tuple[Design, ...] = field(default=(), repr=False)
+
+    @property
+    def sweep_hash(self) -> str:
+        """Digest of the file text (16 hex digits)."""
+        return hashlib.sha256(self.text.encode()).hexdigest()[:16]
+
+    @property
+    def axis_fields(self) -> list[str]:
+        """Every swept ``section.key``, in file order."""
+        return [p for paths, _ in self.axes for p in paths]
+
+    def tasks(self) -> list[SweepTask]:
+        """Every design x scene x noise x seed, in a stable order."""
+        out = []
+        for d in self.designs:
+            for scene, noise, seed in itertools.product(
+                self.run.scenes, self.run.noise, self.run.seeds
+            ):
+                out.append(SweepTask(
+                    point_id=task_id(d.toml, scene, self.run.steps, seed, noise, self.run.size),
+                    design=d, scene=scene, noise=noise, seed=seed, steps=self.run.steps,
+                    size=self.run.size,
+                ))
+        return out
+
+
+def task_id(
+    toml: str, scene: str, steps: int, seed: int, noise: bool, size: tuple[int, int]
+) -> str:
+    """Stable id of a results row: SHA-256 (24 hex digits) of the canonical point and run."""
+    key = json.dumps([toml, scene, int(steps), int(seed), bool(noise), list(size)])
+    return hashlib.sha256(key.encode()).hexdigest()[:24]
+
+
+def load_sweep(path: str | os.PathLike) -> SweepSpec:
+    """Read and validate a sweep file; errors name the file and the field."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise RvsmError(f"cannot read sweep file {p}: {exc.strerror or exc}") from None
+    return parse_sweep(text, str(p), base_dir=p.parent)
+
+
+def parse_sweep(
+    text: str, source: str = "sweep", base_dir: str | os.PathLike | None = None
+) -> SweepSpec:
+    """Parse sweep TOML text (``base_dir`` resolves a relative base file)."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise RvsmError(f"{source}: not valid TOML: {exc}") from None
+    for key in data:
+        if key not in SECTIONS:
+            raise RvsmError(f"{source}: unknown section [{key}]; valid: {', '.join(SECTIONS)}")
+    base = _parse_base(data.get("base"), source, Path(base_dir or "."))
+    axes = _parse_axes(data.get("axes", {}), source)
+    run = _parse_run(data.get("run"), source)
+    hardware = _parse_hardware(data.get("hardware", {}), source)
+    spec = SweepSpec(source, text, base, axes, run, hardware)
+    return dataclasses.replace(spec, designs=tuple(_expand(spec)))
+
+
+def _parse_base(raw: Any, source: str, base_dir: Path) -> DesignPoint:
+    if raw is None:
+        return default_design_point()
+    if isinstance(raw, str):
+        raw = {"file": raw}
+    if not isinstance(raw, dict):
+        raise RvsmError(f"{source}: base must be a design point file name or a table")
+    raw = dict(raw)
+    file = raw.pop("file", None)
+    if file is not None:
+        if not isinstance(file, str):
+            raise RvsmError(f"{source}: base.file must be a path string, got {file!r}")
+        point = load_design_point(base_dir / file)
+    else:
+        point = default_design_point()
+    if raw:
+        merged = point.to_toml_dict()
+        for sec, table in raw.items():
+            if not isinstance(table, dict):
+                raise RvsmError(f"{source}: base.{sec} must be a table like [base.{sec}]")
+            merged.setdefault(sec, {}).update(table)
+        point = DesignPoint.from_toml_dict(merged, f"{source}: [base]")
+    return point
+
+
+def _parse_axes(raw: Any, source: str) -> tuple:
+    if not isinstance(raw, dict):
+        raise RvsmError(f"{source}: [axes] must be a table of \"section.key\" = values")
+    axes = []
+    seen: set[str] = set()
+    for key, value in raw.items():
+        if isinstance(value, dict) and "start" not in value and "values" not in value:
+            raise RvsmError(
+                f"{source}: axes.{key}: quote dotted axis names (\"adc.bits\" = [...]) so "
+                "TOML does not read them as tables"
+            )
+        paths = tuple(p.strip() for p in str(key).split(","))
+        for p in paths:
+            where = f"{source}: axes.\"{key}\""
+            if p in RUN_ONLY:
+                raise RvsmError(
+                    f"{where}: {p} is set by [run] (size, noise, seeds), not an axis"
+                )
+            if p not in PATH_FIELD:
+                valid = ", ".join(f"{s}.{k}" for s, k, _ in TOML_FIELDS
+                                  if f"{s}.{k}" not in RUN_ONLY)
+                raise RvsmError(f"{where}: unknown field {p}; axes take {valid}")
+            if p in seen:
+                raise RvsmError(f"{where}: {p} is swept twice")
+            seen.add(p)
+        values = _axis_values(value, f"{source}: axes.\"{key}\"")
+        combos = []
+        for v in values:
+            combo = tuple(v) if len(paths) > 1 else (v,)
+            if len(paths) > 1 and (not isinstance(v, list) or len(v) != len(paths)):
+                raise RvsmError(
+                    f"{source}: axes.\"{key}\": each value must be a list of {len(paths)} "
+                    f"values (one per linked field), got {v!r}"
+                )
+            for p, x in zip(paths, combo, strict=True):
+                if isinstance(x, str) and x.startswith("auto"):
+                    if PATH_FIELD[p] not in AUTO_FIELDS:
+                        raise RvsmError(
+                            f"{source}: axes.\"{key}\": {x!r} is only allowed for "
+                            "weights.bits and datapath.accumulator_bits"
+                        )
+                    _auto_offset(x, f"{source}: axes.\"{key}\"")
+            combos.append(combo)
+        axes.append((paths, tuple(combos)))
+    return tuple(axes)
+
+
+def _axis_values(value: Any, where: str) -> list:
+    if isinstance(value, list):
+        if not value:
+            raise RvsmError(f"{where}: empty list of values")
+        return value
+    if isinstance(value, dict):
+        extra = set(value) - {"start", "stop", "step"}
+        if extra or "start" not in value or "stop" not in value:
+            raise RvsmError(f"{where}: a range is {{start = A, stop = B, step = C}} (stop "
+                            "included, step default 1)")
+        start, stop, step = value["start"], value["stop"], value.get("step", 1)
+        nums = (start, stop, step)
+        if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in nums):
+            raise RvsmError(f"{where}: start, stop and step must be numbers")
+        if step <= 0 or stop < start:
+            raise RvsmError(f"{where}: need step > 0 and stop >= start, got {value}")
+        n = int(math.floor((stop - start) / step + 1e-9)) + 1
+        if n > MAX_POINTS:
+            raise RvsmError(f"{where}: range has {n} values, more than {MAX_POINTS}")
+        if all(isinstance(v, int) for v in nums):
+            return [start + i * step for i in range(n)]
+        return [round(start + i * step, 12) for i in range(n)]
+    raise RvsmError(f"{where}: give a list of values or a range {{start, stop, step}}, "
+                    f"not {value!r} (a single value belongs in [base])")
+
+
+def _auto_offset(text: str, where: str) -> int:
+    rest = text[4:].strip()
+    if not rest:
+        return 0
+    try:
+        if rest[0] not in "+-":
+            raise ValueError
+        return int(rest)
+    except ValueError:
+        raise RvsmError(f"{where}: {text!r} is not \"auto\" or \"auto+N\"") from None
+
+
+def _parse_run(raw: Any, source: str) -> RunSettings:
+    if not isinstance(raw, dict):
+        raise RvsmError(f"{source}: missing [run] table (run.scenes is required)")
+    for key in raw:
+        if key not in RUN_KEYS:
+            raise RvsmError(f"{source}: unknown key run.{key}; [run] takes {', '.join(RUN_KEYS)}")
+    scenes = raw.get("scenes")
+    if isinstance(scenes, str):
+        scenes = [scenes]
+    if not isinstance(scenes, list) or not scenes or not all(isinstance(s, str) for s in scenes):
+        raise RvsmError(f"{source}: run.scenes must be a non-empty list of scene names or "
+                        "paths, e.g. [\"coin\", \"flyball\"]")
+    size_text = raw.get("size", "64x96")
+    try:
+        size = parse_size(str(size_text))
+    except RvsmError as exc:
+        raise RvsmError(f"{source}: run.size: {exc}") from None
+    frames = _pos_int(raw.get("frames", 11), f"{source}: run.frames")
+    spf = _pos_int(raw.get("steps_per_frame", 10), f"{source}: run.steps_per_frame")
+    seeds = raw.get("seeds", [0])
+    seeds = seeds if isinstance(seeds, list) else [seeds]
+    for s in seeds:
+        if isinstance(s, bool) or not isinstance(s, int) or s < 0:
+            raise RvsmError(f"{source}: run.seeds must be integers >= 0, got {s!r}")
+    noise = raw.get("noise", [False])
+    noise = noise if isinstance(noise, list) else [noise]
+    if not noise or not all(isinstance(n, bool) for n in noise):
+        raise RvsmError(f"{source}: run.noise must be true, false or a list of them")
+    method = raw.get("method", "auto")
+    if method not in ("auto", "tfi", "tfp", "rvsm"):
+        raise RvsmError(f"{source}: run.method must be auto, tfi, tfp or rvsm, got {method!r}")
+    match = raw.get("match", "gain")
+    if match not in ("gain", "affine"):
+        raise RvsmError(f"{source}: run.match must be gain or affine, got {match!r}")
+    return RunSettings(tuple(dict.fromkeys(scenes)), size, frames, spf,
+                       tuple(dict.fromkeys(seeds)), tuple(dict.fromkeys(noise)), method, match)
+
+
+def _parse_hardware(raw: Any, source: str) -> HardwareSettings:
+    if not isinstance(raw, dict):
+        raise RvsmError(f"{source}: [hardware] must be a table")
+    for key in raw:
+        if key not in HARDWARE_KEYS:
+            raise RvsmError(f"{source}: unknown key hardware.{key}; [hardware] takes "
+                            f"{', '.join(HARDWARE_KEYS)}")
+    enabled = raw.get("enabled", True)
+    if not isinstance(enabled, bool):
+        raise RvsmError(f"{source}: hardware.enabled must be true or false")
+    try:
+        size = parse_size(str(raw.get("size", "4x4")))
+    except RvsmError as exc:
+        raise RvsmError(f"{source}: hardware.size: {exc}") from None
+    if size[0] * size[1] > 64:
+        raise RvsmError(f"{source}: hardware.size {size[0]}x{size[1]} is too large to "
+                        "synthesise (flat RTL); use at most 64 pixels, e.g. \"4x4\"")
+    return HardwareSettings(enabled, size)
+
+
+def _pos_int(v: Any, where: str) -> int:
+    if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+        raise RvsmError(f"{where} must be an integer >= 1, got {v!r}")
+    return v
+
+
+def _expand(spec: SweepSpec) -> list[Design]:
+    names = [paths for paths, _ in spec.axes]
+    value_lists = [values for _, values in spec.axes]
+    n = math.prod(len(v) for v in value_lists) if value_lists else 1
+    if n > MAX_POINTS:
+        raise RvsmError(f"{spec.source}: [axes] make {n} design points, more than {MAX_POINTS}")
+    designs: dict[str, Design] = {}
+    for combo in itertools.product(*value_lists):
+        axes: dict[str, Any] = {}
+        for paths, values in zip(names, combo, strict=True):
+            axes.update(zip(paths, values, strict=True))
+        d = make_design(spec.base, axes)
+        designs.setdefault(d.design_id, d)
+    return list(designs.values())
+
+
+def make_design(base: DesignPoint, axes: dict[str, Any]) -> Design:
+    """Apply ``axes`` (``section.key -> value``, ``"auto[+N]"`` allowed) to ``base``."""
+    kwargs = {PATH_FIELD[p]: v for p, v in axes.items()}
+    autos = {f: _auto_offset(v, f) for f, v in kwargs.items()
+             if isinstance(v, str) and f in AUTO_FIELDS and v.startswith("auto")}
+    try:
+        if autos:
+            wide = {f: (MAX_WEIGHT_BITS if f == "weight_bits" else MAX_ACC_BITS) for f in autos}
+            kwargs.update(_resolve_autos(base, kwargs, wide, autos))
+        point = dataclasses.replace(base, noise=False, seed=0, **kwargs)
+    except RvsmError as exc:
+        text = json.dumps({"base": base.to_dict(), "axes": axes}, sort_keys=True, default=str)
+        return Design(hashlib.sha256(text.encode()).hexdigest()[:16], dict(axes), None,
+                      str(exc), text)
+    except (TypeError, ValueError) as exc:  # pragma: no cover - defensive
+        text = json.dumps({"base": base.to_dict(), "axes": axes}, sort_keys=True, default=str)
+        return Design(hashlib.sha256(text.encode()).hexdigest()[:16], dict(axes), None,
+                      f"{type(exc).__name__}: {exc}", text)
+    toml = design_point_toml(point)
+    return Design(hashlib.sha256(toml.encode()).hexdigest()[:16], dict(axes), point, None, toml)
+
+
+def _resolve_autos(
+    base: DesignPoint, kwargs: dict[str, Any], wide: dict[str, int], autos: dict[str, int]
+) -> dict[str, int]:
+    """Smallest widths: weights.bits holding every quantised weight, accumulator_bits
+    holding the largest nominal threshold (saturation at 2**(W-1)-1 >= threshold still
+    fires, so with ``reset = "zero"`` nothing is lost), each plus its offset."""
+    trial = dataclasses.replace(base, noise=False, seed=0, **{**kwargs, **wide})
+    out = {}
+    if "weight_bits" in autos:
+        ws = quantise_model(trial.model, trial.weight_frac_bits, trial.weight_rounding)
+        need = max(max(_signed_bits(int(w.max())), _signed_bits(int(w.min()))) for w in ws)
+        out["weight_bits"] = max(2, need + autos["weight_bits"])
+    if "accumulator_bits" in autos:
+        need = _signed_bits(int(trial.nominal_thresholds().max()))
+        out["accumulator_bits"] = max(2, need + autos["accumulator_bits"])
+    return out

@@ -1,0 +1,201 @@
+"""Sweep results in SQLite (WAL): one row per design point x scene x noise x seed.
+
+Tables (see docs/design-space.md):
+
+- ``sweeps``: every sweep file run into this database (hash, path, text, times).
+- ``points``: every task a sweep expanded to, keyed by ``point_id``, with its design.
+- ``results``: one row per finished task, primary key ``(point_id, scene, noise, seed,
+  steps, size)``; ``status`` ``ok`` (metrics), ``invalid`` (validation refused the design;
+  ``error`` says why) or ``error`` (the computation failed; retried on the next run). The
+  full record (JSON) and the full design point (TOML) are stored with it.
+- ``hw_cost``: yosys cells / flip-flops per distinct RTL, keyed by the contract digest.
+
+Only the coordinating process writes, one transaction per row, so an interrupted sweep
+keeps every finished row and a rerun adds exactly the missing ones.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sqlite3
+import time
+from pathlib import Path
+from typing import Any
+
+from rvsm.model.errors import RvsmError
+
+from .sweep_spec import SweepSpec, SweepTask
+
+SCHEMA_VERSION = 1
+SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS sweeps (
+    sweep_hash TEXT PRIMARY KEY, path TEXT NOT NULL, text TEXT NOT NULL,
+    first_run TEXT NOT NULL, last_run TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS points (
+    point_id TEXT PRIMARY KEY, design_id TEXT NOT NULL, sweep_hash TEXT NOT NULL,
+    scene TEXT NOT NULL, noise INTEGER NOT NULL, seed INTEGER NOT NULL,
+    steps INTEGER NOT NULL, size TEXT NOT NULL, axes TEXT NOT NULL,
+    design_toml TEXT NOT NULL, hw_digest TEXT, error TEXT
+);
+CREATE TABLE IF NOT EXISTS results (
+    point_id TEXT NOT NULL, scene TEXT NOT NULL, noise INTEGER NOT NULL,
+    seed INTEGER NOT NULL, steps INTEGER NOT NULL, size TEXT NOT NULL,
+    design_id TEXT NOT NULL, model TEXT, status TEXT NOT NULL, error TEXT,
+    agreement REAL, psnr_float REAL, psnr_fixed REAL, psnr_cost REAL,
+    ssim_float REAL, ssim_fixed REAL, ssim_cost REAL,
+    mse_float REAL, mse_fixed REAL, mse_cost REAL, max_saturation_rate REAL,
+    seconds REAL, axes TEXT NOT NULL, record TEXT, design_toml TEXT NOT NULL,
+    hw_digest TEXT, finished TEXT NOT NULL,
+    PRIMARY KEY (point_id, scene, noise, seed, steps, size)
+);
+CREATE INDEX IF NOT EXISTS results_design ON results (design_id);
+CREATE TABLE IF NOT EXISTS hw_cost (
+    digest TEXT PRIMARY KEY, size TEXT NOT NULL, pixels INTEGER NOT NULL,
+    cells INTEGER NOT NULL, flip_flops INTEGER NOT NULL,
+    cells_per_pixel REAL NOT NULL, ff_per_pixel REAL NOT NULL,
+    seconds REAL NOT NULL, contract TEXT NOT NULL, cell_types TEXT, finished TEXT NOT NULL
+);
+"""
+METRICS = ("agreement", "psnr_float", "psnr_fixed", "psnr_cost", "ssim_float", "ssim_fixed",
+           "ssim_cost", "mse_float", "mse_fixed", "mse_cost", "max_saturation_rate")
+
+
+def _now() -> str:
+    return time.strftime("%Y-%m-%dT%H:%M:%S")
+
+
+class SweepStore:
+    """An open results database (``path``; created with its schema if missing)."""
+
+    def __init__(self, path: str | os.PathLike) -> None:
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self.db = sqlite3.connect(self.path, timeout=30)
+            self.db.execute("PRAGMA journal_mode=WAL")
+            self.db.execute("PRAGMA synchronous=NORMAL")
+            self.db.executescript(SCHEMA)
+            self.db.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)",
+                            (str(SCHEMA_VERSION),))
+            self.db.commit()
+        except sqlite3.DatabaseError as exc:
+            raise RvsmError(f"{self.path}: not a usable sweep database: {exc}") from None
+
+    def close(self) -> None:
+        """Close the connection."""
+        self.db.close()
+
+    def __enter__(self) -> SweepStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- writing ------------------------------------------------------------------------
+
+    def register(self, spec: SweepSpec, tasks: list[SweepTask], digests: dict[str, str]) -> None:
+        """Record the sweep file and its tasks (idempotent; one transaction)."""
+        now = _now()
+        with self.db:
+            self.db.execute(
+                "INSERT INTO sweeps VALUES (?, ?, ?, ?, ?) ON CONFLICT(sweep_hash) "
+                "DO UPDATE SET last_run = excluded.last_run, path = excluded.path",
+                (spec.sweep_hash, spec.source, spec.text, now, now),
+            )
+            self.db.executemany(
+                "INSERT OR IGNORE INTO points VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                [(t.point_id, t.design.design_id, spec.sweep_hash, t.scene, int(t.noise),
+                  t.seed, t.steps, t.size_text, json.dumps(t.design.axes), t.design.toml,
+                  digests.get(t.design.design_id), t.design.error) for t in tasks],
+            )
+
+    def attach_digests(self, digests: dict[str, str]) -> None:
+        """Give rows stored without hardware cost (``[hardware]`` was off) their digest."""
+        with self.db:
+            self.db.executemany(
+                "UPDATE results SET hw_digest = ? WHERE design_id = ? AND hw_digest IS NULL",
+                [(dig, did) for did, dig in digests.items()],
+            )
+
+    def write_result(self, task: SweepTask, record: dict[str, Any] | None, status: str,
+                     error: str | None = None, hw_digest: str | None = None) -> bool:
+        """Store one task's outcome; committed at once. Returns False if already stored
+        (a finished row is never replaced; an ``error`` row is)."""
+        rec = record or {}
+        row = (task.point_id, task.scene, int(task.noise), task.seed, task.steps,
+               task.size_text, task.design.design_id, rec.get("model"), status, error,
+               *[rec.get(m) for m in METRICS], rec.get("seconds"),
+               json.dumps(task.design.axes), json.dumps(rec) if record else None,
+               task.design.toml, hw_digest, _now())
+        with self.db:
+            self.db.execute(
+                "DELETE FROM results WHERE point_id = ? AND scene = ? AND noise = ? AND "
+                "seed = ? AND steps = ? AND size = ? AND status = 'error'",
+                row[:6],
+            )
+            cur = self.db.execute(
+                f"INSERT OR IGNORE INTO results VALUES ({', '.join('?' * len(row))})", row
+            )
+        return cur.rowcount == 1
+
+    def write_hw_cost(self, digest: str, stats: dict[str, Any]) -> None:
+        """Store one synthesis result (ignored if the digest is already known)."""
+        with self.db:
+            self.db.execute(
+                "INSERT OR IGNORE INTO hw_cost VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                (digest, stats["size"], stats["pixels"], stats["cells"], stats["flip_flops"],
+                 stats["cells"] / stats["pixels"], stats["flip_flops"] / stats["pixels"],
+                 stats["seconds"], stats["contract"], json.dumps(stats.get("cell_types", {})),
+                 _now()),
+            )
+
+    # -- reading ------------------------------------------------------------------------
+
+    def done_keys(self) -> set[tuple]:
+        """Keys ``(point_id, scene, noise, seed, steps, size)`` of finished rows."""
+        cur = self.db.execute("SELECT point_id, scene, noise, seed, steps, size FROM results "
+                              "WHERE status != 'error'")
+        return {tuple(r) for r in cur}
+
+    def known_digests(self) -> set[str]:
+        """Contract digests already synthesised."""
+        return {r[0] for r in self.db.execute("SELECT digest FROM hw_cost")}
+
+    def results(self, status: str | None = None) -> list[dict[str, Any]]:
+        """Result rows as dicts (``record`` and ``axes`` decoded), joined with hw_cost."""
+        q = ("SELECT r.*, h.cells, h.flip_flops, h.cells_per_pixel, h.ff_per_pixel, "
+             "h.size AS hw_size FROM results r LEFT JOIN hw_cost h ON h.digest = r.hw_digest")
+        args: tuple = ()
+        if status is not None:
+            q += " WHERE r.status = ?"
+            args = (status,)
+        cur = self.db.execute(q + " ORDER BY r.rowid", args)
+        cols = [c[0] for c in cur.description]
+        rows = []
+        for r in cur:
+            d = dict(zip(cols, r, strict=True))
+            d["axes"] = json.loads(d["axes"])
+            d["record"] = json.loads(d["record"]) if d["record"] else None
+            d["noise"] = bool(d["noise"])
+            rows.append(d)
+        return rows
+
+    def count(self, table: str = "results") -> int:
+        """Rows in ``table``."""
+        if table not in ("results", "points", "hw_cost", "sweeps"):
+            raise ValueError(table)
+        return int(self.db.execute(f"SELECT COUNT(*) FROM {table}").fetchone()[0])
+
+
+def open_existing(path: str | os.PathLike) -> SweepStore:
+    """Open a results database that must already exist (for reports)."""
+    p = Path(path)
+    if not p.is_file():
+        raise RvsmError(f"{p}: no such results database; run `rvsm sweep SWEEP.toml -o {p}`")
+    store = SweepStore(p)
+    if not store.db.execute("SELECT 1 FROM meta WHERE key = 'schema_version'").fetchone():
+        raise RvsmError(f"{p}: not a sweep results database")
+    return store

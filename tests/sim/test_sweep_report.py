@@ -1,0 +1,68 @@
+"""Sweep reports: Pareto extraction, aggregation, recommendation, figures."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from rvsm.sim.sweep_report import (
+    pareto_figure,
+    pareto_mask,
+    recommend,
+    summarise,
+    width_cost_figure,
+)
+from rvsm.sim.sweep_run import run_sweep
+from rvsm.sim.sweep_spec import parse_sweep
+from rvsm.sim.sweep_store import SweepStore
+
+
+def test_pareto_known_set():
+    hw = [1, 2, 3, 4, 2, 5, 3, 1]
+    cost = [5, 3, 3, 1, 4, 0.5, 2, 6]
+    # (1,5) front; (2,3) front; (3,3) dominated by (2,3); (4,1) front; (2,4) dominated;
+    # (5,0.5) front; (3,2) front; (1,6) dominated by (1,5)
+    assert pareto_mask(hw, cost).tolist() == [True, True, False, True, False, True, True,
+                                              False]
+
+
+def test_pareto_ties_and_empty():
+    assert pareto_mask([1, 1], [2, 2]).tolist() == [True, True]
+    assert pareto_mask([], []).size == 0
+    rng = np.random.default_rng(0)
+    x, y = rng.random(50), rng.random(50)
+    m = pareto_mask(x, y)
+    for i in np.flatnonzero(m):  # no front point is dominated by any point
+        assert not np.any((x <= x[i]) & (y <= y[i]) & ((x < x[i]) | (y < y[i])))
+    for i in np.flatnonzero(~m):  # every other point is
+        assert np.any((x <= x[i]) & (y <= y[i]) & ((x < x[i]) | (y < y[i])))
+
+
+def test_summarise_recommend_and_figures(tmp_path):
+    spec = parse_sweep("""
+[axes]
+"adc.bits" = [5, 8]
+"weights.frac_bits" = [6, 10]
+"weights.bits" = ["auto"]
+"datapath.accumulator_bits" = ["auto"]
+[run]
+scenes = ["coin"]
+size = "16x24"
+frames = 3
+noise = [false, true]
+[hardware]
+enabled = false
+""")
+    db = tmp_path / "r.sqlite"
+    run_sweep(spec, db, workers=0, progress=False)
+    with SweepStore(db) as store:
+        designs = summarise(store.results())
+    assert len(designs) == 4 and all(d.complete and len(d.rows) == 2 for d in designs)
+    for d in designs:
+        assert d.worst_cost == max(abs(r["psnr_cost"]) for r in d.rows)
+        assert d.proxy_bits == sum(d.values[k] for k in d.values if k != "weights.frac_bits")
+    rec = recommend(designs, tolerance=1e9)
+    assert rec is not None and rec.hw == min(d.hw for d in designs)
+    assert recommend(designs, tolerance=-1.0) is None
+    for fig in (width_cost_figure(designs), pareto_figure(designs)):
+        assert isinstance(fig, Figure)

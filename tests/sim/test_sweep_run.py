@@ -1,0 +1,195 @@
+"""Running sweeps: resume after an interrupt, no duplicates, changed files, Dask, CLI."""
+
+from __future__ import annotations
+
+import sqlite3
+
+import pytest
+
+from rvsm.sim import sweep_run
+from rvsm.sim.cli import main
+from rvsm.sim.sweep_run import run_sweep
+from rvsm.sim.sweep_spec import parse_sweep
+
+SWEEP = """
+[axes]
+"adc.bits" = [6, 8]
+"weights.frac_bits" = [7, 9]
+"weights.bits" = ["auto"]
+"datapath.accumulator_bits" = ["auto"]
+[run]
+scenes = ["coin"]
+size = "16x24"
+frames = 3
+noise = [false, true]
+[hardware]
+enabled = false
+"""
+
+
+@pytest.fixture
+def counter(monkeypatch):
+    """Count calls of the task function (inline runs only)."""
+    calls = []
+    real = sweep_run.evaluate_task
+
+    def counting(task, *args):
+        calls.append(task.point_id)
+        return real(task, *args)
+
+    monkeypatch.setattr(sweep_run, "evaluate_task", counting)
+    return calls
+
+
+def _keys(db):
+    with sqlite3.connect(db) as con:
+        return list(con.execute("SELECT point_id, scene, noise, seed, steps, size FROM results"))
+
+
+def test_resume_after_interrupt_no_duplicates(tmp_path, counter):
+    spec = parse_sweep(SWEEP)
+    db = tmp_path / "r.sqlite"
+
+    def stop_after_three(summary):
+        if summary.computed == 3:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(spec, db, workers=0, progress=False, on_result=stop_after_three)
+    assert len(_keys(db)) == 3 and len(counter) == 3
+    s = run_sweep(spec, db, workers=0, progress=False)
+    assert (s.already_done, s.computed) == (3, 5)
+    assert len(counter) == 8 and len(set(counter)) == 8  # nothing computed twice
+    keys = _keys(db)
+    assert len(keys) == 8 == len(set(keys))
+    s = run_sweep(spec, db, workers=0, progress=False)  # a rerun computes nothing
+    assert (s.already_done, s.computed) == (8, 0) and len(counter) == 8
+    with sqlite3.connect(db) as con:
+        toml, = con.execute("SELECT design_toml FROM results LIMIT 1").fetchone()
+    assert "[adc]" in toml and "[datapath]" in toml  # the full design point is stored
+
+
+def test_changed_sweep_adds_only_new_points(tmp_path, counter):
+    db = tmp_path / "r.sqlite"
+    run_sweep(parse_sweep(SWEEP), db, workers=0, progress=False)
+    assert len(counter) == 8
+    changed = SWEEP.replace('"adc.bits" = [6, 8]', '"adc.bits" = [6, 7, 8]')
+    s = run_sweep(parse_sweep(changed), db, workers=0, progress=False)
+    assert (s.already_done, s.computed) == (8, 4)
+    assert len(_keys(db)) == 12 == len(set(_keys(db)))
+    with sqlite3.connect(db) as con:
+        assert con.execute("SELECT COUNT(*) FROM sweeps").fetchone()[0] == 2
+
+
+def test_invalid_points_recorded_not_fatal(tmp_path):
+    text = SWEEP.replace('"weights.bits" = ["auto"]', '"weights.bits" = [4, "auto"]')
+    db = tmp_path / "r.sqlite"
+    s = run_sweep(parse_sweep(text), db, workers=0, progress=False)
+    assert s.invalid == 8 and s.computed == 8
+    with sqlite3.connect(db) as con:
+        errors = [r[0] for r in con.execute("SELECT error FROM results WHERE status='invalid'")]
+    assert len(errors) == 8 and all("weights" in e for e in errors)
+    s = run_sweep(parse_sweep(text), db, workers=0, progress=False)
+    assert s.already_done == 16 and s.invalid == 0
+
+
+def test_dask_threads_match_inline(tmp_path):
+    spec = parse_sweep(SWEEP)
+    a, b = tmp_path / "a.sqlite", tmp_path / "b.sqlite"
+    run_sweep(spec, a, workers=0, progress=False)
+    s = run_sweep(spec, b, workers=1, processes=False, progress=False)
+    assert s.computed == 8 and s.workers == 1
+    q = "SELECT point_id, psnr_fixed, agreement FROM results ORDER BY point_id"
+    with sqlite3.connect(a) as ca, sqlite3.connect(b) as cb:
+        assert list(ca.execute(q)) == list(cb.execute(q))
+
+
+def test_dask_interrupt_keeps_rows(tmp_path):
+    spec = parse_sweep(SWEEP)
+    db = tmp_path / "r.sqlite"
+
+    def stop(summary):
+        if summary.computed == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(spec, db, workers=1, processes=False, progress=False, on_result=stop)
+    assert len(_keys(db)) == 2
+    s = run_sweep(spec, db, workers=1, processes=False, progress=False)
+    assert (s.already_done, s.computed) == (2, 6)
+    assert len(set(_keys(db))) == len(_keys(db)) == 8
+
+
+def test_two_process_local_cluster(tmp_path):
+    s = run_sweep(parse_sweep(SWEEP), tmp_path / "r.sqlite", workers=2, progress=False)
+    assert s.computed == 8 and s.workers == 2 and not s.errors
+
+
+def test_hw_cost_synthesised_once(tmp_path):
+    text = """
+[axes]
+"threshold.phi" = [300.0, 400.0]
+[run]
+scenes = ["coin"]
+size = "8x8"
+frames = 2
+[hardware]
+size = "1x1"
+"""
+    db = tmp_path / "r.sqlite"
+    s = run_sweep(parse_sweep(text), db, workers=0, progress=False)
+    assert s.hw_synthesised == 1 and s.computed == 2  # phi does not change the RTL
+    s = run_sweep(parse_sweep(text.replace("400.0", "350.0")), db, workers=0, progress=False)
+    assert s.hw_synthesised == 0 and s.hw_cached == 1 and s.computed == 1
+    with sqlite3.connect(db) as con:
+        cells, ffs = con.execute("SELECT cells, flip_flops FROM hw_cost").fetchone()
+        assert cells > ffs > 0
+        assert con.execute("SELECT COUNT(*) FROM results r JOIN hw_cost h "
+                           "ON h.digest = r.hw_digest").fetchone()[0] == 3
+
+
+def test_cli_run_report_and_errors(tmp_path, capsys):
+    f = tmp_path / "s.toml"
+    f.write_text(SWEEP)
+    db = tmp_path / "r.sqlite"
+    assert main(["sweep", str(f), "-o", str(db), "--workers", "0", "--no-progress"]) == 0
+    assert main(["sweep", "run", str(f), "-o", str(db), "--workers", "0",
+                 "--no-progress"]) == 0
+    assert "8 already done, 0 computed" in capsys.readouterr().out
+    out = tmp_path / "rep"
+    assert main(["sweep", "report", str(db), "-o", str(out)]) == 0
+    assert {p.name for p in out.iterdir()} >= {"report.md", "pareto.png", "width-cost.png"}
+    bad = tmp_path / "bad.toml"
+    bad.write_text(SWEEP.replace('"adc.bits"', '"adc.bitz"'))
+    assert main(["sweep", str(bad), "-o", str(db)]) == 2
+    assert "adc.bitz" in capsys.readouterr().err
+    assert main(["sweep", "report", str(tmp_path / "missing.sqlite")]) == 2
+
+
+def test_existing_scheduler(tmp_path):
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=":0") as cluster:
+        s = run_sweep(parse_sweep(SWEEP), tmp_path / "r.sqlite",
+                      scheduler=cluster.scheduler_address, progress=False)
+    assert s.computed == 8 and s.workers == 1
+
+
+def test_hardware_added_later_attaches_to_old_rows(tmp_path):
+    text = """
+[run]
+scenes = ["coin"]
+size = "8x8"
+frames = 2
+[hardware]
+enabled = false
+"""
+    db = tmp_path / "r.sqlite"
+    run_sweep(parse_sweep(text), db, workers=0, progress=False)
+    s = run_sweep(parse_sweep(text.replace("enabled = false", 'size = "1x1"')), db,
+                  workers=0, progress=False)
+    assert s.computed == 0 and s.hw_synthesised == 1
+    with sqlite3.connect(db) as con:
+        assert con.execute("SELECT COUNT(*) FROM results WHERE hw_digest IS NOT NULL"
+                           ).fetchone()[0] == 1
