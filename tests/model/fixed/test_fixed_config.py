@@ -17,7 +17,6 @@ from rvsm.model.fixed.config import (
     save_design_point,
 )
 
-
 # The widths the numbers in these tests were worked out for (8-bit ADC, 12/10 weights,
 # 21-bit accumulator), pinned so that the tests do not move with the project default.
 WIDE = {"adc_bits": 8, "weight_bits": 12, "weight_frac_bits": 10, "accumulator_bits": 21}
