@@ -61,9 +61,13 @@ def stimuli(c: ArrayContract, seed: int, steps: int = 60) -> dict[str, tuple]:
     fpn = np.clip(np.round(top / 8 * (1 + 0.5 * rng.standard_normal((s, h, w)))), 1, top)
     fpn.reshape(-1)[:: max(1, fpn.size // 3)] = top
     fpn.reshape(-1)[1] = 1
+    # dark pixels ringed by full-scale ones: DoG sums go negative, so -1 spikes fire
+    yy, xx = np.indices((h, w))
+    checker = np.broadcast_to(((yy + xx) % 2) * full, (steps, h, w)).copy()
     return {
         "random": (rand, thr, ()),
         "extremes": (extremes, thr, ()),
+        "checkerboard": (checker, thr, ()),
         "fixed_pattern": (rand, fpn.astype(np.int64), ()),
         "clear_mid_stream": (rand, thr, (steps // 3, steps // 2 + 1)),
     }
