@@ -126,23 +126,45 @@ def _load_folder(path: Path) -> np.ndarray:
     return np.stack(frames)
 
 
-def _load_video(path: Path) -> np.ndarray:
+def _video_plugin_installed() -> bool:
+    """True if imageio has a reader for common video containers (ffmpeg or PyAV)."""
+    import importlib.util
+
+    return any(importlib.util.find_spec(m) for m in ("imageio_ffmpeg", "av"))
+
+
+def _read_frames(path: Path, what: str) -> list[np.ndarray]:
+    """Every frame (page) of ``path`` through ``imageio.v3.imiter``, as grey ``(H, W)``."""
     import imageio.v3 as iio
 
     try:
-        frames = [_to_grey(fr, str(path)) for fr in iio.imiter(path)]
+        with warnings.catch_warnings():  # imageio's plugin probing warns on bad files
+            warnings.simplefilter("ignore")
+            return [_to_grey(fr, str(path)) for fr in iio.imiter(path)]
     except RvsmError:
         raise
     except Exception as exc:
-        msg = str(exc).lower()
-        if isinstance(exc, ImportError) or any(
-            w in msg for w in ("plugin", "backend", "ffmpeg", "pyav", "no module")
-        ):
-            raise RvsmError(
-                f"{path}: no video reader is installed; run `pip install imageio[ffmpeg]` "
-                "or give an image folder / .npy file instead"
-            ) from None
-        raise RvsmError(f"{path}: cannot read video ({type(exc).__name__})") from None
+        raise RvsmError(
+            f"{path}: cannot read this {what} ({type(exc).__name__}: {exc}); the file may be "
+            "corrupt or truncated"
+        ) from None
+
+
+def _load_image_file(path: Path) -> np.ndarray:
+    """A single image file: one frame, or every frame of an animated GIF / multi-page TIFF."""
+    frames = _read_frames(path, "image")
+    if not frames:
+        raise RvsmError(f"{path}: image file has no frames")
+    return np.stack(frames)
+
+
+def _load_video(path: Path) -> np.ndarray:
+    if not _video_plugin_installed():
+        raise RvsmError(
+            f"{path}: no video reader is installed; run `pip install imageio[ffmpeg]` "
+            "or give an image folder, an animated GIF or a .npy file instead"
+        )
+    frames = _read_frames(path, "video")
     if not frames:
         raise RvsmError(f"{path}: video has no frames")
     return np.stack(frames)
@@ -205,7 +227,7 @@ def load_scene(
     elif suffix == ".npy":
         frames = _load_npy(path)
     elif suffix in IMAGE_SUFFIXES:
-        frames = _read_image(path)[None]
+        frames = _load_image_file(path)
     elif suffix in VIDEO_SUFFIXES:
         frames = _load_video(path)
     else:

@@ -148,3 +148,28 @@ def test_video_without_plugin_or_garbage(tmp_path) -> None:
         load_scene(str(p))
     msg = str(info.value)
     assert "\n" not in msg and str(p) in msg
+
+
+def test_animated_gif_is_a_frame_sequence(tmp_path):
+    import imageio.v3 as iio
+
+    frames = (np.arange(4)[:, None, None] * 60 + np.zeros((4, 10, 16))).astype(np.uint8)
+    iio.imwrite(tmp_path / "anim.gif", frames)
+    scene = load_scene(str(tmp_path / "anim.gif"))
+    assert scene.frames.shape == (4, 10, 16)
+    np.testing.assert_allclose(scene.frames[:, 0, 0], [0, 60, 120, 180], atol=1)
+
+
+def test_video_without_a_reader_says_how_to_install(tmp_path, monkeypatch):
+    from rvsm.model import scene_io
+
+    monkeypatch.setattr(scene_io, "_video_plugin_installed", lambda: False)
+    (tmp_path / "clip.mp4").write_bytes(b"\x00" * 64)
+    with pytest.raises(RvsmError, match=r"pip install imageio\[ffmpeg\]"):
+        load_scene(str(tmp_path / "clip.mp4"))
+
+
+def test_corrupt_image_file_is_one_clear_error(tmp_path):
+    (tmp_path / "bad.gif").write_bytes(b"GIF89a")
+    with pytest.raises(RvsmError, match="corrupt or truncated"):
+        load_scene(str(tmp_path / "bad.gif"))
