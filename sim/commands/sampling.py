@@ -129,11 +129,6 @@ def run_evaluate(args: argparse.Namespace) -> int:
 
     spikes, meta = load_spikes(args.spikes)
     scene = scene_from_meta(meta, override=args.scene)
-    if spikes.shape[0] != scene.num_steps or spikes.shape[2:] != scene.shape:
-        raise RvsmError(
-            f"spikes {spikes.shape} do not fit scene {scene.name!r} "
-            f"({scene.num_steps} steps, {scene.shape[0]}x{scene.shape[1]})"
-        )
     model = meta.get("model")
     phis = meta.get("phis")
     if model is None or phis is None:

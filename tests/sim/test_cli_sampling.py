@@ -145,3 +145,13 @@ def test_simulate_fixed_refuses_float_options(tmp_path, capsys):
                         "-o", tmp_path / "x.npz")
     assert code == 2 and "--model" in err and "design point" in err
     assert not (tmp_path / "x.npz").exists()
+
+
+def test_evaluate_refuses_spikes_that_do_not_fit_the_scene(tmp_path, capsys):
+    from rvsm.model.spike_files import save_spikes
+
+    meta = {"scene_arg": "coin", "height": 16, "width": 16, "num_frames": 3,
+            "steps_per_frame": 2, "hold": False, "model": "fsm", "phis": [400.0]}
+    save_spikes(tmp_path / "mm.npz", np.zeros((5, 1, 8, 8), np.int8), meta)
+    code, _, err = _run(capsys, "evaluate", tmp_path / "mm.npz")
+    assert code == 2 and err.count("\n") == 1 and "do not match scene" in err
