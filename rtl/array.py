@@ -129,12 +129,14 @@ def simulate(
     codes: np.ndarray,
     thresholds: np.ndarray,
     clear_before: Sequence[int] = (),
+    vcd_path: str | None = None,
 ) -> np.ndarray:
     """Run :class:`RvsmArray` in ``amaranth.sim``; spikes ``(T, S, H, W) int8``.
 
     Thresholds are loaded through the configuration port, one step is strobed per clock
     and ``clear`` is pulsed for one cycle before each step in ``clear_before``; outputs
     are read :attr:`RvsmArray.latency` cycles after each strobe (checking ``valid``).
+    With ``vcd_path`` the run's waveform is written there.
     """
     from amaranth.sim import Simulator
 
@@ -174,5 +176,9 @@ def simulate(
     sim = Simulator(dut)
     sim.add_clock(1e-6)
     sim.add_testbench(bench)
-    sim.run()
+    if vcd_path is None:
+        sim.run()
+    else:
+        with sim.write_vcd(str(vcd_path)):
+            sim.run()
     return out.reshape(steps, c.num_scales, c.height, c.width)

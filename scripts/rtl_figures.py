@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from rvsm.model.fixed.config import default_design_point
-from rvsm.sim.verify import run_rtl
+from rvsm.sim.cosim.verify import run_rtl
 
 
 def main() -> None:

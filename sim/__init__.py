@@ -1,1 +1,3 @@
-"""Simulation front end: the rvsm CLI, experiments, cocotb runners and design sweeps."""
+"""Everything that runs the twins: the ``rvsm`` CLI (:mod:`.cli`), RTL co-simulation
+(:mod:`.cosim`), the paper's studies and the demo (:mod:`.studies`) and design sweeps
+(:mod:`.sweep`)."""

@@ -5,19 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.fixed.weights import quantise_model
 from rvsm.model.kernels import MODEL_NAMES
 from rvsm.rtl.array import RvsmArray, simulate
 from rvsm.rtl.pixel_cell import PixelCell
-
-
-def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int = 12,
-                   shift: int = 1, reset: str = "subtract") -> ArrayContract:
-    """A small contract from a model's quantised kernels."""
-    ks = quantise_model(model, frac_bits, "round-half-up")
-    weights = tuple(tuple(tuple(int(v) for v in row) for row in k) for k in ks)
-    return ArrayContract(h, w, 4, weights, shift, acc_bits, model != "fsm", reset)
 
 
 def test_latency_is_named() -> None:
@@ -25,18 +15,18 @@ def test_latency_is_named() -> None:
 
 
 @pytest.mark.parametrize("model", MODEL_NAMES)
-def test_every_model_matches_contract(model: str) -> None:
-    c = model_contract(model, 3, 5)
+def test_every_model_matches_contract(model: str, small_contract, amaranth_sim) -> None:
+    c = small_contract(model, 3, 5, acc_bits=12)
     rng = np.random.default_rng(3)
     codes = rng.integers(0, 16, (25, 3, 5))
     thr = rng.integers(1, 200, (c.num_scales, 3, 5))
     want = c.run(codes, thr)
-    assert np.array_equal(simulate(c, codes, thr), want)
+    assert np.array_equal(simulate(c, codes, thr, vcd_path=amaranth_sim.vcd_path()), want)
 
 
 @pytest.mark.parametrize("reset", ["zero", "subtract"])
-def test_extremes_saturation_and_clear(reset: str) -> None:
-    c = model_contract("dog2", 4, 4, acc_bits=8, shift=0, reset=reset)
+def test_extremes_saturation_and_clear(reset: str, small_contract, amaranth_sim) -> None:
+    c = small_contract("dog2", 4, 4, acc_bits=8, shift=0, reset=reset)
     rng = np.random.default_rng(5)
     codes = np.concatenate([np.zeros((4, 4, 4), int), np.full((6, 4, 4), 15),
                             rng.integers(0, 16, (10, 4, 4))])
@@ -44,6 +34,6 @@ def test_extremes_saturation_and_clear(reset: str) -> None:
     thr[0, 1:3, 1:3] = rng.integers(1, 127, (2, 2))
     clears = (7, 13)
     want = np.concatenate([c.run(codes[a:b], thr) for a, b in ((0, 7), (7, 13), (13, 20))])
-    got = simulate(c, codes, thr, clear_before=clears)
+    got = simulate(c, codes, thr, clear_before=clears, vcd_path=amaranth_sim.vcd_path())
     assert np.array_equal(got, want)
     assert (want == -1).any() and (want == 1).any()

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from amaranth.sim import Simulator
 
 from rvsm.model.fixed.core import FixedIntegrator, accumulator_range, arithmetic_shift
 from rvsm.rtl.pixel_cell import PixelCell
 
 
 def run_cell(
-    sums: list[int], thr: int, bits: int, signed: bool, reset: str, shift: int = 0,
+    amaranth_sim, sums: list[int], thr: int, bits: int, signed: bool, reset: str, shift: int = 0,
     sum_bits: int = 12, clear_at: tuple[int, ...] = (),
 ) -> list[int]:
     """Strobe ``sums`` through one cell; spikes per step (+1/-1/0)."""
@@ -37,10 +36,7 @@ def run_cell(
                 await ctx.tick()
             out.append(ctx.get(cell.spike_pos) - ctx.get(cell.spike_neg))
 
-    sim = Simulator(cell)
-    sim.add_clock(1e-6)
-    sim.add_testbench(bench)
-    sim.run()
+    amaranth_sim.run(cell, bench)
     return out
 
 
@@ -59,38 +55,38 @@ def expected(sums: list[int], thr: int, bits: int, signed: bool, reset: str,
 
 @pytest.mark.parametrize("signed", [True, False])
 @pytest.mark.parametrize("reset", ["zero", "subtract"])
-def test_random_sums_match_integrator(signed: bool, reset: str) -> None:
+def test_random_sums_match_integrator(signed: bool, reset: str, amaranth_sim) -> None:
     rng = np.random.default_rng(7)
     lo = -2048 if signed else 0
     sums = [int(v) for v in rng.integers(lo, 2048, 200)]
     for shift in (0, 2):
-        got = run_cell(sums, 300, 10, signed, reset, shift=shift)
+        got = run_cell(amaranth_sim, sums, 300, 10, signed, reset, shift=shift)
         assert got == expected(sums, 300, 10, signed, reset, shift=shift)
 
 
-def test_both_saturation_rails_and_exact_threshold() -> None:
+def test_both_saturation_rails_and_exact_threshold(amaranth_sim) -> None:
     bits = 8
     lo, hi = accumulator_range(bits)
     # threshold at the top rail: only a saturated accumulator reaches it exactly
     sums = [100, 100, 100, -100, -100, -100, -100, 127, 0, 5]
     for thr in (hi, 127, 100, 1):
-        got = run_cell(sums, thr, bits, True, "subtract")
+        got = run_cell(amaranth_sim, sums, thr, bits, True, "subtract")
         assert got == expected(sums, thr, bits, True, "subtract")
     assert lo == -128
 
 
-def test_threshold_hit_exactly_fires() -> None:
-    got = run_cell([5, 5, 10, -20], 10, 8, True, "zero")
+def test_threshold_hit_exactly_fires(amaranth_sim) -> None:
+    got = run_cell(amaranth_sim, [5, 5, 10, -20], 10, 8, True, "zero")
     assert got == [0, 1, 1, -1]
 
 
-def test_clear_restarts_accumulator() -> None:
+def test_clear_restarts_accumulator(amaranth_sim) -> None:
     sums = [7, 7, 7, 7, 7, 7]
-    got = run_cell(sums, 20, 8, True, "zero", clear_at=(2, 4))
+    got = run_cell(amaranth_sim, sums, 20, 8, True, "zero", clear_at=(2, 4))
     assert got == expected(sums, 20, 8, True, "zero", clear_at=(2, 4))
     assert got == [0, 0, 0, 0, 0, 0]
 
 
-def test_unsigned_model_never_fires_negative() -> None:
-    got = run_cell([-100] * 20, 5, 8, False, "zero")
+def test_unsigned_model_never_fires_negative(amaranth_sim) -> None:
+    got = run_cell(amaranth_sim, [-100] * 20, 5, 8, False, "zero")
     assert set(got) == {0}

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.model.fixed.config import default_design_point, save_design_point
+from rvsm.model.fixed.config import default_design_point
 from rvsm.rtl.array import RvsmArray
-from rvsm.sim.cli import main
+from rvsm.rtl.verilog import write_outputs
 
 
 @pytest.fixture(scope="module")
@@ -21,8 +21,7 @@ def generated(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, object]:
     from dataclasses import replace
 
     point = replace(point, model="fsm")
-    save_design_point(tmp / "p.toml", point)
-    assert main(["verilog", str(tmp / "p.toml"), "-o", str(tmp / "out")]) == 0
+    write_outputs(point.contract(), tmp / "out")
     return tmp / "out", point
 
 

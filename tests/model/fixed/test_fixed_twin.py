@@ -1,5 +1,5 @@
 """The fixed twin end to end: contract equality, determinism, convergence, stimulus,
-profile, cost and the CLI."""
+profile and cost (the CLI: tests/sim/cli/test_fixed.py)."""
 
 from __future__ import annotations
 
@@ -9,14 +9,13 @@ import json
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.config import DesignPoint, default_design_point, save_design_point
+from rvsm.model.fixed.config import DesignPoint, default_design_point
 from rvsm.model.fixed.cost import quantisation_cost, spike_agreement
 from rvsm.model.fixed.profile import format_profile, profile_figure, profile_report
 from rvsm.model.fixed.stimulus import load_stimulus, make_stimulus, save_stimulus
 from rvsm.model.fixed.twin import simulate_fixed
 from rvsm.model.samplers import sample
 from rvsm.model.scene_library import builtin_scene
-from rvsm.sim.cli import main
 
 SIZE = (24, 32)
 
@@ -135,28 +134,3 @@ def test_cost_keys(scene):
         assert np.isfinite(r[key])
     assert r["psnr_cost"] == pytest.approx(r["psnr_float"] - r["psnr_fixed"])
     assert len(r["agreement_per_scale"]) == 4
-
-
-def test_cli(tmp_path, capsys):
-    assert main(["config", "new"]) == 0
-    text = capsys.readouterr().out
-    assert "[datapath]" in text and "accumulator_bits = 18" in text
-    point = tmp_path / "p.toml"
-    assert main(["config", "new", "-o", str(point), "--size", "24x32"]) == 0
-    assert main(["config", "check", str(point)]) == 0
-    assert "101999" in capsys.readouterr().out
-    common = ["character", "--fixed", str(point), "--frames", "4"]
-    assert main(["stimulus", *common, "-o", str(tmp_path / "s.npz")]) == 0
-    assert load_stimulus(tmp_path / "s.npz").check()
-    assert main(["profile", *common, "--plot", str(tmp_path / "prof.png")]) == 0
-    assert (tmp_path / "prof.png").stat().st_size > 1000
-    capsys.readouterr()
-    assert main(["cost", *common, "--size", "16x20", "--json"]) == 0
-    out = json.loads(capsys.readouterr().out)
-    assert out["height"] == 16 and {"agreement", "psnr_float", "psnr_fixed", "psnr_cost"} <= set(
-        out)
-    bad = tmp_path / "bad.toml"
-    save_design_point(bad, _point())
-    bad.write_text(bad.read_text().replace('model = "dog4"', 'model = "dog9"'))
-    assert main(["config", "check", str(bad)]) == 2
-    assert "array.model" in capsys.readouterr().err

@@ -1,4 +1,4 @@
-"""Running sweeps: resume after an interrupt, no duplicates, changed files, Dask, CLI."""
+"""Running sweeps: resume after an interrupt, no duplicates, changed files, Dask."""
 
 from __future__ import annotations
 
@@ -6,10 +6,9 @@ import sqlite3
 
 import pytest
 
-from rvsm.sim import sweep_run
-from rvsm.sim.cli import main
-from rvsm.sim.sweep_run import run_sweep
-from rvsm.sim.sweep_spec import parse_sweep
+from rvsm.sim.sweep import run as sweep_run
+from rvsm.sim.sweep.run import run_sweep
+from rvsm.sim.sweep.spec import parse_sweep
 
 SWEEP = """
 [axes]
@@ -146,24 +145,6 @@ size = "1x1"
         assert cells > ffs > 0
         assert con.execute("SELECT COUNT(*) FROM results r JOIN hw_cost h "
                            "ON h.digest = r.hw_digest").fetchone()[0] == 3
-
-
-def test_cli_run_report_and_errors(tmp_path, capsys):
-    f = tmp_path / "s.toml"
-    f.write_text(SWEEP)
-    db = tmp_path / "r.sqlite"
-    assert main(["sweep", str(f), "-o", str(db), "--workers", "0", "--no-progress"]) == 0
-    assert main(["sweep", "run", str(f), "-o", str(db), "--workers", "0",
-                 "--no-progress"]) == 0
-    assert "8 already done, 0 computed" in capsys.readouterr().out
-    out = tmp_path / "rep"
-    assert main(["sweep", "report", str(db), "-o", str(out)]) == 0
-    assert {p.name for p in out.iterdir()} >= {"report.md", "pareto.png", "width-cost.png"}
-    bad = tmp_path / "bad.toml"
-    bad.write_text(SWEEP.replace('"adc.bits"', '"adc.bitz"'))
-    assert main(["sweep", str(bad), "-o", str(db)]) == 2
-    assert "adc.bitz" in capsys.readouterr().err
-    assert main(["sweep", "report", str(tmp_path / "missing.sqlite")]) == 2
 
 
 def test_existing_scheduler(tmp_path):

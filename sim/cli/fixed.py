@@ -9,7 +9,7 @@ from pathlib import Path
 
 from rvsm.model.errors import RvsmError
 
-from ..cli_args import add_scene_arguments, load_scene_from_args, parse_size_arg
+from .args import add_scene_arguments, load_scene_from_args, parse_size_arg
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,7 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     _common(p)
     p.add_argument("--steps", type=int, default=None, help="keep only the first N steps")
     p.add_argument("-o", "--output", required=True, help="output stimulus .npz")
-    p.set_defaults(func=run_stimulus)
+    p.set_defaults(func=cmd_stimulus)
 
     p = sub.add_parser("profile", help="quantisation profile (saturation, ranges, weights)",
                        description="Print per-scale saturation counts, observed sum and "
@@ -109,7 +109,7 @@ def run_config_check(args: argparse.Namespace) -> int:
     return 0
 
 
-def run_stimulus(args: argparse.Namespace) -> int:
+def cmd_stimulus(args: argparse.Namespace) -> int:
     """``rvsm stimulus``."""
     from rvsm.model.fixed.stimulus import make_stimulus, save_stimulus
 

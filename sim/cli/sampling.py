@@ -11,7 +11,7 @@ from rvsm.model.errors import RvsmError
 from rvsm.model.samplers import DEFAULT_PHI, RESET_MODES, SamplerConfig, sample
 from rvsm.model.spike_files import export_dat, import_dat, load_spikes, save_spikes
 
-from ..cli_args import (
+from .args import (
     add_noise_arguments,
     add_scene_arguments,
     load_scene_from_args,

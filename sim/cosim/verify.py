@@ -20,7 +20,7 @@ import numpy as np
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
 
-from .runner import build, check_simulator, run_stimulus
+from .runner import build, check_simulator, run_testbench
 
 __all__ = ["MAX_PARALLEL_SIDE", "expected_spikes", "run_rtl", "verify", "write_stimulus"]
 
@@ -97,7 +97,7 @@ def run_rtl(
     run_dir = work / sim / name
     stim = write_stimulus(run_dir / "stimulus.npz", contract, codes, thresholds, expected,
                           clear_before)
-    result = run_stimulus(sb, stim, run_dir, waves=waves)
+    result = run_testbench(sb, stim, run_dir, waves=waves)
     if result["mismatches"] and not result["waves"]:
         first = result["first_mismatch"] or {}
         upto = min(len(codes), int(first.get("step", len(codes) - 1)) + 1)
@@ -106,7 +106,7 @@ def run_rtl(
                                thresholds, expected[:upto],
                                [t for t in clear_before if t < upto])
         sbw = build(contract, sim, root, waves=True)
-        result["waves"] = run_stimulus(sbw, stim2, again_dir, waves=True)["waves"]
+        result["waves"] = run_testbench(sbw, stim2, again_dir, waves=True)["waves"]
     result.update(
         build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
         build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),

@@ -1,7 +1,7 @@
 """Build the generated Verilog on Icarus Verilog or Verilator and run the testbench.
 
 One build per (contract, simulator) is cached under ``build_root/<sim>-<digest>/`` and
-reused by every stimulus (``run_stimulus``), so a Verilator compile is paid once.
+reused by every stimulus (``run_testbench``), so a Verilator compile is paid once.
 Icarus builds always include the FST dump module; Verilator builds get ``--trace``
 only when waves are asked for (a second cached build), since tracing doubles the C++.
 """
@@ -27,10 +27,10 @@ from rvsm.rtl.verilog import DEFAULT_TOP, GeneratedVerilog, verilator_env, write
 if TYPE_CHECKING:
     from cocotb_tools.runner import Runner
 
-__all__ = ["SIMULATORS", "SimBuild", "build", "check_simulator", "run_stimulus"]
+__all__ = ["SIMULATORS", "SimBuild", "build", "check_simulator", "run_testbench"]
 
 SIMULATORS = ("icarus", "verilator")
-TB_MODULE = "rvsm.sim.cocotb_tb.tb_array"
+TB_MODULE = "rvsm.sim.cosim.tb_array"
 #: Verilator flags for Amaranth's netlist (warnings are the lint's job, not the build's).
 VERILATOR_BUILD_ARGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style", "-O2")
 #: Expose only the top-level ports to VPI in Verilator builds (see :func:`_runner`).
@@ -213,7 +213,7 @@ def _reuse_verilog(
     return None
 
 
-def run_stimulus(
+def run_testbench(
     sb: SimBuild, stimulus: str | os.PathLike, test_dir: str | os.PathLike,
     waves: bool = False,
 ) -> dict:

@@ -1,33 +1,36 @@
-"""The ``rvsm`` command line.
+"""The ``rvsm`` entry point: the parser built from :data:`FAMILIES`, and exit statuses.
 
-Every module in :mod:`rvsm.sim.commands` exposes ``register(subparsers)``, which adds its
-sub-command(s) and sets ``func(args) -> int`` on them. Errors a user can fix are raised as
+Each module in :data:`FAMILIES` exposes ``register(subparsers)``, which adds its
+sub-command(s) and sets ``func(args) -> int`` on them; this list is the one place a
+command is registered. Errors a user can fix are raised as
 :class:`~rvsm.model.errors.RvsmError` and printed here on one line, with exit status 2.
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib
-import pkgutil
 import sys
+from types import ModuleType
 
 from rvsm.model.errors import RvsmError
 
-from . import commands
+from . import demo, fixed, rtl, sampling, scenes, studies, sweep
+
+#: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
+#: co-simulation, paper studies, the demo, design sweeps.
+FAMILIES: tuple[ModuleType, ...] = (sampling, scenes, fixed, rtl, studies, demo, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The full ``rvsm`` argument parser, with every discovered sub-command."""
+    """The full ``rvsm`` argument parser, with every sub-command of :data:`FAMILIES`."""
     parser = argparse.ArgumentParser(
         prog="rvsm",
         description="RVSM spike-camera digital twin: float model, fixed-point twin, "
         "Amaranth RTL and cocotb verification.",
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
-        module = importlib.import_module(f"{commands.__name__}.{info.name}")
-        module.register(sub)
+    for family in FAMILIES:
+        family.register(sub)
     return parser
 
 

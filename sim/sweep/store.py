@@ -25,7 +25,7 @@ from typing import Any
 
 from rvsm.model.errors import RvsmError
 
-from .sweep_spec import SweepSpec, SweepTask
+from .spec import SweepSpec, SweepTask
 
 SCHEMA_VERSION = 1
 SCHEMA = """

@@ -59,8 +59,8 @@ def run_sweep_command(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace, sweep_file: str) -> int:
-    from ..sweep_run import run_sweep
-    from ..sweep_spec import load_sweep
+    from rvsm.sim.sweep.run import run_sweep
+    from rvsm.sim.sweep.spec import load_sweep
 
     if args.workers is not None and args.workers < 0:
         raise RvsmError(f"--workers must be >= 0, got {args.workers}")
@@ -83,7 +83,7 @@ def _run(args: argparse.Namespace, sweep_file: str) -> int:
 
 
 def _report(args: argparse.Namespace) -> int:
-    from ..sweep_report import write_report
+    from rvsm.sim.sweep.report import write_report
 
     db = Path(args.path)
     out = Path(args.output) if args.output else db.with_name(db.stem + "-report")

@@ -135,8 +135,7 @@ def run_rtl_demo(
     """
     from rvsm.model.fixed.config import default_design_point, save_design_point
     from rvsm.rtl.verilog import write_outputs
-
-    from .verify import verify
+    from rvsm.sim.cosim.verify import verify
 
     point = default_design_point().with_size(*size)
     point_path = out_dir / "point.toml"

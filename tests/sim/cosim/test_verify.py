@@ -1,7 +1,7 @@
 """cocotb regressions: generated Verilog vs the fixed twin, on Icarus and Verilator.
 
 One build per (contract, simulator) is shared by many stimuli (the build cache of
-:mod:`rvsm.sim.runner`). Default: a border-heavy dog4 3x5 array and a 4x4 FSM array on
+:mod:`rvsm.sim.cosim.runner`). Default: a border-heavy dog4 3x5 array and a 4x4 FSM array on
 both simulators, every model on Icarus, the checker-can-fail proof and tool errors.
 ``-m slow`` (``make regress``): every model on both shapes and simulators, longer streams.
 """
@@ -16,34 +16,11 @@ import pytest
 
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.fixed.weights import quantise_model
 from rvsm.model.kernels import MODEL_NAMES
-from rvsm.sim.runner import check_simulator
-from rvsm.sim.verify import expected_spikes, run_rtl
+from rvsm.sim.cosim.runner import check_simulator
+from rvsm.sim.cosim.verify import expected_spikes, run_rtl
 
 SIMS = ["icarus", "verilator"]
-
-
-def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int = 10,
-                   shift: int = 1, reset: str = "subtract") -> ArrayContract:
-    """A small contract from a model's quantised kernels (4-bit ADC)."""
-    ks = quantise_model(model, frac_bits, "round-half-up")
-    weights = tuple(tuple(tuple(int(v) for v in row) for row in k) for k in ks)
-    return ArrayContract(h, w, 4, weights, shift, acc_bits, model != "fsm", reset)
-
-
-@pytest.fixture(scope="session")
-def work(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """One work folder per worker, with a build cache shared by pytest-xdist workers."""
-    return tmp_path_factory.mktemp("cocotb")
-
-
-@pytest.fixture(scope="session")
-def builds(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """Build cache shared by every xdist worker of this session (safe: atomic renames)."""
-    base = tmp_path_factory.getbasetemp()
-    root = base.parent if base.name.startswith("popen-gw") else base
-    return root / "rvsm-builds"
 
 
 def stimuli(c: ArrayContract, seed: int, steps: int = 60) -> dict[str, tuple]:
@@ -87,7 +64,7 @@ def _shifted_sums(c: ArrayContract, codes: np.ndarray) -> np.ndarray:
     return arithmetic_shift(integer_receptive_sums(codes, c.weight_arrays), c.shift)
 
 
-def check_all(c: ArrayContract, sim: str, work: Path, builds: Path, seed: int,
+def check_all(c: ArrayContract, sim: str, cosim_work: Path, rtl_builds: Path, seed: int,
               steps: int = 60) -> None:
     """Every stimulus of :func:`stimuli` plus exact thresholds: zero mismatches."""
     spikes = {1: 0, -1: 0}
@@ -95,8 +72,8 @@ def check_all(c: ArrayContract, sim: str, work: Path, builds: Path, seed: int,
     codes, thr = exact_threshold_case(c)
     cases["exact_threshold"] = (codes, thr, ())
     for name, (codes, thr, clears) in cases.items():
-        r = run_rtl(c, codes, thr, sim, clear_before=clears, work_dir=work, name=name,
-                    build_root=builds)
+        r = run_rtl(c, codes, thr, sim, clear_before=clears, work_dir=cosim_work, name=name,
+                    build_root=rtl_builds)
         assert r["mismatches"] == 0, (name, r["first_mismatch"])
         assert r["compared"] == codes.shape[0] * c.num_scales * c.height * c.width
         want = expected_spikes(c, codes, thr, clears)
@@ -108,32 +85,34 @@ def check_all(c: ArrayContract, sim: str, work: Path, builds: Path, seed: int,
 
 
 @pytest.mark.parametrize("sim", SIMS)
-def test_dog4_border_array(sim: str, work: Path, builds: Path) -> None:
+def test_dog4_border_array(small_contract, sim: str, cosim_work: Path, rtl_builds: Path) -> None:
     """dog4 on 3x5: 9x9 kernels mostly outside the array, 10-bit accumulators."""
-    check_all(model_contract("dog4", 3, 5), sim, work, builds, seed=11)
+    check_all(small_contract("dog4", 3, 5), sim, cosim_work, rtl_builds, seed=11)
 
 
 @pytest.mark.parametrize("sim", SIMS)
-def test_fsm_square_array(sim: str, work: Path, builds: Path) -> None:
+def test_fsm_square_array(small_contract, sim: str, cosim_work: Path, rtl_builds: Path) -> None:
     """FSM (unsigned, zero reset) on 4x4 with 6-bit accumulators: the rail is hit."""
-    c = model_contract("fsm", 4, 4, frac_bits=0, acc_bits=6, shift=0, reset="zero")
-    check_all(c, sim, work, builds, seed=12)
+    c = small_contract("fsm", 4, 4, frac_bits=0, acc_bits=6, shift=0, reset="zero")
+    check_all(c, sim, cosim_work, rtl_builds, seed=12)
 
 
 @pytest.mark.parametrize("model", MODEL_NAMES)
-def test_every_model_icarus(model: str, work: Path, builds: Path) -> None:
-    c = model_contract(model, 3, 5)
+def test_every_model_icarus(small_contract, model: str, cosim_work: Path, rtl_builds: Path) -> None:
+    c = small_contract(model, 3, 5)
     rng = np.random.default_rng(13)
     codes = rng.integers(0, 16, (40, 3, 5))
     thr = rng.integers(1, 120, (c.num_scales, 3, 5))
-    r = run_rtl(c, codes, thr, "icarus", work_dir=work, name=f"model_{model}",
-                build_root=builds)
+    r = run_rtl(c, codes, thr, "icarus", work_dir=cosim_work, name=f"model_{model}",
+                build_root=rtl_builds)
     assert r["mismatches"] == 0, r["first_mismatch"]
 
 
-def test_checker_catches_wrong_expectation(work: Path, builds: Path) -> None:
+def test_checker_catches_wrong_expectation(
+    small_contract, cosim_work: Path, rtl_builds: Path
+) -> None:
     """A deliberately wrong expectation is reported, named, and a waveform is kept."""
-    c = model_contract("dog4", 3, 5)
+    c = small_contract("dog4", 3, 5)
     rng = np.random.default_rng(14)
     codes = rng.integers(0, 16, (30, 3, 5))
     thr = rng.integers(1, 60, (c.num_scales, 3, 5))
@@ -141,8 +120,8 @@ def test_checker_catches_wrong_expectation(work: Path, builds: Path) -> None:
     step, scale, row, col = 17, 2, 1, 4
     good = int(wrong[step, scale, row, col])
     wrong[step, scale, row, col] = 1 if good != 1 else -1
-    r = run_rtl(c, codes, thr, "icarus", expected=wrong, work_dir=work, name="wrong",
-                build_root=builds)
+    r = run_rtl(c, codes, thr, "icarus", expected=wrong, work_dir=cosim_work, name="wrong",
+                build_root=rtl_builds)
     assert r["mismatches"] == 1
     assert r["first_mismatch"] == {"step": step, "scale": scale, "row": row, "column": col,
                                    "expected": int(wrong[step, scale, row, col]),
@@ -151,16 +130,18 @@ def test_checker_catches_wrong_expectation(work: Path, builds: Path) -> None:
 
 
 @pytest.mark.slow
-def test_checker_catches_wrong_expectation_verilator(work: Path, builds: Path) -> None:
+def test_checker_catches_wrong_expectation_verilator(
+    small_contract, cosim_work: Path, rtl_builds: Path
+) -> None:
     """Same proof on Verilator, whose wave build (``--trace``) is made on demand."""
-    c = model_contract("dog4", 3, 5)
+    c = small_contract("dog4", 3, 5)
     rng = np.random.default_rng(15)
     codes = rng.integers(0, 16, (20, 3, 5))
     thr = rng.integers(1, 60, (c.num_scales, 3, 5))
     wrong = expected_spikes(c, codes, thr)
     wrong[9, 0, 0, 0] = 1 if wrong[9, 0, 0, 0] != 1 else 0
-    r = run_rtl(c, codes, thr, "verilator", expected=wrong, work_dir=work,
-                name="wrong_v", build_root=builds)
+    r = run_rtl(c, codes, thr, "verilator", expected=wrong, work_dir=cosim_work,
+                name="wrong_v", build_root=rtl_builds)
     assert r["mismatches"] == 1 and r["first_mismatch"]["step"] == 9
     assert r["waves"] and Path(r["waves"]).exists()
 
@@ -171,38 +152,20 @@ def test_missing_simulator_is_one_clear_line(monkeypatch: pytest.MonkeyPatch) ->
         check_simulator("icarus")
 
 
-def test_cli_verify_design_point(work: Path, tmp_path: Path,
-                                 capsys: pytest.CaptureFixture) -> None:
-    """``rvsm verify SCENE --fixed point.toml --json`` on a small dog1 point."""
-    import json
-
-    from rvsm.model.fixed.config import default_design_point, save_design_point
-    from rvsm.sim.cli import main
-
-    point = tmp_path / "p.toml"
-    save_design_point(point, default_design_point().with_size(4, 6))
-    rc = main(["verify", "coin", "--fixed", str(point), "--sim", "icarus", "--steps", "40",
-               "--size", "4x6", "--json", "--work", str(work)])
-    out = json.loads(capsys.readouterr().out)
-    assert rc == 0
-    assert out["simulator"] == "icarus" and out["mismatches"] == 0
-    assert out["compared"] == 40 * 4 * 4 * 6
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("sim", SIMS)
 @pytest.mark.parametrize("shape", [(4, 4), (3, 5)])
 @pytest.mark.parametrize("model", MODEL_NAMES)
-def test_every_model_both_shapes(model: str, shape: tuple[int, int], sim: str,
-                                 work: Path, builds: Path) -> None:
-    check_all(model_contract(model, *shape), sim, work, builds, seed=21, steps=300)
+def test_every_model_both_shapes(small_contract, model: str, shape: tuple[int, int], sim: str,
+                                 cosim_work: Path, rtl_builds: Path) -> None:
+    check_all(small_contract(model, *shape), sim, cosim_work, rtl_builds, seed=21, steps=300)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("sim", SIMS)
-def test_long_stream_8x12(sim: str, work: Path, builds: Path) -> None:
-    c = model_contract("dog2", 8, 12, frac_bits=8, acc_bits=14, shift=2, reset="zero")
-    check_all(c, sim, work, builds, seed=22, steps=2000)
+def test_long_stream_8x12(small_contract, sim: str, cosim_work: Path, rtl_builds: Path) -> None:
+    c = small_contract("dog2", 8, 12, frac_bits=8, acc_bits=14, shift=2, reset="zero")
+    check_all(c, sim, cosim_work, rtl_builds, seed=22, steps=2000)
 
 
 def test_tools_present() -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from rvsm.model.errors import RvsmError
-from rvsm.sim.sweep_spec import make_design, parse_sweep
+from rvsm.sim.sweep.spec import make_design, parse_sweep
 
 GOOD = """
 [base.adc]

@@ -24,8 +24,8 @@ from rvsm.model.atomic import atomic_path, write_text_atomic
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.config import FIELD_PATH, parse_design_point
 
-from .sweep_spec import PATH_FIELD
-from .sweep_store import open_existing
+from .spec import PATH_FIELD
+from .store import open_existing
 
 PROXY_LABEL = "adc + weight + accumulator bits (proxy: no synthesis)"
 

@@ -5,8 +5,15 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..cli_args import load_scene_from_args
-from ..demo import DEMO_MODELS, DEMO_RTL_SIZE, DEMO_RTL_STEPS, DEMO_SCENE, run_float_demo
+from rvsm.sim.studies.demo import (
+    DEMO_MODELS,
+    DEMO_RTL_SIZE,
+    DEMO_RTL_STEPS,
+    DEMO_SCENE,
+    run_float_demo,
+)
+
+from .args import load_scene_from_args
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -44,7 +51,7 @@ def run_demo(args: argparse.Namespace) -> int:
           "reconstructions")
     if args.sim == "none":
         return 0
-    from ..demo import run_rtl_demo
+    from rvsm.sim.studies.demo import run_rtl_demo
 
     h, w = DEMO_RTL_SIZE
     print(f"RTL: default design point at {h}x{w}, Verilog + {DEMO_RTL_STEPS}-step "

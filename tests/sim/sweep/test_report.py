@@ -5,16 +5,16 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from rvsm.sim.sweep_report import (
+from rvsm.sim.sweep.report import (
     pareto_figure,
     pareto_mask,
     recommend,
     summarise,
     width_cost_figure,
 )
-from rvsm.sim.sweep_run import run_sweep
-from rvsm.sim.sweep_spec import parse_sweep
-from rvsm.sim.sweep_store import SweepStore
+from rvsm.sim.sweep.run import run_sweep
+from rvsm.sim.sweep.spec import parse_sweep
+from rvsm.sim.sweep.store import SweepStore
 
 
 def test_pareto_known_set():

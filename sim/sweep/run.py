@@ -23,8 +23,8 @@ from typing import Any
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.config import DesignPoint
 
-from .sweep_spec import SweepSpec, SweepTask
-from .sweep_store import SweepStore
+from .spec import SweepSpec, SweepTask
+from .store import SweepStore
 
 
 @dataclass
@@ -79,7 +79,7 @@ def hw_point(point: DesignPoint, size: tuple[int, int]) -> DesignPoint:
 
 def hw_digest(point: DesignPoint, size: tuple[int, int]) -> str:
     """Cache key of a design's RTL at ``size``: the build digest of its contract."""
-    from .runner import contract_digest
+    from rvsm.sim.cosim.runner import contract_digest
 
     return contract_digest(hw_point(point, size).contract())
 

@@ -70,7 +70,7 @@ def _verilog(args: argparse.Namespace) -> int:
 
 
 def _verify(args: argparse.Namespace) -> int:
-    from rvsm.sim.verify import verify
+    from rvsm.sim.cosim.verify import verify
 
     if args.steps is not None and args.steps < 1:
         raise RvsmError(f"--steps must be >= 1, got {args.steps}")

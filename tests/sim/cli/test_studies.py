@@ -7,8 +7,8 @@ import csv
 import pytest
 
 from rvsm.model.kernels import MODEL_NAMES
-from rvsm.sim import experiments as ex
 from rvsm.sim.cli import main
+from rvsm.sim.studies.robustness import ROBUST_MODELS
 
 
 def test_table_cli_tiny(tmp_path):
@@ -41,17 +41,10 @@ def test_robustness_cli_tiny(tmp_path):
     for name in ("robustness.csv", "robustness.json", "fig8.png"):
         assert (out / name).stat().st_size > 0
     rows = list(csv.DictReader((out / "robustness.csv").open()))
-    assert len(rows) == 2 * len(ex.ROBUST_MODELS)
+    assert len(rows) == 2 * len(ROBUST_MODELS)
     # k = 0: dark current exactly 2 per step, threshold 400 -> FSM fires every 200 steps
     fsm0 = next(r for r in rows if r["model"] == "fsm" and float(r["k"]) == 0)
     assert float(fsm0["asas"]) == pytest.approx(1 / 300)
-
-
-def test_run_robustness_returns_indices():
-    res = ex.run_robustness(ks=[1.0], size=(10, 10), num_steps=200, models=["dog4"])
-    (row,) = res.rows
-    assert len(row["asass"]) == 4
-    assert row["asas"] == pytest.approx(row["ass"] / (10 * 10 * 4))
 
 
 def test_bad_arguments_are_user_errors(capsys):

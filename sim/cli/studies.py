@@ -9,8 +9,7 @@ from pathlib import Path
 from rvsm.model.atomic import atomic_path, write_text_atomic
 from rvsm.model.errors import RvsmError
 from rvsm.model.samplers import DEFAULT_PHI
-
-from .. import experiments as ex
+from rvsm.sim.studies import robustness, table
 
 # Defaults of ``rvsm table``: the built-in scenes' full 250 x 400 canvas and 41 frames
 # (400 steps): 108 runs in ~6.5 min on a 2-core machine; see docs/reproduction.md.
@@ -56,13 +55,13 @@ def save_figure(fig, path: Path) -> None:
 def cmd_table(args: argparse.Namespace) -> int:
     """Run the quality table and write table.md, table.csv and fig6.png."""
     names = [n.strip() for item in (args.scenes or []) for n in item.split(",") if n.strip()]
-    scenes = ex.load_scenes(
+    scenes = table.load_scenes(
         names or None,
         parse_size(args.size),
         _positive("--frames", args.frames),
         _positive("--steps-per-frame", args.steps_per_frame),
     )
-    result = ex.run_table(scenes, seed=args.seed, phi=args.phi, progress=not args.quiet)
+    result = table.run_table(scenes, seed=args.seed, phi=args.phi, progress=not args.quiet)
     out = Path(args.output)
     h, w = scenes[0].shape
     note = (
@@ -71,9 +70,9 @@ def cmd_table(args: argparse.Namespace) -> int:
         f"phi={args.phi:g}, noise NoiseParams(k=1, seed={args.seed}); "
         f"{len(result.rows)} runs in {result.seconds:.0f} s.\n"
     )
-    write_text_atomic(out / "table.md", ex.table_markdown(result) + note)
-    write_text_atomic(out / "table.csv", ex.table_csv(result))
-    save_figure(ex.table_figure(result), out / "fig6.png")
+    write_text_atomic(out / "table.md", table.table_markdown(result) + note)
+    write_text_atomic(out / "table.csv", table.table_csv(result))
+    save_figure(table.table_figure(result), out / "fig6.png")
     print(f"wrote {out / 'table.md'}, table.csv, fig6.png ({result.seconds:.0f} s)")
     return 0
 
@@ -81,14 +80,14 @@ def cmd_table(args: argparse.Namespace) -> int:
 def cmd_robustness(args: argparse.Namespace) -> int:
     """Run the robustness sweep and write robustness.csv, robustness.json, fig8.png."""
     size = parse_size(args.size)
-    result = ex.run_robustness(
+    result = robustness.run_robustness(
         parse_floats(args.ks), size, _positive("--steps", args.steps), seed=args.seed,
         phi=args.phi, progress=not args.quiet,
     )
     out = Path(args.output)
-    write_text_atomic(out / "robustness.csv", ex.robustness_csv(result))
+    write_text_atomic(out / "robustness.csv", robustness.robustness_csv(result))
     write_text_atomic(out / "robustness.json", json.dumps(result.rows, indent=1) + "\n")
-    save_figure(ex.robustness_figure(result), out / "fig8.png")
+    save_figure(robustness.robustness_figure(result), out / "fig8.png")
     print(f"wrote {out / 'robustness.csv'}, robustness.json, fig8.png "
           f"({result.seconds:.0f} s)")
     return 0
@@ -119,7 +118,7 @@ def register(subparsers) -> None:
         description="Black scene, sweep the noise intensity k, count spikes of FSM, "
         "One..Four DoG and Four Gauss: ASS, ASAS and ASASS per scale.",
     )
-    p.add_argument("--ks", default=",".join(f"{k:g}" for k in ex.DEFAULT_KS),
+    p.add_argument("--ks", default=",".join(f"{k:g}" for k in robustness.DEFAULT_KS),
                    help="comma-separated noise intensities (default %(default)s)")
     p.add_argument("--size", default="100x100", help="HxW (default %(default)s)")
     p.add_argument("--steps", type=int, default=1000, help="steps T (default %(default)s)")

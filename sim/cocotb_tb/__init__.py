@@ -1,1 +1,0 @@
-"""cocotb testbenches that drive the generated Verilog with the fixed twin's stimulus."""

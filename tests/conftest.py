@@ -1,0 +1,92 @@
+"""Fixtures shared by the whole suite.
+
+- :func:`small_contract`: a factory of small :class:`ArrayContract` s from a model's
+  quantised kernels (4-bit ADC by default), for RTL and co-simulation tests.
+- :func:`amaranth_sim`: runs an ``amaranth.sim`` test bench on a component; with
+  ``pytest --waves DIR`` it also writes one VCD per run into ``DIR`` (named after the
+  test), so a failing RTL test can be opened in a waveform viewer.
+- :func:`cosim_work` / :func:`rtl_builds`: a work folder per worker and a Verilog build
+  cache shared by every pytest-xdist worker of the session.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Awaitable, Callable
+from pathlib import Path
+
+import pytest
+
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.weights import quantise_model
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption("--waves", metavar="DIR", default=None,
+                     help="write a VCD of every amaranth.sim run into DIR")
+
+
+def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int = 10,
+                   shift: int = 1, reset: str = "subtract", adc_bits: int = 4) -> ArrayContract:
+    """A small contract from ``model``'s quantised kernels (round-half-up weights)."""
+    ks = quantise_model(model, frac_bits, "round-half-up")
+    weights = tuple(tuple(tuple(int(v) for v in row) for row in k) for k in ks)
+    return ArrayContract(h, w, adc_bits, weights, shift, acc_bits, model != "fsm", reset)
+
+
+@pytest.fixture
+def small_contract() -> Callable[..., ArrayContract]:
+    """:func:`model_contract`: ``small_contract("dog4", 3, 5, acc_bits=12)``."""
+    return model_contract
+
+
+class AmaranthSim:
+    """Runs test benches in ``amaranth.sim`` (1 MHz clock on ``sync``)."""
+
+    def __init__(self, waves_dir: Path | None, test_name: str) -> None:
+        self.waves_dir = waves_dir
+        self.test_name = re.sub(r"[^A-Za-z0-9_.-]+", "_", test_name)
+        self.runs = 0
+
+    def vcd_path(self) -> Path | None:
+        """The next VCD file of this test, or None without ``--waves``."""
+        if self.waves_dir is None:
+            return None
+        self.runs += 1
+        self.waves_dir.mkdir(parents=True, exist_ok=True)
+        return self.waves_dir / f"{self.test_name}-{self.runs}.vcd"
+
+    def run(self, dut: object, bench: Callable[[object], Awaitable[None]]) -> None:
+        """Simulate ``dut`` with ``bench(ctx)`` as its test bench until the bench returns."""
+        from amaranth.sim import Simulator
+
+        sim = Simulator(dut)
+        sim.add_clock(1e-6)
+        sim.add_testbench(bench)
+        vcd = self.vcd_path()
+        if vcd is None:
+            sim.run()
+        else:
+            with sim.write_vcd(str(vcd)):
+                sim.run()
+
+
+@pytest.fixture
+def amaranth_sim(request: pytest.FixtureRequest) -> AmaranthSim:
+    """An :class:`AmaranthSim` for this test (VCDs with ``pytest --waves DIR``)."""
+    waves = request.config.getoption("--waves")
+    return AmaranthSim(Path(waves) if waves else None, request.node.name)
+
+
+@pytest.fixture(scope="session")
+def cosim_work(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One co-simulation work folder per worker."""
+    return tmp_path_factory.mktemp("cocotb")
+
+
+@pytest.fixture(scope="session")
+def rtl_builds(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Build cache shared by every xdist worker of this session (safe: atomic renames)."""
+    base = tmp_path_factory.getbasetemp()
+    root = base.parent if base.name.startswith("popen-gw") else base
+    return root / "rvsm-builds"
