@@ -33,6 +33,7 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.widths import index_bits
 
 from .pixel_cell import PixelCell
 from .receptive_sum import sum_width, weighted_sum
@@ -60,7 +61,7 @@ class RvsmArray(wiring.Component):
         self.contract = contract
         c = contract
         self.num_accumulators = c.num_scales * c.height * c.width
-        self.addr_bits = max(1, (self.num_accumulators - 1).bit_length())
+        self.addr_bits = index_bits(self.num_accumulators)
         super().__init__({
             "codes": In(unsigned(c.height * c.width * c.adc_bits)),
             "strobe": In(1),

@@ -22,6 +22,8 @@ from amaranth.hdl import Module, Mux, Signal, signed, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
+from rvsm.model.fixed.widths import signed_range
+
 __all__ = ["PixelCell"]
 
 
@@ -68,8 +70,7 @@ class PixelCell(wiring.Component):
     @property
     def acc_range(self) -> tuple[int, int]:
         """``(lo, hi)`` of the W-bit signed accumulator."""
-        w = self.accumulator_bits
-        return -(1 << (w - 1)), (1 << (w - 1)) - 1
+        return signed_range(self.accumulator_bits)
 
     def elaborate(self, platform: object) -> Module:
         """Registers and next-state logic of the cell."""

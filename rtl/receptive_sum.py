@@ -20,9 +20,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from amaranth.hdl import Module, Shape, Value, signed, unsigned
+from amaranth.hdl import Module, Value, signed, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
+
+from rvsm.model.fixed.widths import signed_bits_for, unsigned_max
 
 __all__ = ["ReceptiveSum", "csd_digits", "sum_width", "weighted_sum"]
 
@@ -45,7 +47,7 @@ def csd_digits(value: int) -> list[tuple[int, int]]:
 
 def sum_width(lo: int, hi: int) -> int:
     """Bits of a signed word holding every integer in ``lo..hi`` (at least 2)."""
-    return max(2, Shape.cast(range(min(lo, -1), max(hi, 0) + 1)).width)
+    return signed_bits_for(lo, hi, minimum=2)
 
 
 def _tree_add(terms: list[Value], width: int) -> Value:
@@ -95,7 +97,7 @@ class ReceptiveSum(wiring.Component):
     def __init__(self, weights: Sequence[int], input_bits: int):
         self.weights = [int(w) for w in weights]
         self.input_bits = input_bits
-        full = (1 << input_bits) - 1
+        full = unsigned_max(input_bits)
         self.lo = sum(w for w in self.weights if w < 0) * full
         self.hi = sum(w for w in self.weights if w > 0) * full
         self.width = sum_width(self.lo, self.hi)

@@ -26,6 +26,7 @@ from amaranth.back import verilog as amaranth_verilog
 from rvsm.model.atomic import write_text_atomic
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.widths import index_bits, unsigned_max
 
 from .array import RvsmArray
 
@@ -82,12 +83,12 @@ def port_map(contract: ArrayContract) -> list[dict]:
     """Top-level ports: name, direction, width and meaning (with bit ordering)."""
     c = contract
     n_acc = c.num_scales * c.height * c.width
-    addr_bits = max(1, (n_acc - 1).bit_length())
+    addr_bits = index_bits(n_acc)
     return [
         {"name": "clk", "dir": "in", "width": 1, "desc": "clock (rising edge)"},
         {"name": "rst", "dir": "in", "width": 1,
          "desc": "synchronous reset: accumulators and spikes to 0, thresholds to "
-                 f"{(1 << c.threshold_bits) - 1}"},
+                 f"{unsigned_max(c.threshold_bits)}"},
         {"name": "codes", "dir": "in", "width": c.height * c.width * c.adc_bits,
          "desc": f"ADC codes, pixel (y, x) at bits [(y*{c.width}+x)*{c.adc_bits} +: "
                  f"{c.adc_bits}]"},
@@ -100,7 +101,7 @@ def port_map(contract: ArrayContract) -> list[dict]:
         {"name": "cfg_addr", "dir": "in", "width": addr_bits,
          "desc": f"accumulator index (s*{c.height}+y)*{c.width}+x, 0..{n_acc - 1}"},
         {"name": "cfg_data", "dir": "in", "width": c.threshold_bits,
-         "desc": f"threshold, 1..{(1 << c.threshold_bits) - 1}"},
+         "desc": f"threshold, 1..{unsigned_max(c.threshold_bits)}"},
         {"name": "spike_pos", "dir": "out", "width": n_acc,
          "desc": "+1 spikes, accumulator (s*H+y)*W+x at that bit"},
         {"name": "spike_neg", "dir": "out", "width": n_acc,

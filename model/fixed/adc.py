@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import RvsmError
+from .widths import unsigned_max
 
 ROUNDINGS = ("truncate", "round-half-up")
 ADC_CLIPS = ("saturate", "error")
@@ -38,7 +39,7 @@ def quantise(values: np.ndarray, rounding: str) -> np.ndarray:
 
 def adc_gain(bits: int, full_scale: float) -> float:
     """Codes per brightness unit: ``(2**bits - 1) / full_scale``."""
-    return ((1 << bits) - 1) / float(full_scale)
+    return unsigned_max(bits) / float(full_scale)
 
 
 def adc_codes(
@@ -54,7 +55,7 @@ def adc_codes(
     the rounding and clipping rules.
     """
     b = np.asarray(brightness, dtype=np.float64)
-    top = (1 << bits) - 1
+    top = unsigned_max(bits)
     if clip == "error":
         lo, hi = float(b.min(initial=0.0)), float(b.max(initial=0.0))
         if lo < 0 or hi > full_scale:

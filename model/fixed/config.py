@@ -37,8 +37,9 @@ from ..kernels import MODEL_NAMES, ModelSpec, model_spec
 from ..noise import NoiseParams, NoiseSource
 from ..samplers import RESET_MODES, SamplerConfig
 from .adc import ADC_CLIPS, ROUNDINGS, adc_gain
-from .core import ArrayContract, accumulator_range
-from .weights import quantise_model, weight_range
+from .core import ArrayContract
+from .weights import quantise_model
+from .widths import signed_bits, signed_range
 
 THRESHOLD_ROUNDINGS = ("ceil", "round-half-up", "truncate")
 MAX_ADC_BITS = 16
@@ -150,7 +151,7 @@ class DesignPoint:
     # -- validation of derived integers ------------------------------------------------
 
     def _check_weights(self) -> None:
-        lo, hi = weight_range(self.weight_bits)
+        lo, hi = signed_range(self.weight_bits)
         for s, w in enumerate(self.integer_weights()):
             if w.min() < lo or w.max() > hi:
                 bad = int(w.max()) if w.max() > hi else int(w.min())
@@ -158,7 +159,7 @@ class DesignPoint:
                     f"weights: scale {s} of {self.model} quantises to {bad}, outside the "
                     f"signed {self.weight_bits}-bit range {lo}..{hi}; raise weights.bits or "
                     f"lower weights.frac_bits (now {self.weight_frac_bits}); need "
-                    f"weights.bits >= {_signed_bits(bad)}"
+                    f"weights.bits >= {signed_bits(bad)}"
                 )
             if not w.any():
                 raise RvsmError(
@@ -174,7 +175,7 @@ class DesignPoint:
                 )
 
     def _check_thresholds(self) -> None:
-        lo, hi = accumulator_range(self.accumulator_bits)
+        lo, hi = signed_range(self.accumulator_bits)
         field = "threshold.scale_phi" if self.scale_phi is not None else "threshold.phi"
         for s, (v, t) in enumerate(zip(self.phis, self.nominal_thresholds(), strict=True)):
             if t > hi:
@@ -182,7 +183,7 @@ class DesignPoint:
                     f"{field} = {v:g} (scale {s}) maps to {t} accumulator LSBs, which a "
                     f"{self.accumulator_bits}-bit signed accumulator cannot hold (valid "
                     f"thresholds 1..{hi}); raise datapath.accumulator_bits to >= "
-                    f"{_signed_bits(t)}, raise datapath.shift or lower weights.frac_bits"
+                    f"{signed_bits(t)}, raise datapath.shift or lower weights.frac_bits"
                 )
             if t < 1:
                 raise RvsmError(
@@ -291,7 +292,7 @@ class DesignPoint:
         src = noise if noise is not None else self.noise_source()
         theta, v_os = src.fixed_pattern()
         analog = np.maximum(theta * self.phis[:, None, None] + v_os, 0.0)
-        _, hi = accumulator_range(self.accumulator_bits)
+        _, hi = signed_range(self.accumulator_bits)
         return np.clip(self.to_threshold_lsbs(analog), 1, hi)
 
     def sampler_config(self) -> SamplerConfig:
@@ -425,9 +426,3 @@ def _choice(point: DesignPoint, name: str, choices: tuple[str, ...]) -> None:
     v = getattr(point, name)
     if v not in choices:
         raise RvsmError(f"{FIELD_PATH[name]} must be one of {', '.join(choices)}; got {v!r}")
-
-
-def _signed_bits(value: int) -> int:
-    """Smallest signed two's-complement width holding ``value``."""
-    v = int(value)
-    return (v.bit_length() if v >= 0 else (-v - 1).bit_length()) + 1

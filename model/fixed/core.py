@@ -24,13 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import RvsmError
+from .widths import signed_range, unsigned_max
 
 RESET_MODES = ("zero", "subtract")
-
-
-def accumulator_range(accumulator_bits: int) -> tuple[int, int]:
-    """``(lo, hi)`` of a signed ``accumulator_bits``-wide two's-complement register."""
-    return -(1 << (accumulator_bits - 1)), (1 << (accumulator_bits - 1)) - 1
 
 
 def integer_receptive_sums(codes: np.ndarray, weights: Sequence[np.ndarray]) -> np.ndarray:
@@ -163,7 +159,7 @@ class FixedIntegrator:
             raise RvsmError(f"accumulator_bits must be 2..62, got {accumulator_bits}")
         if reset not in RESET_MODES:
             raise RvsmError(f"reset must be one of {RESET_MODES}, got {reset!r}")
-        self.lo, self.hi = accumulator_range(accumulator_bits)
+        self.lo, self.hi = signed_range(accumulator_bits)
         thr = np.asarray(thresholds, dtype=np.int64)
         if thr.ndim != 3:
             raise RvsmError(f"thresholds must be (S, H, W), got shape {thr.shape}")
@@ -272,12 +268,26 @@ class ArrayContract:
     def sum_range(self, scale: int) -> tuple[int, int]:
         """``(lo, hi)`` of scale ``scale``'s per-step weighted sum before the shift."""
         k = self.weight_arrays[scale]
-        full = (1 << self.adc_bits) - 1
+        full = unsigned_max(self.adc_bits)
         return int(k[k < 0].sum()) * full, int(k[k > 0].sum()) * full
 
-    def run(self, codes: np.ndarray, thresholds: np.ndarray) -> np.ndarray:
-        """Spikes ``(T, S, H, W) int8`` for ``codes (T, H, W)`` and ``thresholds (S, H, W)``."""
-        return run_integer_array(
-            codes, self.weight_arrays, self.shift, thresholds,
-            self.accumulator_bits, self.signed, self.reset,
-        )
+    def run(
+        self, codes: np.ndarray, thresholds: np.ndarray, clear_before: Sequence[int] = ()
+    ) -> np.ndarray:
+        """Spikes ``(T, S, H, W) int8`` for ``codes (T, H, W)`` and ``thresholds (S, H, W)``.
+
+        ``clear_before`` lists steps before which the array is cleared (the RTL's
+        ``clear``): every accumulator restarts from 0 at those steps, thresholds kept.
+        Steps outside ``1 .. T-1`` change nothing.
+        """
+        codes = np.asarray(codes)
+        cuts = sorted({int(t) for t in clear_before if 0 < int(t) < len(codes)})
+        bounds = [0, *cuts, len(codes)]
+        parts = [
+            run_integer_array(
+                codes[a:b], self.weight_arrays, self.shift, thresholds,
+                self.accumulator_bits, self.signed, self.reset,
+            )
+            for a, b in zip(bounds[:-1], bounds[1:], strict=True)
+        ]
+        return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=0)

@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import RvsmError
-from .core import accumulator_range
 from .twin import FixedRun
 from .weights import weight_error_report
+from .widths import signed_range
 
 
 def profile_report(run: FixedRun) -> dict:
@@ -27,7 +27,7 @@ def profile_report(run: FixedRun) -> dict:
     ``weights`` (the :func:`weight_error_report` entry).
     """
     p, st, c = run.point, run.stats, run.contract
-    lo, hi = accumulator_range(p.accumulator_bits)
+    lo, hi = signed_range(p.accumulator_bits)
     werr = weight_error_report(p.model, p.weight_bits, p.weight_frac_bits, p.weight_rounding)
     scales = []
     for s in range(p.num_scales):
@@ -132,7 +132,7 @@ def profile_figure(run: FixedRun):
     ax_w.legend(loc="lower right", fontsize="small")
     # Right: sums and accumulators, in integer LSBs.
     rows = []
-    lo, hi = accumulator_range(p.accumulator_bits)
+    lo, hi = signed_range(p.accumulator_bits)
     for s in range(p.num_scales):
         s_lo, s_hi = c.sum_range(s)
         rows.append((f"scale {s} sum", st.sum_hist[s] if st.sum_hist is not None else None,

@@ -1,21 +1,28 @@
 """RTL stimulus: exactly what the fixed twin saw, and what it answered (SPEC section 5).
 
-A stimulus file (``.npz``, no pickles) holds:
+One format from the fixed twin to the RTL: ``rvsm stimulus`` writes it, the cocotb
+testbench (:mod:`rvsm.sim.cosim.tb_array`) drives the RTL from it, and
+``rvsm verify --stimulus FILE`` replays it. A stimulus file (``.npz``, no pickles) holds:
 
 - ``codes``: ``(T, H, W) uint16`` ADC codes, the per-step input of the array;
 - ``thresholds``: ``(S, H, W) int64`` integer thresholds (accumulator LSBs);
 - ``spikes``: ``(T, S, H, W) int8`` expected spikes in {-1, 0, 1};
+- ``clear_before``: ``(K,) int64`` steps before which the array is cleared (every
+  accumulator restarts from 0, thresholds kept; :meth:`ArrayContract.run` semantics);
+  empty for one uninterrupted stream. Files without it (older ones) mean empty;
 - ``weights``: ``(S, 2Lmax+1, 2Lmax+1) int64`` integer kernels, each centred and
   zero-padded to the largest template; ``half_widths``: ``(S,) int64`` their ``L``;
 - ``contract``: JSON of the :class:`~.core.ArrayContract` fields (weights as nested
   lists); ``point``: the design point's TOML text; ``meta``: JSON metadata.
 
 A testbench loads it with :func:`load_stimulus`, configures the RTL from ``contract`` and
-``thresholds``, drives ``codes`` step by step and compares every spike.
+``thresholds``, drives ``codes`` step by step (pulsing ``clear`` before the listed steps)
+and compares every spike.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import zipfile
@@ -34,12 +41,14 @@ from .twin import simulate_fixed
 STIMULUS_KEYS = (
     "codes", "thresholds", "spikes", "weights", "half_widths", "contract", "point", "meta",
 )
+OPTIONAL_KEYS = ("clear_before",)
 
 
 @dataclass
 class Stimulus:
     """Per-step ADC ``codes (T, H, W) uint16``, ``thresholds (S, H, W) int64``, expected
-    ``spikes (T, S, H, W) int8``, the integer ``contract`` and (when known) its point."""
+    ``spikes (T, S, H, W) int8``, the integer ``contract``, (when known) its point, and
+    the steps ``clear_before`` which the array restarts from zero."""
 
     codes: np.ndarray
     thresholds: np.ndarray
@@ -47,10 +56,27 @@ class Stimulus:
     contract: ArrayContract
     point: DesignPoint | None = None
     meta: dict = field(default_factory=dict)
+    clear_before: tuple[int, ...] = ()
+
+    def __post_init__(self) -> None:
+        self.clear_before = tuple(sorted({int(t) for t in self.clear_before}))
+
+    @property
+    def num_steps(self) -> int:
+        """T, the number of steps."""
+        return int(self.codes.shape[0])
 
     def check(self) -> bool:
-        """True when ``contract.run(codes, thresholds)`` reproduces ``spikes`` exactly."""
-        return bool(np.array_equal(self.contract.run(self.codes, self.thresholds), self.spikes))
+        """True when ``contract.run(codes, thresholds, clear_before)`` reproduces ``spikes``."""
+        want = self.contract.run(self.codes, self.thresholds, self.clear_before)
+        return bool(np.array_equal(want, self.spikes))
+
+    def first_steps(self, steps: int) -> Stimulus:
+        """The same stimulus cut to its first ``steps`` steps (clears beyond them dropped)."""
+        return dataclasses.replace(
+            self, codes=self.codes[:steps], spikes=self.spikes[:steps],
+            clear_before=tuple(t for t in self.clear_before if t < steps),
+        )
 
 
 def make_stimulus(
@@ -99,6 +125,7 @@ def save_stimulus(path: str | os.PathLike, stim: Stimulus) -> None:
         "codes": np.asarray(stim.codes, dtype=np.uint16),
         "thresholds": np.asarray(stim.thresholds, dtype=np.int64),
         "spikes": np.asarray(stim.spikes, dtype=np.int8),
+        "clear_before": np.asarray(stim.clear_before, dtype=np.int64).reshape(-1),
         "weights": weights,
         "half_widths": np.array([len(k) // 2 for k in c.weights], dtype=np.int64),
         "contract": np.array(json.dumps(asdict(c))),
@@ -121,7 +148,7 @@ def load_stimulus(path: str | os.PathLike) -> Stimulus:
                 raise RvsmError(
                     f"{p} is not an rvsm stimulus file: missing {', '.join(sorted(missing))}"
                 )
-            arrays = {k: data[k] for k in STIMULUS_KEYS}
+            arrays = {k: data[k] for k in STIMULUS_KEYS + OPTIONAL_KEYS if k in data.files}
     except RvsmError:
         raise
     except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
@@ -138,4 +165,5 @@ def load_stimulus(path: str | os.PathLike) -> Stimulus:
         contract=contract,
         point=point,
         meta=json.loads(str(arrays["meta"])),
+        clear_before=tuple(int(t) for t in arrays.get("clear_before", ())),
     )

@@ -14,11 +14,7 @@ import numpy as np
 
 from ..kernels import model_spec
 from .adc import quantise
-
-
-def weight_range(bits: int) -> tuple[int, int]:
-    """``(lo, hi)`` of a signed ``bits``-wide weight."""
-    return -(1 << (bits - 1)), (1 << (bits - 1)) - 1
+from .widths import signed_range
 
 
 def quantise_kernel(kernel: np.ndarray, frac_bits: int, rounding: str) -> np.ndarray:
@@ -40,7 +36,7 @@ def weight_error_report(model: str, bits: int, frac_bits: int, rounding: str) ->
     in LSBs, and ``sum_float``/``sum_fixed``, ``abs_sum_float``/``abs_sum_fixed``.
     """
     spec = model_spec(model)
-    lo, hi = weight_range(bits)
+    lo, hi = signed_range(bits)
     lsb = 2.0 ** -frac_bits
     out = []
     for s, k in enumerate(spec.kernels()):

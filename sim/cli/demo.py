@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from rvsm.sim.cosim import SIMULATORS
 from rvsm.sim.studies.demo import (
     DEMO_MODELS,
     DEMO_RTL_SIZE,
@@ -30,7 +31,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--steps-per-frame", type=int, default=None, metavar="M")
     p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
     p.add_argument("-o", "--output", default="out", help="output folder (default out/)")
-    p.add_argument("--sim", choices=("verilator", "icarus", "none"), default="verilator",
+    p.add_argument("--sim", choices=(*SIMULATORS, "none"), default="verilator",
                    help="simulator for the RTL check of the default design point "
                    "(default verilator; none skips it)")
     p.set_defaults(func=run_demo, hold=False)

@@ -7,6 +7,7 @@ import json
 import sys
 
 from rvsm.model.errors import RvsmError
+from rvsm.sim.cosim import SIMULATORS
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -29,12 +30,17 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="synthesise with yosys (synth; stat) and print cells/flip-flops")
     p.set_defaults(func=_verilog)
 
-    p = sub.add_parser("verify", help="simulate the RTL and compare every spike with the "
-                       "fixed twin", description="Build the generated Verilog on Icarus or "
-                       "Verilator, drive the fixed twin's stimulus, compare every spike.")
-    p.add_argument("scene", help="built-in scene name or scene path")
-    p.add_argument("--fixed", required=True, help="design point TOML")
-    p.add_argument("--sim", choices=("icarus", "verilator"), default="icarus")
+    p = sub.add_parser(
+        "verify", help="simulate the RTL and compare every spike with the fixed twin",
+        description="Build the generated Verilog on Icarus or Verilator, drive a stimulus, "
+        "compare every spike. Either SCENE --fixed POINT.toml (the fixed twin makes the "
+        "stimulus) or --stimulus FILE (replay a file written by `rvsm stimulus`).",
+    )
+    p.add_argument("scene", nargs="?", help="built-in scene name or scene path")
+    p.add_argument("--fixed", metavar="POINT.toml", help="design point TOML (with SCENE)")
+    p.add_argument("--stimulus", metavar="FILE.npz",
+                   help="replay this stimulus file (from `rvsm stimulus`) instead")
+    p.add_argument("--sim", choices=SIMULATORS, default="icarus")
     p.add_argument("--steps", type=int, help="simulate only the first N steps")
     p.add_argument("--size", type=_size, help="override the array size, HxW")
     p.add_argument("--waves", action="store_true", help="keep a waveform (FST/VCD)")
@@ -70,12 +76,23 @@ def _verilog(args: argparse.Namespace) -> int:
 
 
 def _verify(args: argparse.Namespace) -> int:
-    from rvsm.sim.cosim.verify import verify
+    from rvsm.sim.cosim.verify import replay, verify
 
     if args.steps is not None and args.steps < 1:
         raise RvsmError(f"--steps must be >= 1, got {args.steps}")
-    r = verify(args.scene, args.fixed, args.sim, steps=args.steps, waves=args.waves,
-               size=args.size, work_dir=args.work)
+    if args.stimulus:
+        given = [n for n, v in (("SCENE", args.scene), ("--fixed", args.fixed),
+                                ("--size", args.size)) if v is not None]
+        if given:
+            raise RvsmError(f"{', '.join(given)} cannot be combined with --stimulus: the "
+                            "stimulus file holds the scene's codes and the contract")
+        r = replay(args.stimulus, args.sim, steps=args.steps, waves=args.waves,
+                   work_dir=args.work)
+    else:
+        if args.scene is None or args.fixed is None:
+            raise RvsmError("rvsm verify needs SCENE --fixed POINT.toml, or --stimulus FILE")
+        r = verify(args.scene, args.fixed, args.sim, steps=args.steps, waves=args.waves,
+                   size=args.size, work_dir=args.work)
     if args.json:
         r = dict(r)
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]

@@ -3,3 +3,6 @@
 :mod:`.runner` builds (cached per contract) and runs the cocotb testbench
 :mod:`.tb_array` on one stimulus file; :mod:`.verify` is ``rvsm verify``.
 """
+
+#: HDL simulators the runner can build for (``--sim`` of ``rvsm verify`` and the demo).
+SIMULATORS: tuple[str, ...] = ("icarus", "verilator")

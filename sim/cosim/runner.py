@@ -24,12 +24,13 @@ from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.rtl.verilog import DEFAULT_TOP, GeneratedVerilog, verilator_env, write_outputs
 
+from . import SIMULATORS
+
 if TYPE_CHECKING:
     from cocotb_tools.runner import Runner
 
 __all__ = ["SIMULATORS", "SimBuild", "build", "check_simulator", "run_testbench"]
 
-SIMULATORS = ("icarus", "verilator")
 TB_MODULE = "rvsm.sim.cosim.tb_array"
 #: Verilator flags for Amaranth's netlist (warnings are the lint's job, not the build's).
 VERILATOR_BUILD_ARGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style", "-O2")

@@ -1,9 +1,10 @@
 """cocotb 2.x testbench: the RTL array against the fixed twin, spike for spike.
 
 Inputs (environment, or ``+rvsm_stimulus=`` / ``+rvsm_result=`` plusargs):
-``RVSM_STIMULUS`` -- an ``.npz`` with ``codes (T,H,W)``, ``thresholds (S,H,W)``,
-``expected (T,S,H,W) int8`` and ``clear_before`` (steps before which ``clear`` is
-pulsed); ``RVSM_RESULT`` -- where the JSON result goes.
+``RVSM_STIMULUS`` -- a stimulus file (:mod:`rvsm.model.fixed.stimulus`, what
+``rvsm stimulus`` writes): ``codes (T,H,W)``, ``thresholds (S,H,W)``, expected
+``spikes (T,S,H,W) int8``, ``clear_before`` (steps before which ``clear`` is pulsed) and
+the contract (``adc_bits``); ``RVSM_RESULT`` -- where the JSON result goes.
 
 Sequence: reset; load every threshold through ``cfg_we/cfg_addr/cfg_data``; then one
 clock per step with ``strobe`` high (inputs driven on the falling edge), a ``clear``
@@ -22,6 +23,8 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
+
+from rvsm.model.fixed.stimulus import load_stimulus
 
 MAX_LISTED = 50
 
@@ -61,13 +64,13 @@ def _read(handle: object) -> tuple[int, int]:
 @cocotb.test()
 async def array_matches_fixed_twin(dut: object) -> None:
     """Compare every spike of every step with the fixed twin's expectation."""
-    stim = np.load(_arg("stimulus"))
+    stim = load_stimulus(_arg("stimulus"))
     result_path = _arg("result")
-    codes = stim["codes"]
-    thresholds = stim["thresholds"]
-    expected = stim["expected"].astype(np.int8)
-    clears = {int(t) for t in stim["clear_before"]} if "clear_before" in stim else set()
-    adc_bits = int(stim["adc_bits"])
+    codes = stim.codes.astype(np.int64)
+    thresholds = stim.thresholds
+    expected = stim.spikes
+    clears = set(stim.clear_before)
+    adc_bits = stim.contract.adc_bits
     steps, scales, height, width = expected.shape
     n_acc = scales * height * width
 

@@ -1,12 +1,13 @@
-"""RTL-versus-fixed-twin verification: the function behind ``rvsm verify``.
+"""RTL-versus-fixed-twin verification: the functions behind ``rvsm verify``.
 
-:func:`run_rtl` is the core: given a contract, per-step ADC codes and thresholds, it
-computes the expectation with :meth:`ArrayContract.run` (the bit-accurate model beside
-the RTL), writes a stimulus ``.npz``, builds (cached) and simulates the Verilog, and
-returns the testbench's comparison. On a mismatch without ``waves`` it re-runs the
-stimulus up to the first failing step with waves on, so a waveform is always kept.
-:func:`verify` does the same for a scene and a design-point TOML via the fixed twin's
-stimulus (:func:`rvsm.model.fixed.stimulus.make_stimulus`).
+Everything goes through one stimulus file format (:mod:`rvsm.model.fixed.stimulus`):
+:func:`check_stimulus` writes a :class:`Stimulus` into its run folder, builds (cached)
+and simulates the Verilog with the cocotb testbench, and returns the testbench's
+comparison. On a mismatch without ``waves`` it re-runs the stimulus up to the first
+failing step with waves on, so a waveform is always kept. The entry points build the
+stimulus three ways: :func:`run_rtl` from a contract, codes and thresholds (the
+expectation from :meth:`ArrayContract.run`); :func:`verify` from a scene and a design
+point TOML via the fixed twin; :func:`replay` from a stimulus file (``rvsm stimulus``).
 """
 
 from __future__ import annotations
@@ -19,10 +20,12 @@ import numpy as np
 
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.stimulus import Stimulus, load_stimulus, save_stimulus
+from rvsm.model.fixed.widths import unsigned_max
 
 from .runner import build, check_simulator, run_testbench
 
-__all__ = ["MAX_PARALLEL_SIDE", "expected_spikes", "run_rtl", "verify", "write_stimulus"]
+__all__ = ["MAX_PARALLEL_SIDE", "check_stimulus", "replay", "run_rtl", "verify"]
 
 #: Largest side of a fully parallel array ``verify`` will build (generation time grows
 #: with pixels x taps; a full-resolution sensor needs the streaming array).
@@ -30,42 +33,64 @@ MAX_PARALLEL_SIDE = 64
 DEFAULT_WORK = Path("build") / "verify"
 
 
-def expected_spikes(
-    contract: ArrayContract, codes: np.ndarray, thresholds: np.ndarray,
-    clear_before: Sequence[int] = (),
-) -> np.ndarray:
-    """``contract.run`` per segment, restarting from zero at every ``clear_before`` step."""
-    cuts = sorted({int(t) for t in clear_before if 0 < int(t) < len(codes)})
-    bounds = [0, *cuts, len(codes)]
-    parts = [contract.run(codes[a:b], thresholds) for a, b in zip(bounds, bounds[1:],
-                                                                    strict=False)]
-    return np.concatenate(parts, axis=0)
-
-
-def write_stimulus(
-    path: str | os.PathLike, contract: ArrayContract, codes: np.ndarray,
-    thresholds: np.ndarray, expected: np.ndarray, clear_before: Sequence[int] = (),
-) -> Path:
-    """Write the testbench's ``.npz`` (codes, thresholds, expected, clear_before)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez(path, codes=np.asarray(codes, dtype=np.int64),
-             thresholds=np.asarray(thresholds, dtype=np.int64),
-             expected=np.asarray(expected, dtype=np.int8),
-             clear_before=np.asarray(sorted(clear_before), dtype=np.int64),
-             adc_bits=np.int64(contract.adc_bits))
-    return path
-
-
 def _check_inputs(contract: ArrayContract, codes: np.ndarray, thresholds: np.ndarray) -> None:
     c = contract
     if codes.ndim != 3 or codes.shape[1:] != (c.height, c.width):
         raise RvsmError(f"codes must be (T, {c.height}, {c.width}), got {codes.shape}")
-    if codes.min() < 0 or codes.max() >= (1 << c.adc_bits):
-        raise RvsmError(f"ADC codes must lie in 0..{(1 << c.adc_bits) - 1}")
+    if codes.min() < 0 or codes.max() > unsigned_max(c.adc_bits):
+        raise RvsmError(f"ADC codes must lie in 0..{unsigned_max(c.adc_bits)}")
     if thresholds.shape != (c.num_scales, c.height, c.width):
         raise RvsmError(f"thresholds must be ({c.num_scales}, {c.height}, {c.width}), "
                         f"got {thresholds.shape}")
+
+
+def _check_parallel_size(height: int, width: int) -> None:
+    if max(height, width) > MAX_PARALLEL_SIDE:
+        raise RvsmError(
+            f"the fully parallel RTL array is limited to {MAX_PARALLEL_SIDE}x"
+            f"{MAX_PARALLEL_SIDE} pixels, the design point is {height}x{width}; pass "
+            "--size, e.g. --size 16x16")
+
+
+def check_stimulus(
+    stim: Stimulus,
+    sim: str = "icarus",
+    waves: bool = False,
+    work_dir: str | os.PathLike = DEFAULT_WORK,
+    name: str = "run",
+    build_root: str | os.PathLike | None = None,
+) -> dict:
+    """Drive the RTL of ``stim.contract`` with ``stim`` and compare every spike.
+
+    Writes ``work_dir/<sim>/<name>/stimulus.npz`` (the testbench's input). Returns the
+    testbench result: ``compared``, ``mismatches``, ``first_mismatch``, ``simulator``,
+    ``waves`` (path or None), ``build_seconds``, ``stream_seconds``...
+    """
+    contract = stim.contract
+    _check_inputs(contract, stim.codes, stim.thresholds)
+    want = (stim.num_steps, contract.num_scales, contract.height, contract.width)
+    if stim.spikes.shape != want:
+        raise RvsmError(f"expected spikes must be {want}, got {stim.spikes.shape}")
+    work = Path(work_dir)
+    root = work / "builds" if build_root is None else Path(build_root)
+    sb = build(contract, sim, root, waves=waves)
+    run_dir = work / sim / name
+    path = run_dir / "stimulus.npz"
+    save_stimulus(path, stim)
+    result = run_testbench(sb, path, run_dir, waves=waves)
+    if result["mismatches"] and not result["waves"]:
+        first = result["first_mismatch"] or {}
+        upto = min(stim.num_steps, int(first.get("step", stim.num_steps - 1)) + 1)
+        again_dir = run_dir / "failure"
+        again = again_dir / "stimulus.npz"
+        save_stimulus(again, stim.first_steps(upto))
+        sbw = build(contract, sim, root, waves=True)
+        result["waves"] = run_testbench(sbw, again, again_dir, waves=True)["waves"]
+    result.update(
+        build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
+        build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),
+    )
+    return result
 
 
 def run_rtl(
@@ -82,35 +107,41 @@ def run_rtl(
 ) -> dict:
     """Simulate the RTL on ``codes``/``thresholds`` and compare with the expectation.
 
-    ``expected`` defaults to :func:`expected_spikes` (pass one to test the checker).
-    Returns the testbench result: ``compared``, ``mismatches``, ``first_mismatch``,
-    ``simulator``, ``waves`` (path or None), ``build_seconds``, ``stream_seconds``...
+    ``expected`` defaults to ``contract.run(codes, thresholds, clear_before)`` (pass one
+    to test the checker). Returns :func:`check_stimulus`'s result.
     """
     codes = np.asarray(codes, dtype=np.int64)
     thresholds = np.asarray(thresholds, dtype=np.int64)
     _check_inputs(contract, codes, thresholds)
     if expected is None:
-        expected = expected_spikes(contract, codes, thresholds, clear_before)
-    work = Path(work_dir)
-    root = work / "builds" if build_root is None else Path(build_root)
-    sb = build(contract, sim, root, waves=waves)
-    run_dir = work / sim / name
-    stim = write_stimulus(run_dir / "stimulus.npz", contract, codes, thresholds, expected,
-                          clear_before)
-    result = run_testbench(sb, stim, run_dir, waves=waves)
-    if result["mismatches"] and not result["waves"]:
-        first = result["first_mismatch"] or {}
-        upto = min(len(codes), int(first.get("step", len(codes) - 1)) + 1)
-        again_dir = run_dir / "failure"
-        stim2 = write_stimulus(again_dir / "stimulus.npz", contract, codes[:upto],
-                               thresholds, expected[:upto],
-                               [t for t in clear_before if t < upto])
-        sbw = build(contract, sim, root, waves=True)
-        result["waves"] = run_testbench(sbw, stim2, again_dir, waves=True)["waves"]
-    result.update(
-        build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
-        build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),
-    )
+        expected = contract.run(codes, thresholds, clear_before)
+    stim = Stimulus(codes, thresholds, np.asarray(expected, dtype=np.int8), contract,
+                    clear_before=tuple(clear_before))
+    return check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=name,
+                          build_root=build_root)
+
+
+def replay(
+    stimulus: str | os.PathLike,
+    sim: str = "icarus",
+    steps: int | None = None,
+    waves: bool = False,
+    work_dir: str | os.PathLike = DEFAULT_WORK,
+) -> dict:
+    """Replay a stimulus file (``rvsm stimulus -o FILE``) on the RTL, spike for spike.
+
+    ``steps`` keeps the first steps. Returns :func:`check_stimulus`'s result plus
+    ``stimulus``, ``height`` and ``width``.
+    """
+    check_simulator(sim)
+    stim = load_stimulus(stimulus)
+    c = stim.contract
+    _check_parallel_size(c.height, c.width)
+    if steps is not None and steps < stim.num_steps:
+        stim = stim.first_steps(steps)
+    result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
+                            name=Path(stimulus).stem or "stimulus")
+    result.update(stimulus=str(stimulus), height=c.height, width=c.width)
     return result
 
 
@@ -126,7 +157,7 @@ def verify(
     """Verify the RTL of design point ``fixed`` (TOML) on ``scene``, spike for spike.
 
     ``size = (H, W)`` overrides the point's array size (the scene is rendered or cropped
-    to it); ``steps`` keeps the first steps. Returns :func:`run_rtl`'s result plus
+    to it); ``steps`` keeps the first steps. Returns :func:`check_stimulus`'s result plus
     ``scene`` and ``point``. Raises :class:`RvsmError` on user errors (not on
     mismatches: check ``result["mismatches"]``).
     """
@@ -139,14 +170,9 @@ def verify(
     if size is not None:
         point = point.with_size(*size)
     h, w = point.height, point.width
-    if max(h, w) > MAX_PARALLEL_SIDE:
-        raise RvsmError(
-            f"the fully parallel RTL array is limited to {MAX_PARALLEL_SIDE}x"
-            f"{MAX_PARALLEL_SIDE} pixels, the design point is {h}x{w}; pass --size, "
-            "e.g. --size 16x16")
+    _check_parallel_size(h, w)
     stim = make_stimulus(load_scene(scene, size=(h, w)), point, num_steps=steps)
-    result = run_rtl(stim.contract, stim.codes, stim.thresholds, sim,
-                     expected=stim.spikes, waves=waves, work_dir=work_dir,
-                     name=Path(str(scene)).stem or "scene")
+    result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
+                            name=Path(str(scene)).stem or "scene")
     result.update(scene=str(scene), point=str(fixed), height=h, width=w)
     return result

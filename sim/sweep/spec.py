@@ -39,12 +39,12 @@ from rvsm.model.fixed.config import (
     MAX_WEIGHT_BITS,
     TOML_FIELDS,
     DesignPoint,
-    _signed_bits,
     default_design_point,
     design_point_toml,
     load_design_point,
 )
 from rvsm.model.fixed.weights import quantise_model
+from rvsm.model.fixed.widths import signed_bits
 from rvsm.model.scene_io import parse_size
 
 PATH_FIELD = {path: f for f, path in FIELD_PATH.items()}
@@ -418,9 +418,9 @@ def _resolve_autos(
     out = {}
     if "weight_bits" in autos:
         ws = quantise_model(trial.model, trial.weight_frac_bits, trial.weight_rounding)
-        need = max(max(_signed_bits(int(w.max())), _signed_bits(int(w.min()))) for w in ws)
+        need = max(max(signed_bits(int(w.max())), signed_bits(int(w.min()))) for w in ws)
         out["weight_bits"] = max(2, need + autos["weight_bits"])
     if "accumulator_bits" in autos:
-        need = _signed_bits(int(trial.nominal_thresholds().max()))
+        need = signed_bits(int(trial.nominal_thresholds().max()))
         out["accumulator_bits"] = max(2, need + autos["accumulator_bits"])
     return out

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import FixedIntegrator, accumulator_range, arithmetic_shift
+from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift
+from rvsm.model.fixed.widths import signed_range
 from rvsm.rtl.pixel_cell import PixelCell
 
 
@@ -66,7 +67,7 @@ def test_random_sums_match_integrator(signed: bool, reset: str, amaranth_sim) ->
 
 def test_both_saturation_rails_and_exact_threshold(amaranth_sim) -> None:
     bits = 8
-    lo, hi = accumulator_range(bits)
+    lo, hi = signed_range(bits)
     # threshold at the top rail: only a saturated accumulator reaches it exactly
     sums = [100, 100, 100, -100, -100, -100, -100, 127, 0, 5]
     for thr in (hi, 127, 100, 1):

@@ -112,6 +112,21 @@ def test_contract_run_equals_run_integer_array():
     assert c.threshold_bits == 15
 
 
+def test_contract_run_clear_before_restarts_from_zero():
+    """``clear_before`` = independent runs of the segments; out-of-range steps are no-ops."""
+    p = DesignPoint(height=4, width=5, model="dog2", shift=1, accumulator_bits=12,
+                    weight_bits=10, weight_frac_bits=7, phi=60.0)
+    c = p.contract()
+    rng = np.random.default_rng(8)
+    codes = rng.integers(0, 128, (30, 4, 5))
+    thr = p.integer_thresholds()
+    got = c.run(codes, thr, clear_before=(17, 5, 5))
+    want = np.concatenate([c.run(codes[a:b], thr) for a, b in ((0, 5), (5, 17), (17, 30))])
+    assert np.array_equal(got, want)
+    assert not np.array_equal(got, c.run(codes, thr))  # the restart changes the spikes
+    assert np.array_equal(c.run(codes, thr, clear_before=(0, 30, 99)), c.run(codes, thr))
+
+
 def test_bit_lengths():
     v = np.array([0, 1, -1, 2, 3, -4, 255, 256, -(2**40)])
     assert list(bit_lengths(v)) == [0, 1, 1, 2, 2, 3, 8, 9, 41]

@@ -112,6 +112,21 @@ def test_stimulus_round_trip(tmp_path, scene):
         assert data["weights"].shape == (2, 5, 5) and list(data["half_widths"]) == [1, 2]
     full = make_stimulus(scene, _point(model="dog2", noise=True))
     assert np.array_equal(full.spikes[:17], stim.spikes)
+    assert back.clear_before == ()
+
+
+def test_stimulus_with_clears_round_trip_and_cut(tmp_path, scene):
+    stim = make_stimulus(scene, _point(model="dog2"), num_steps=30)
+    cleared = dataclasses.replace(
+        stim, clear_before=(20, 9),
+        spikes=stim.contract.run(stim.codes, stim.thresholds, (9, 20)))
+    assert cleared.clear_before == (9, 20) and cleared.check()
+    assert not dataclasses.replace(stim, clear_before=(9, 20)).check()
+    save_stimulus(tmp_path / "c.npz", cleared)
+    back = load_stimulus(tmp_path / "c.npz")
+    assert back.clear_before == (9, 20) and back.check()
+    cut = back.first_steps(15)
+    assert cut.num_steps == 15 and cut.clear_before == (9,) and cut.check()
 
 
 def test_profile_report_and_figure(scene):

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from rvsm.model.fixed.config import default_design_point, save_design_point
+from rvsm.model.fixed.stimulus import load_stimulus, save_stimulus
 from rvsm.sim.cli import main
 
 
@@ -32,3 +33,42 @@ def test_cli_verify_design_point(tmp_path: Path, capsys: pytest.CaptureFixture) 
     assert rc == 0
     assert out["simulator"] == "icarus" and out["mismatches"] == 0
     assert out["compared"] == 40 * 4 * 4 * 6
+
+
+def test_stimulus_file_replays_on_icarus(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """``rvsm stimulus`` writes what the testbench reads: ``rvsm verify --stimulus FILE``."""
+    point = tmp_path / "p.toml"
+    save_design_point(point, default_design_point().with_size(4, 4))
+    stim = tmp_path / "s.npz"
+    assert main(["stimulus", "coin", "--fixed", str(point), "--steps", "25",
+                 "-o", str(stim)]) == 0
+    capsys.readouterr()
+    work = str(tmp_path / "work")
+    rc = main(["verify", "--stimulus", str(stim), "--sim", "icarus", "--json", "--work", work])
+    out = json.loads(capsys.readouterr().out)
+    assert rc == 0 and out["mismatches"] == 0
+    assert out["compared"] == 25 * 4 * 4 * 4 and out["expected_spikes"] > 0
+
+    # clears in the middle of the stream, then a tampered expectation: exit 1, named
+    s = load_stimulus(stim)
+    cleared = replace(s, clear_before=(8, 16),
+                      spikes=s.contract.run(s.codes, s.thresholds, (8, 16)))
+    save_stimulus(stim, cleared)
+    assert main(["verify", "--stimulus", str(stim), "--json", "--work", work]) == 0
+    assert json.loads(capsys.readouterr().out)["mismatches"] == 0
+    wrong = cleared.spikes.copy()
+    wrong[12, 1, 2, 3] = 1 if wrong[12, 1, 2, 3] != 1 else 0
+    save_stimulus(stim, replace(cleared, spikes=wrong))
+    assert main(["verify", "--stimulus", str(stim), "--steps", "20", "--json",
+                 "--work", work]) == 1
+    out = json.loads(capsys.readouterr().out)
+    assert out["mismatches"] == 1 and out["first_mismatch"]["step"] == 12
+
+
+def test_verify_needs_scene_and_point_or_stimulus(tmp_path: Path,
+                                                  capsys: pytest.CaptureFixture) -> None:
+    assert main(["verify", "coin"]) == 2
+    assert main(["verify", "coin", "--stimulus", str(tmp_path / "s.npz")]) == 2
+    assert main(["verify", "--stimulus", str(tmp_path / "missing.npz")]) == 2
+    err = capsys.readouterr().err
+    assert "--stimulus" in err and "does not exist" in err

@@ -18,7 +18,7 @@ from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.kernels import MODEL_NAMES
 from rvsm.sim.cosim.runner import check_simulator
-from rvsm.sim.cosim.verify import expected_spikes, run_rtl
+from rvsm.sim.cosim.verify import run_rtl
 
 SIMS = ["icarus", "verilator"]
 
@@ -76,7 +76,7 @@ def check_all(c: ArrayContract, sim: str, cosim_work: Path, rtl_builds: Path, se
                     build_root=rtl_builds)
         assert r["mismatches"] == 0, (name, r["first_mismatch"])
         assert r["compared"] == codes.shape[0] * c.num_scales * c.height * c.width
-        want = expected_spikes(c, codes, thr, clears)
+        want = c.run(codes, thr, clears)
         spikes[1] += int((want == 1).sum())
         spikes[-1] += int((want == -1).sum())
     assert spikes[1] > 0
@@ -116,7 +116,7 @@ def test_checker_catches_wrong_expectation(
     rng = np.random.default_rng(14)
     codes = rng.integers(0, 16, (30, 3, 5))
     thr = rng.integers(1, 60, (c.num_scales, 3, 5))
-    wrong = expected_spikes(c, codes, thr)
+    wrong = c.run(codes, thr)
     step, scale, row, col = 17, 2, 1, 4
     good = int(wrong[step, scale, row, col])
     wrong[step, scale, row, col] = 1 if good != 1 else -1
@@ -138,7 +138,7 @@ def test_checker_catches_wrong_expectation_verilator(
     rng = np.random.default_rng(15)
     codes = rng.integers(0, 16, (20, 3, 5))
     thr = rng.integers(1, 60, (c.num_scales, 3, 5))
-    wrong = expected_spikes(c, codes, thr)
+    wrong = c.run(codes, thr)
     wrong[9, 0, 0, 0] = 1 if wrong[9, 0, 0, 0] != 1 else 0
     r = run_rtl(c, codes, thr, "verilator", expected=wrong, work_dir=cosim_work,
                 name="wrong_v", build_root=rtl_builds)
