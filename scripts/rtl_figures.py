@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from rvsm.model.fixed.config import default_design_point
+from rvsm.model.fixed.design_point import default_design_point
 from rvsm.sim.cosim.verify import run_rtl
 
 

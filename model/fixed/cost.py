@@ -15,7 +15,7 @@ import numpy as np
 
 from ..samplers import sample
 from ..scene import Scene
-from .config import DesignPoint
+from .design_point import DesignPoint
 from .twin import fit_point, simulate_fixed
 
 

@@ -34,8 +34,9 @@ import numpy as np
 from ..atomic import atomic_path
 from ..errors import RvsmError
 from ..scene import Scene
-from .config import DesignPoint, design_point_toml, parse_design_point
 from .core import ArrayContract
+from .design_point import DesignPoint
+from .point_toml import design_point_toml, parse_design_point
 from .twin import simulate_fixed
 
 STIMULUS_KEYS = (

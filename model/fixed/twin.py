@@ -23,7 +23,6 @@ from ..noise import NoiseSource
 from ..samplers import DEFAULT_BLOCK_STEPS, progress_bar, sampling_meta
 from ..scene import Scene
 from .adc import adc_codes
-from .config import DesignPoint
 from .core import (
     ArrayContract,
     FixedIntegrator,
@@ -31,6 +30,7 @@ from .core import (
     bit_length_histogram,
     integer_receptive_sums,
 )
+from .design_point import DesignPoint
 
 
 @dataclass

@@ -60,7 +60,7 @@ def _common(p: argparse.ArgumentParser) -> None:
 
 
 def _point_and_scene(args: argparse.Namespace):
-    from rvsm.model.fixed.config import load_design_point
+    from rvsm.model.fixed.point_toml import load_design_point
 
     point = load_design_point(args.fixed)
     size = parse_size_arg(args.size)
@@ -77,7 +77,8 @@ def _point_and_scene(args: argparse.Namespace):
 
 def run_config_new(args: argparse.Namespace) -> int:
     """``rvsm config new``."""
-    from rvsm.model.fixed.config import default_design_point, design_point_toml, save_design_point
+    from rvsm.model.fixed.design_point import default_design_point
+    from rvsm.model.fixed.point_toml import design_point_toml, save_design_point
 
     point = default_design_point()
     size = parse_size_arg(args.size)
@@ -93,7 +94,7 @@ def run_config_new(args: argparse.Namespace) -> int:
 
 def run_config_check(args: argparse.Namespace) -> int:
     """``rvsm config check``."""
-    from rvsm.model.fixed.config import load_design_point
+    from rvsm.model.fixed.point_toml import load_design_point
 
     p = load_design_point(args.point)
     c = p.contract()

@@ -50,7 +50,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _verilog(args: argparse.Namespace) -> int:
-    from rvsm.model.fixed.config import load_design_point
+    from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.verilog import verilator_lint, write_outputs, yosys_stats
 
     point = load_design_point(args.point)

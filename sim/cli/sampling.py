@@ -98,7 +98,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         if given:
             raise RvsmError(f"{', '.join(given)} come(s) from the design point with --fixed; "
                             "edit the TOML instead")
-        from rvsm.model.fixed.config import load_design_point
+        from rvsm.model.fixed.point_toml import load_design_point
         from rvsm.model.fixed.twin import simulate_fixed
 
         point = load_design_point(args.fixed)

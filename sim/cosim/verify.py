@@ -161,7 +161,7 @@ def verify(
     ``scene`` and ``point``. Raises :class:`RvsmError` on user errors (not on
     mismatches: check ``result["mismatches"]``).
     """
-    from rvsm.model.fixed.config import load_design_point
+    from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.model.fixed.stimulus import make_stimulus
     from rvsm.model.scene_io import load_scene
 

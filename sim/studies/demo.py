@@ -133,7 +133,8 @@ def run_rtl_demo(
     verification result (``compared``, ``mismatches``, ``first_mismatch``, ``waves``,
     timings) plus ``verilog`` and ``generate_seconds``.
     """
-    from rvsm.model.fixed.config import default_design_point, save_design_point
+    from rvsm.model.fixed.design_point import default_design_point
+    from rvsm.model.fixed.point_toml import save_design_point
     from rvsm.rtl.verilog import write_outputs
     from rvsm.sim.cosim.verify import verify
 

@@ -22,9 +22,9 @@ import numpy as np
 
 from rvsm.model.atomic import atomic_path, write_text_atomic
 from rvsm.model.errors import RvsmError
-from rvsm.model.fixed.config import FIELD_PATH, parse_design_point
+from rvsm.model.fixed.design_point import FIELD_BY_PATH, FIELD_PATH
+from rvsm.model.fixed.point_toml import parse_design_point
 
-from .spec import PATH_FIELD
 from .store import open_existing
 
 PROXY_LABEL = "adc + weight + accumulator bits (proxy: no synthesis)"
@@ -99,7 +99,7 @@ def summarise(rows: list[dict[str, Any]]) -> list[DesignSummary]:
 
 
 def _value(point, path: str) -> Any:
-    v = getattr(point, PATH_FIELD[path])
+    v = getattr(point, FIELD_BY_PATH[path].name)
     return list(v) if isinstance(v, tuple) else v
 
 

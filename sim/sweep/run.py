@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from rvsm.model.errors import RvsmError
-from rvsm.model.fixed.config import DesignPoint
+from rvsm.model.fixed.design_point import DesignPoint
 
 from .spec import SweepSpec, SweepTask
 from .store import SweepStore

@@ -33,23 +33,25 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from rvsm.model.errors import RvsmError
-from rvsm.model.fixed.config import (
-    FIELD_PATH,
-    MAX_ACC_BITS,
-    MAX_WEIGHT_BITS,
-    TOML_FIELDS,
+from rvsm.model.fixed.design_point import (
+    FIELDS,
     DesignPoint,
     default_design_point,
-    design_point_toml,
-    load_design_point,
 )
-from rvsm.model.fixed.weights import quantise_model
-from rvsm.model.fixed.widths import signed_bits
+from rvsm.model.fixed.point_toml import (
+    design_point_toml,
+    from_toml_dict,
+    load_design_point,
+    to_toml_dict,
+)
 from rvsm.model.scene_io import parse_size
 
-PATH_FIELD = {path: f for f, path in FIELD_PATH.items()}
-RUN_ONLY = ("array.height", "array.width", "noise.enabled", "noise.seed")
-AUTO_FIELDS = ("weight_bits", "accumulator_bits")
+#: ``section.key`` -> design point field name of every field a sweep may vary.
+AXES: dict[str, str] = {f.path: f.name for f in FIELDS if f.sweep}
+#: Fields set by ``[run]`` (array size, noise, seed), not by axes.
+RUN_ONLY: tuple[str, ...] = tuple(f.path for f in FIELDS if not f.sweep)
+#: Axes that may say ``"auto"`` / ``"auto+N"`` (smallest width + N).
+AUTO_AXES: tuple[str, ...] = tuple(f.path for f in FIELDS if f.auto)
 SECTIONS = ("base", "axes", "run", "hardware")
 RUN_KEYS = ("scenes", "size", "frames", "steps_per_frame", "seeds", "noise", "method", "match")
 HARDWARE_KEYS = ("enabled", "size")
@@ -139,11 +141,6 @@ class SweepSpec:
         """Digest of the file text (16 hex digits)."""
         return hashlib.sha256(self.text.encode()).hexdigest()[:16]
 
-    @property
-    def axis_fields(self) -> list[str]:
-        """Every swept ``section.key``, in file order."""
-        return [p for paths, _ in self.axes for p in paths]
-
     def tasks(self) -> list[SweepTask]:
         """Every design x scene x noise x seed, in a stable order."""
         out = []
@@ -212,12 +209,12 @@ def _parse_base(raw: Any, source: str, base_dir: Path) -> DesignPoint:
     else:
         point = default_design_point()
     if raw:
-        merged = point.to_toml_dict()
+        merged = to_toml_dict(point)
         for sec, table in raw.items():
             if not isinstance(table, dict):
                 raise RvsmError(f"{source}: base.{sec} must be a table like [base.{sec}]")
             merged.setdefault(sec, {}).update(table)
-        point = DesignPoint.from_toml_dict(merged, f"{source}: [base]")
+        point = from_toml_dict(merged, f"{source}: [base]")
     return point
 
 
@@ -239,9 +236,8 @@ def _parse_axes(raw: Any, source: str) -> tuple:
                 raise RvsmError(
                     f"{where}: {p} is set by [run] (size, noise, seeds), not an axis"
                 )
-            if p not in PATH_FIELD:
-                valid = ", ".join(f"{s}.{k}" for s, k, _ in TOML_FIELDS
-                                  if f"{s}.{k}" not in RUN_ONLY)
+            if p not in AXES:
+                valid = ", ".join(AXES)
                 raise RvsmError(f"{where}: unknown field {p}; axes take {valid}")
             if p in seen:
                 raise RvsmError(f"{where}: {p} is swept twice")
@@ -257,10 +253,10 @@ def _parse_axes(raw: Any, source: str) -> tuple:
                 )
             for p, x in zip(paths, combo, strict=True):
                 if isinstance(x, str) and x.startswith("auto"):
-                    if PATH_FIELD[p] not in AUTO_FIELDS:
+                    if p not in AUTO_AXES:
                         raise RvsmError(
                             f"{source}: axes.\"{key}\": {x!r} is only allowed for "
-                            "weights.bits and datapath.accumulator_bits"
+                            f"{' and '.join(AUTO_AXES)}"
                         )
                     _auto_offset(x, f"{source}: axes.\"{key}\"")
             combos.append(combo)
@@ -388,14 +384,16 @@ def _expand(spec: SweepSpec) -> list[Design]:
 
 def make_design(base: DesignPoint, axes: dict[str, Any]) -> Design:
     """Apply ``axes`` (``section.key -> value``, ``"auto[+N]"`` allowed) to ``base``."""
-    kwargs = {PATH_FIELD[p]: v for p, v in axes.items()}
-    autos = {f: _auto_offset(v, f) for f, v in kwargs.items()
-             if isinstance(v, str) and f in AUTO_FIELDS and v.startswith("auto")}
+    changes: dict[str, Any] = {"noise": False, "seed": 0}
+    extra_bits: dict[str, int] = {}
+    for path, value in axes.items():
+        name = AXES[path]
+        if isinstance(value, str) and path in AUTO_AXES and value.startswith("auto"):
+            extra_bits[name] = _auto_offset(value, path)
+        else:
+            changes[name] = value
     try:
-        if autos:
-            wide = {f: (MAX_WEIGHT_BITS if f == "weight_bits" else MAX_ACC_BITS) for f in autos}
-            kwargs.update(_resolve_autos(base, kwargs, wide, autos))
-        point = dataclasses.replace(base, noise=False, seed=0, **kwargs)
+        point = DesignPoint.with_smallest_widths(base, changes, extra_bits)
     except RvsmError as exc:
         text = json.dumps({"base": base.to_dict(), "axes": axes}, sort_keys=True, default=str)
         return Design(hashlib.sha256(text.encode()).hexdigest()[:16], dict(axes), None,
@@ -406,21 +404,3 @@ def make_design(base: DesignPoint, axes: dict[str, Any]) -> Design:
                       f"{type(exc).__name__}: {exc}", text)
     toml = design_point_toml(point)
     return Design(hashlib.sha256(toml.encode()).hexdigest()[:16], dict(axes), point, None, toml)
-
-
-def _resolve_autos(
-    base: DesignPoint, kwargs: dict[str, Any], wide: dict[str, int], autos: dict[str, int]
-) -> dict[str, int]:
-    """Smallest widths: weights.bits holding every quantised weight, accumulator_bits
-    holding the largest nominal threshold (saturation at 2**(W-1)-1 >= threshold still
-    fires, so with ``reset = "zero"`` nothing is lost), each plus its offset."""
-    trial = dataclasses.replace(base, noise=False, seed=0, **{**kwargs, **wide})
-    out = {}
-    if "weight_bits" in autos:
-        ws = quantise_model(trial.model, trial.weight_frac_bits, trial.weight_rounding)
-        need = max(max(signed_bits(int(w.max())), signed_bits(int(w.min()))) for w in ws)
-        out["weight_bits"] = max(2, need + autos["weight_bits"])
-    if "accumulator_bits" in autos:
-        need = signed_bits(int(trial.nominal_thresholds().max()))
-        out["accumulator_bits"] = max(2, need + autos["accumulator_bits"])
-    return out

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.model.fixed.config import default_design_point
+from rvsm.model.fixed.design_point import default_design_point
 from rvsm.rtl.array import RvsmArray
 from rvsm.rtl.verilog import write_outputs
 

@@ -8,9 +8,8 @@ import numpy as np
 import pytest
 
 from rvsm.model.errors import RvsmError
-from rvsm.model.fixed.config import (
-    DesignPoint,
-    default_design_point,
+from rvsm.model.fixed.design_point import FIELD_PATH, FIELDS, DesignPoint, default_design_point
+from rvsm.model.fixed.point_toml import (
     design_point_toml,
     load_design_point,
     parse_design_point,
@@ -157,3 +156,38 @@ def test_refused_at_load_time(tmp_path):
 def test_partial_toml_uses_defaults():
     p = parse_design_point('[array]\nmodel = "gauss1"\nheight = 5\nwidth = 6\n')
     assert p == DesignPoint(height=5, width=6, model="gauss1")
+
+
+def test_every_field_declared_once_drives_toml_validation_and_comments():
+    """The field table is the single source: TOML keys, comments and refusals."""
+    text = design_point_toml(default_design_point())
+    for f in FIELDS:
+        assert f"# {f.key}: {f.comment()}" in text
+        assert f.path == FIELD_PATH[f.name]
+    assert [f.name for f in FIELDS] == [f.name for f in dataclasses.fields(DesignPoint)]
+    assert parse_design_point(text) == default_design_point()
+    for f in FIELDS:  # a value of no valid kind is refused naming that field
+        with pytest.raises(RvsmError, match=f.path.replace(".", r"\.")):
+            dataclasses.replace(default_design_point(), **{f.name: object()})
+
+
+def test_commented_scale_phi_follows_phi():
+    text = design_point_toml(dataclasses.replace(default_design_point(), phi=250.0,
+                                                 model="dog2"))
+    assert "# scale_phi = [250.0, 250.0]" in text
+
+
+@pytest.mark.parametrize("frac", [4, 7, 9, 12])
+def test_smallest_widths_are_the_smallest_valid(frac):
+    base = wide_point(weight_frac_bits=frac, weight_bits=32, accumulator_bits=40)
+    wb, ab = base.smallest_weight_bits(), base.smallest_accumulator_bits()
+    fitted = DesignPoint.with_smallest_widths(
+        base, {}, {"weight_bits": 0, "accumulator_bits": 0})
+    assert (fitted.weight_bits, fitted.accumulator_bits) == (max(2, wb), max(2, ab))
+    with pytest.raises(RvsmError, match="weights"):
+        dataclasses.replace(fitted, weight_bits=fitted.weight_bits - 1)
+    with pytest.raises(RvsmError, match="datapath.accumulator_bits"):
+        dataclasses.replace(fitted, accumulator_bits=fitted.accumulator_bits - 1)
+    plus = DesignPoint.with_smallest_widths(base, {"shift": 1}, {"accumulator_bits": 2})
+    want = dataclasses.replace(base, shift=1).smallest_accumulator_bits() + 2
+    assert plus.shift == 1 and plus.accumulator_bits == want

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from rvsm.model.errors import RvsmError
-from rvsm.model.fixed.config import DesignPoint
 from rvsm.model.fixed.core import (
     ArrayContract,
     FixedIntegrator,
@@ -16,6 +15,7 @@ from rvsm.model.fixed.core import (
     integer_receptive_sums_direct,
     run_integer_array,
 )
+from rvsm.model.fixed.design_point import DesignPoint
 
 
 def _one(value: int) -> np.ndarray:

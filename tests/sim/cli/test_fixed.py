@@ -5,7 +5,8 @@ from __future__ import annotations
 import dataclasses
 import json
 
-from rvsm.model.fixed.config import DesignPoint, default_design_point, save_design_point
+from rvsm.model.fixed.design_point import DesignPoint, default_design_point
+from rvsm.model.fixed.point_toml import save_design_point
 from rvsm.model.fixed.stimulus import load_stimulus
 from rvsm.sim.cli import main
 

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.model.fixed.config import default_design_point, save_design_point
+from rvsm.model.fixed.design_point import default_design_point
+from rvsm.model.fixed.point_toml import save_design_point
 from rvsm.model.fixed.stimulus import load_stimulus, save_stimulus
 from rvsm.sim.cli import main
 

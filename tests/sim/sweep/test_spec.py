@@ -87,3 +87,19 @@ def test_bad_sweep_refused_naming_field(text, needle):
         parse_sweep(text, "bad.toml")
     assert needle in str(info.value)
     assert "bad.toml" in str(info.value)
+
+
+def test_axes_are_the_declared_sweepable_fields():
+    from rvsm.model.fixed.design_point import FIELDS, default_design_point
+    from rvsm.sim.sweep.spec import AUTO_AXES, AXES, RUN_ONLY
+
+    assert set(AXES) | set(RUN_ONLY) == {f.path for f in FIELDS}
+    assert AUTO_AXES == ("weights.bits", "datapath.accumulator_bits")
+    base = default_design_point()
+    for path in AXES:  # every declared axis is accepted and lands on its field
+        value = getattr(base, AXES[path])
+        d = make_design(base, {path: value})
+        assert d.error is None and getattr(d.point, AXES[path]) == value
+    for path in RUN_ONLY:
+        with pytest.raises(RvsmError, match="set by \\[run\\]"):
+            parse_sweep(f'[axes]\n"{path}" = [1]\n[run]\nscenes = ["coin"]\n')
