@@ -21,6 +21,7 @@ from .errors import RvsmError
 from .filtering import receptive_field_sums
 from .kernels import ModelSpec, model_spec
 from .noise import NoiseParams, NoiseSource
+from .progress import progress_bar
 from .scene import Scene
 
 RESET_MODES = ("zero", "subtract")
@@ -215,24 +216,13 @@ def sample(
 
 
 def sampling_meta(scene: Scene, config: SamplerConfig) -> dict:
-    """Metadata needed to reproduce a spike train (goes into the spike file's ``meta``)."""
-    h, w = scene.shape
+    """Metadata needed to reproduce a spike train (goes into the spike file's ``meta``):
+    the scene's :meth:`~rvsm.model.scene.Scene.meta`, its name, steps and the sampler."""
     return {
         "kind": "float",
         "scene": scene.name,
-        "height": h,
-        "width": w,
-        "steps_per_frame": scene.steps_per_frame,
-        "hold": scene.hold,
+        **scene.meta(),
         "num_steps": scene.num_steps,
         "phis": [float(v) for v in config.phis],
         **config.to_dict(),
     }
-
-
-def progress_bar(total: int, desc: str, enabled: bool):
-    """A tqdm bar over ``total`` steps (a silent no-op bar when ``enabled`` is False)."""
-    from tqdm.auto import tqdm
-
-    return tqdm(total=total, desc=desc, unit="step", disable=not enabled, leave=False)
-

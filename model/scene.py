@@ -53,12 +53,17 @@ def validate_frames(frames: np.ndarray, source: str = "scene") -> np.ndarray:
 
 @dataclass(frozen=True)
 class Scene:
-    """Frames ``(F, H, W) float64`` in 8-bit brightness units and how they become steps."""
+    """Frames ``(F, H, W) float64`` in 8-bit brightness units and how they become steps.
+
+    ``source`` is what loads the scene again (a built-in name or a path, as given to
+    :func:`rvsm.model.scene_io.load_scene`); ``None`` for a scene made in code.
+    """
 
     name: str
     frames: np.ndarray = field(repr=False)
     steps_per_frame: int = DEFAULT_STEPS_PER_FRAME
     hold: bool = False
+    source: str | None = None
 
     def __post_init__(self) -> None:
         frames = validate_frames(self.frames, self.name)
@@ -114,11 +119,21 @@ class Scene:
         for t0 in range(0, self.num_steps, block_steps):
             yield t0, min(t0 + block_steps, self.num_steps)
 
-    def cropped(self, height: int, width: int) -> Scene:
-        """The top-left ``height x width`` window of this scene."""
-        return Scene(
-            self.name, self.frames[:, :height, :width], self.steps_per_frame, self.hold
-        )
+    def meta(self) -> dict:
+        """What it takes to load this scene again: goes into spike files' ``meta``.
+
+        ``scene_arg`` (the source, else the name), ``height``, ``width``, ``num_frames``,
+        ``steps_per_frame`` and ``hold``.
+        """
+        h, w = self.shape
+        return {
+            "scene_arg": self.source if self.source is not None else self.name,
+            "height": h,
+            "width": w,
+            "num_frames": self.num_frames,
+            "steps_per_frame": self.steps_per_frame,
+            "hold": self.hold,
+        }
 
 
 def interpolate(stack: np.ndarray, f: np.ndarray, a: np.ndarray) -> np.ndarray:

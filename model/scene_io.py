@@ -240,4 +240,4 @@ def load_scene(
         frames = frames[: int(num_frames)]
     frames = _fit_size(frames, size, str(path))
     name = path.stem if path.suffix else path.name
-    return Scene(name, frames, steps_per_frame, hold)
+    return Scene(name, frames, steps_per_frame, hold, source=text)

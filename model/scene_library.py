@@ -389,7 +389,8 @@ def builtin_scene(
     hold: bool = False,
 ) -> Scene:
     """Built-in scene ``name`` as a :class:`Scene` (``size`` is ``(H, W)`` pixels)."""
-    return Scene(name, render_frames(name, size, num_frames), steps_per_frame, hold)
+    return Scene(name, render_frames(name, size, num_frames), steps_per_frame, hold,
+                 source=name)
 
 
 def black_scene(size: tuple[int, int], num_steps: int) -> Scene:

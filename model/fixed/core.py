@@ -24,9 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import RvsmError
+from ..samplers import RESET_MODES
 from .widths import signed_range, unsigned_max
-
-RESET_MODES = ("zero", "subtract")
 
 
 def integer_receptive_sums(codes: np.ndarray, weights: Sequence[np.ndarray]) -> np.ndarray:

@@ -107,9 +107,6 @@ def profile_figure(run: FixedRun):
     representable ranges, a red tick at the threshold. Needs ``histograms=True`` in
     :func:`~.twin.simulate_fixed` for the right panel's boxes (min..max otherwise).
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
     from matplotlib.figure import Figure
 
     p, st, c = run.point, run.stats, run.contract

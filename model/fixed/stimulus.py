@@ -103,13 +103,13 @@ def _first_steps(scene: Scene, steps: int) -> Scene:
     m = scene.steps_per_frame
     if scene.hold:
         frames = scene.frames[: -(-steps // m)]
-        out = Scene(scene.name, frames, m, True)
+        out = Scene(scene.name, frames, m, True, scene.source)
     else:
         frames = scene.frames[: -(-steps // m) + 1]
-        out = Scene(scene.name, frames, m, False)
+        out = Scene(scene.name, frames, m, False, scene.source)
     if out.num_steps == steps:
         return out
-    return Scene(scene.name, out.brightness(0, steps), 1, True)
+    return Scene(scene.name, out.brightness(0, steps), 1, True, scene.source)
 
 
 def save_stimulus(path: str | os.PathLike, stim: Stimulus) -> None:

@@ -20,7 +20,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..noise import NoiseSource
-from ..samplers import DEFAULT_BLOCK_STEPS, progress_bar, sampling_meta
+from ..progress import progress_bar
+from ..samplers import DEFAULT_BLOCK_STEPS, sampling_meta
 from ..scene import Scene
 from .adc import adc_codes
 from .core import (

@@ -49,7 +49,8 @@ def noise_from_args(args: argparse.Namespace) -> NoiseParams | None:
 
 
 def parse_size_arg(text: str | None) -> tuple[int, int] | None:
-    """``"HxW"`` -> ``(H, W)``; ``None`` stays ``None``."""
+    """``--size``: ``"HxW"`` (or ``H*W``) -> ``(H, W)`` via
+    :func:`rvsm.model.scene_io.parse_size`, the one size parser; ``None`` stays ``None``."""
     if text is None:
         return None
     from rvsm.model.scene_io import parse_size
@@ -72,18 +73,6 @@ def load_scene_from_args(
         steps_per_frame=args.steps_per_frame or DEFAULT_STEPS_PER_FRAME,
         hold=bool(args.hold),
     )
-
-
-def scene_meta(args: argparse.Namespace, scene: Scene) -> dict:
-    """What it takes to load ``scene`` again: goes into spike files' ``meta``."""
-    return {
-        "scene_arg": str(args.scene),
-        "height": scene.shape[0],
-        "width": scene.shape[1],
-        "num_frames": scene.num_frames,
-        "steps_per_frame": scene.steps_per_frame,
-        "hold": scene.hold,
-    }
 
 
 def scene_from_meta(meta: dict, override: str | None = None) -> Scene:

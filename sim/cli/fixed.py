@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from rvsm.model.errors import RvsmError
+from rvsm.model.reconstruction import MATCH_MODES, METHODS
 
 from .args import add_scene_arguments, load_scene_from_args, parse_size_arg
 
@@ -48,8 +49,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description="Run the float model and the fixed twin on the same scene, "
                        "seed and noise; report spike agreement and PSNR/SSIM of both.")
     _common(p)
-    p.add_argument("--method", default="auto", choices=("auto", "tfi", "tfp", "rvsm"))
-    p.add_argument("--match", default="gain", choices=("gain", "affine"))
+    p.add_argument("--method", default="auto", choices=METHODS)
+    p.add_argument("--match", default="gain", choices=MATCH_MODES)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run_cost)
 

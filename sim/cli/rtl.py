@@ -9,11 +9,7 @@ import sys
 from rvsm.model.errors import RvsmError
 from rvsm.sim.cosim import SIMULATORS
 
-
-def _size(text: str) -> tuple[int, int]:
-    from rvsm.model.scene_io import parse_size
-
-    return parse_size(text)
+from .args import parse_size_arg
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,7 +19,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "and a port map (JSON, Markdown) for a design point.")
     p.add_argument("point", help="design point TOML")
     p.add_argument("-o", "--out", default="build", help="output folder (default: build)")
-    p.add_argument("--size", type=_size, help="override the array size, HxW")
+    p.add_argument("--size", metavar="HxW", help="override the array size")
     p.add_argument("--top", default="rvsm_array", help="top module name")
     p.add_argument("--lint", action="store_true", help="run verilator --lint-only")
     p.add_argument("--stats", action="store_true",
@@ -42,7 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="replay this stimulus file (from `rvsm stimulus`) instead")
     p.add_argument("--sim", choices=SIMULATORS, default="icarus")
     p.add_argument("--steps", type=int, help="simulate only the first N steps")
-    p.add_argument("--size", type=_size, help="override the array size, HxW")
+    p.add_argument("--size", metavar="HxW", help="override the array size")
     p.add_argument("--waves", action="store_true", help="keep a waveform (FST/VCD)")
     p.add_argument("--work", default="build/verify", help="build/run folder")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -53,9 +49,10 @@ def _verilog(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.verilog import verilator_lint, write_outputs, yosys_stats
 
+    size = parse_size_arg(args.size)
     point = load_design_point(args.point)
-    if args.size:
-        point = point.with_size(*args.size)
+    if size is not None:
+        point = point.with_size(*size)
     contract = point.contract()
     if max(contract.height, contract.width) > 64:
         print(f"rvsm: note: a {contract.height}x{contract.width} fully parallel array "
@@ -92,7 +89,7 @@ def _verify(args: argparse.Namespace) -> int:
         if args.scene is None or args.fixed is None:
             raise RvsmError("rvsm verify needs SCENE --fixed POINT.toml, or --stimulus FILE")
         r = verify(args.scene, args.fixed, args.sim, steps=args.steps, waves=args.waves,
-                   size=args.size, work_dir=args.work)
+                   size=parse_size_arg(args.size), work_dir=args.work)
     if args.json:
         r = dict(r)
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]

@@ -8,6 +8,7 @@ import json
 import numpy as np
 
 from rvsm.model.errors import RvsmError
+from rvsm.model.reconstruction import MATCH_MODES, METHODS
 from rvsm.model.samplers import DEFAULT_PHI, RESET_MODES, SamplerConfig, sample
 from rvsm.model.spike_files import export_dat, import_dat, load_spikes, save_spikes
 
@@ -18,7 +19,6 @@ from .args import (
     noise_from_args,
     parse_size_arg,
     scene_from_meta,
-    scene_meta,
 )
 
 
@@ -48,8 +48,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("spikes", help=".npz spike file")
     p.add_argument("scene", nargs="?", default=None,
                    help="scene to score against (default: the one in the file's meta)")
-    p.add_argument("--method", default="auto", choices=("auto", "tfi", "tfp", "rvsm"))
-    p.add_argument("--match", default="gain", choices=("gain", "affine"),
+    p.add_argument("--method", default="auto", choices=METHODS)
+    p.add_argument("--match", default="gain", choices=MATCH_MODES,
                    help="brightness matching before scoring")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run_evaluate)
@@ -113,7 +113,6 @@ def run_simulate(args: argparse.Namespace) -> int:
         scene = load_scene_from_args(args)
         train = sample(scene, config, progress=True)
         spikes, meta = train.spikes, dict(train.meta)
-    meta.update(scene_meta(args, scene))
     if args.dat:
         export_dat(args.dat, spikes, flip=args.flip)
     save_spikes(args.output, spikes, meta)

@@ -8,7 +8,6 @@ import numpy as np
 
 from rvsm.model.atomic import atomic_path
 from rvsm.model.errors import RvsmError
-from rvsm.model.scene_io import parse_size
 from rvsm.model.scene_library import (
     DEFAULT_FRAMES,
     DEFAULT_SIZE,
@@ -16,6 +15,8 @@ from rvsm.model.scene_library import (
     render_frames,
     scene_descriptions,
 )
+
+from .args import parse_size_arg
 
 SHEET_FRAMES = 4
 
@@ -62,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if not args.output:
         raise RvsmError("--render needs -o FILE.png, the contact sheet to write")
-    size = DEFAULT_SIZE if args.size is None else parse_size(args.size)
+    size = parse_size_arg(args.size) or DEFAULT_SIZE
     frames = render_frames(args.render, size, args.frames)
     sheet = contact_sheet(frames)
     import imageio.v3 as iio

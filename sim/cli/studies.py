@@ -11,6 +11,8 @@ from rvsm.model.errors import RvsmError
 from rvsm.model.samplers import DEFAULT_PHI
 from rvsm.sim.studies import robustness, table
 
+from .args import parse_size_arg
+
 # Defaults of ``rvsm table``: the built-in scenes' full 250 x 400 canvas and 41 frames
 # (400 steps): 108 runs in ~6.5 min on a 2-core machine; see docs/reproduction.md.
 TABLE_SIZE = (250, 400)
@@ -18,12 +20,9 @@ TABLE_FRAMES = 41
 TABLE_STEPS_PER_FRAME = 10
 
 
-def parse_size(text: str) -> tuple[int, int]:
-    """``"HxW"`` -> ``(H, W)``, both >= 8."""
-    try:
-        h, w = (int(v) for v in str(text).lower().split("x"))
-    except ValueError:
-        raise RvsmError(f"size must look like HxW (e.g. 250x400), got {text!r}") from None
+def scored_size(text: str) -> tuple[int, int]:
+    """``"HxW"`` (:func:`parse_size_arg`) -> ``(H, W)``, both >= 8 (SSIM's window)."""
+    h, w = parse_size_arg(text)
     if h < 8 or w < 8:
         raise RvsmError(f"size must be at least 8x8 (SSIM needs 7x7), got {h}x{w}")
     return h, w
@@ -57,7 +56,7 @@ def cmd_table(args: argparse.Namespace) -> int:
     names = [n.strip() for item in (args.scenes or []) for n in item.split(",") if n.strip()]
     scenes = table.load_scenes(
         names or None,
-        parse_size(args.size),
+        scored_size(args.size),
         _positive("--frames", args.frames),
         _positive("--steps-per-frame", args.steps_per_frame),
     )
@@ -79,7 +78,7 @@ def cmd_table(args: argparse.Namespace) -> int:
 
 def cmd_robustness(args: argparse.Namespace) -> int:
     """Run the robustness sweep and write robustness.csv, robustness.json, fig8.png."""
-    size = parse_size(args.size)
+    size = scored_size(args.size)
     result = robustness.run_robustness(
         parse_floats(args.ks), size, _positive("--steps", args.steps), seed=args.seed,
         phi=args.phi, progress=not args.quiet,

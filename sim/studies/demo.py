@@ -58,8 +58,7 @@ def run_float_demo(
         start = time.perf_counter()
         train = sample(scene, config, progress=progress)
         seconds = time.perf_counter() - start
-        meta = {**train.meta, "scene_arg": scene.name, "num_frames": scene.num_frames}
-        save_spikes(out_dir / f"{model}.npz", train.spikes, meta)
+        save_spikes(out_dir / f"{model}.npz", train.spikes, train.meta)
         scores = evaluate_spikes(train.spikes, scene, model, config.phis)
         _save_figure(train.spikes, scene, model, config.phis, out_dir / f"{model}.png")
         rows.append(DemoRow(model, int(np.count_nonzero(train.spikes)),
@@ -71,15 +70,13 @@ def run_float_demo(
 
 
 def _save_figure(spikes, scene: Scene, model: str, phis, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     steps = scored_steps(scene, phis)
     picks = steps[np.linspace(0, steps.size - 1, min(3, steps.size)).astype(int)]
     truth, recon = reconstruct_for_display(spikes, scene, model, phis, picks)
-    fig, axes = plt.subplots(len(picks), 2, figsize=(8, 2.6 * len(picks)), squeeze=False)
+    fig = Figure(figsize=(8, 2.6 * len(picks)))
+    axes = fig.subplots(len(picks), 2, squeeze=False)
     for row, t in enumerate(picks):
         for col, (img, label) in enumerate(((truth[row], "ground truth"),
                                             (recon[row], f"{model} reconstruction"))):
@@ -90,7 +87,6 @@ def _save_figure(spikes, scene: Scene, model: str, phis, path: Path) -> None:
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=100, format="png")
-    plt.close(fig)
 
 
 def metrics_markdown(scene: Scene, rows: list[DemoRow]) -> str:

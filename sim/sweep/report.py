@@ -125,16 +125,14 @@ def width_cost_figure(designs: list[DesignSummary], tolerance: float = 0.1):
     """PSNR cost against each swept numeric field: every design (grey dots, worst cost
     over scenes and noise) and, per model (scale ladder), the best worst-case cost
     reachable at each width (line). Returns a matplotlib Figure."""
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     paths = [p for p in (designs[0].values if designs else {})
              if all(isinstance(d.values.get(p), (int, float)) and
                     not isinstance(d.values.get(p), bool) for d in designs)]
     n = max(1, len(paths))
-    fig, axs = plt.subplots(1, n, figsize=(4.2 * n, 3.6), squeeze=False)
+    fig = Figure(figsize=(4.2 * n, 3.6))
+    axs = fig.subplots(1, n, squeeze=False)
     for ax, path in zip(axs[0], paths, strict=False):
         xs = [d.values[path] for d in designs]
         ax.scatter(xs, [d.worst_cost for d in designs], s=12, color="0.75", zorder=1,
@@ -164,12 +162,10 @@ def width_cost_figure(designs: list[DesignSummary], tolerance: float = 0.1):
 def pareto_figure(designs: list[DesignSummary], tolerance: float = 0.1):
     """Worst PSNR cost against hardware cost; the Pareto front in colour, dominated points
     grey. Returns a matplotlib Figure."""
-    import matplotlib
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig = Figure(figsize=(6.4, 4.4))
+    ax = fig.subplots()
     hw = np.array([d.hw for d in designs], dtype=float)
     cost = np.array([d.worst_cost for d in designs], dtype=float)
     mask = pareto_mask(hw, cost) if designs else np.zeros(0, bool)
@@ -287,8 +283,6 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
     Returns the files written and the recommended design (``label``, ``toml``,
     ``worst_cost``, ``cells_per_pixel``) or None.
     """
-    import matplotlib.pyplot as plt
-
     with open_existing(db) as store:
         rows = store.results()
         sweeps = list(store.db.execute("SELECT sweep_hash, path FROM sweeps"))
@@ -304,7 +298,6 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
         fig = make(designs, tolerance)
         with atomic_path(out / name) as tmp:
             fig.savefig(tmp, dpi=130)
-        plt.close(fig)
         files.append(out / name)
     text = report_markdown(
         Path(db).name, designs, [r for r in rows if r["status"] == "invalid"],

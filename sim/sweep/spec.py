@@ -44,6 +44,7 @@ from rvsm.model.fixed.point_toml import (
     load_design_point,
     to_toml_dict,
 )
+from rvsm.model.reconstruction import MATCH_MODES, METHODS
 from rvsm.model.scene_io import parse_size
 
 #: ``section.key`` -> design point field name of every field a sweep may vary.
@@ -331,13 +332,20 @@ def _parse_run(raw: Any, source: str) -> RunSettings:
     if not noise or not all(isinstance(n, bool) for n in noise):
         raise RvsmError(f"{source}: run.noise must be true, false or a list of them")
     method = raw.get("method", "auto")
-    if method not in ("auto", "tfi", "tfp", "rvsm"):
-        raise RvsmError(f"{source}: run.method must be auto, tfi, tfp or rvsm, got {method!r}")
+    if method not in METHODS:
+        raise RvsmError(f"{source}: run.method must be {_alternatives(METHODS)}, "
+                        f"got {method!r}")
     match = raw.get("match", "gain")
-    if match not in ("gain", "affine"):
-        raise RvsmError(f"{source}: run.match must be gain or affine, got {match!r}")
+    if match not in MATCH_MODES:
+        raise RvsmError(f"{source}: run.match must be {_alternatives(MATCH_MODES)}, "
+                        f"got {match!r}")
     return RunSettings(tuple(dict.fromkeys(scenes)), size, frames, spf,
                        tuple(dict.fromkeys(seeds)), tuple(dict.fromkeys(noise)), method, match)
+
+
+def _alternatives(words: tuple[str, ...]) -> str:
+    """``("a", "b", "c")`` -> ``"a, b or c"``."""
+    return f"{', '.join(words[:-1])} or {words[-1]}"
 
 
 def _parse_hardware(raw: Any, source: str) -> HardwareSettings:

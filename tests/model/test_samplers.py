@@ -122,3 +122,17 @@ def test_per_scale_thresholds():
 def test_invalid_configs_are_refused(kwargs, match):
     with pytest.raises(RvsmError, match=match):
         SamplerConfig(**kwargs)
+
+
+def test_meta_says_how_to_reload_the_scene():
+    from rvsm.model.scene_io import load_scene
+
+    scene = load_scene("coin", size=(12, 16), num_frames=3, steps_per_frame=4)
+    meta = sample(scene, SamplerConfig(model="fsm")).meta
+    assert {k: meta[k] for k in ("scene_arg", "height", "width", "num_frames",
+                                 "steps_per_frame", "hold")} == {
+        "scene_arg": "coin", "height": 12, "width": 16, "num_frames": 3,
+        "steps_per_frame": 4, "hold": False}
+    again = load_scene(meta["scene_arg"], size=(meta["height"], meta["width"]),
+                       num_frames=meta["num_frames"], steps_per_frame=meta["steps_per_frame"])
+    assert np.array_equal(again.frames, scene.frames)

@@ -52,3 +52,14 @@ def test_bad_arguments_are_user_errors(capsys):
     assert main(["table", "--scenes", "nope", "--size", "24x32", "-q"]) == 2
     assert main(["robustness", "--ks", "a,b", "-q"]) == 2
     assert "rvsm: error:" in capsys.readouterr().err
+
+
+def test_one_size_syntax_for_every_command(tmp_path, capsys):
+    """``H*W`` works for ``rvsm table`` as for ``rvsm simulate`` (one size parser)."""
+    assert main(["table", "--scenes", "character", "--size", "24*32", "--frames", "3",
+                 "--steps-per-frame", "2", "-q", "-o", str(tmp_path / "t")]) == 0
+    assert main(["table", "--size", "6x6", "-q"]) == 2
+    assert main(["verilog", str(tmp_path / "p.toml"), "--size", "big"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[0].startswith("rvsm: error: size must be at least 8x8")
+    assert err[1].startswith("rvsm: error: bad size 'big'") and len(err) == 2
