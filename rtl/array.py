@@ -5,14 +5,16 @@ Architecture (one clock domain ``sync``, synchronous reset ``rst``)::
     codes[H*W*N] --> per (scale, pixel): receptive weighted sum (constant shift-and-add,
                      :mod:`rvsm.rtl.receptive_sum`) --> PixelCell (shift, saturate,
                      compare, fire, reset; threshold register) --> spike_pos / spike_neg
-    cfg_we/cfg_addr/cfg_data --> address decode --> one cell's threshold register
+    cfg (we/addr/data) --> address decode --> one cell's threshold register
 
 Bit ordering of the flat ports (all little-endian, index 0 = LSB):
 
 * ``codes``: pixel ``(y, x)`` at bits ``[(y*W + x)*N +: N]`` (unsigned ADC code);
 * ``spike_pos`` / ``spike_neg``: accumulator ``a = (s*H + y)*W + x`` at bit ``a``;
-* ``cfg_addr``: the same accumulator index ``a``; ``cfg_data`` the threshold
-  (``1 .. 2**(W-1)-1``), written when ``cfg_we`` is high at a clock edge.
+* ``cfg.addr``: the same accumulator index ``a``; ``cfg.data`` the threshold
+  (``1 .. 2**(W-1)-1``), written when ``cfg.we`` is high at a clock edge. ``cfg`` is the
+  threshold-write bus (:class:`~rvsm.rtl.interfaces.ThresholdWriteSignature`); in the
+  Verilog its ports are ``cfg_we``, ``cfg_addr``, ``cfg_data`` (:mod:`rvsm.rtl.ports`).
 
 Timing: ``codes`` are sampled at a rising edge where ``strobe`` is high (one contract
 step per strobe; strobes may be back to back); the spikes of that step are on
@@ -33,8 +35,9 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.fixed.widths import index_bits
+from rvsm.model.fixed.widths import index_bits, unsigned_max
 
+from .interfaces import ThresholdWriteSignature
 from .pixel_cell import PixelCell
 from .receptive_sum import sum_width, weighted_sum
 
@@ -49,9 +52,10 @@ def accumulator_index(contract: ArrayContract, scale: int, row: int, col: int) -
 class RvsmArray(wiring.Component):
     """``S x H x W`` accumulators over an ``H x W`` ADC-code input, from a contract.
 
-    Ports: ``codes`` In(H*W*N), ``strobe`` In(1), ``clear`` In(1), ``cfg_we`` In(1),
-    ``cfg_addr`` In(addr_bits), ``cfg_data`` In(W-1), ``spike_pos`` Out(S*H*W),
-    ``spike_neg`` Out(S*H*W), ``valid`` Out(1). See the module docstring for ordering.
+    Ports: ``codes`` In(H*W*N), ``strobe`` In(1), ``clear`` In(1), ``cfg``
+    In(ThresholdWriteSignature(W-1, addr_bits)), ``spike_pos`` Out(S*H*W), ``spike_neg``
+    Out(S*H*W), ``valid`` Out(1). See the module docstring for ordering;
+    :meth:`port_docs` describes each Verilog port.
     """
 
     #: Clock cycles from the strobe edge sampling ``codes`` to valid spike outputs.
@@ -66,9 +70,7 @@ class RvsmArray(wiring.Component):
             "codes": In(unsigned(c.height * c.width * c.adc_bits)),
             "strobe": In(1),
             "clear": In(1),
-            "cfg_we": In(1),
-            "cfg_addr": In(unsigned(self.addr_bits)),
-            "cfg_data": In(unsigned(c.threshold_bits)),
+            "cfg": In(ThresholdWriteSignature(c.threshold_bits, self.addr_bits)),
             "spike_pos": Out(unsigned(self.num_accumulators)),
             "spike_neg": Out(unsigned(self.num_accumulators)),
             "valid": Out(1),
@@ -79,9 +81,27 @@ class RvsmArray(wiring.Component):
         """Clock cycles from the strobe edge sampling ``codes`` to valid spike outputs."""
         return self.LATENCY
 
-    def sum_bits(self, scale: int) -> int:
-        """Signed width of scale ``scale``'s exact weighted sum."""
-        return sum_width(*self.contract.sum_range(scale))
+    def port_docs(self) -> dict[str, str]:
+        """Meaning of every Verilog port (names as :func:`rvsm.rtl.ports.port_map`)."""
+        c = self.contract
+        n_acc = self.num_accumulators
+        top = unsigned_max(c.threshold_bits)
+        return {
+            "clk": "clock (rising edge)",
+            "rst": "synchronous reset: accumulators and spikes to 0, thresholds to "
+                   f"{top}",
+            "codes": f"ADC codes, pixel (y, x) at bits [(y*{c.width}+x)*{c.adc_bits} +: "
+                     f"{c.adc_bits}]",
+            "strobe": "sample strobe: one contract step per rising edge with strobe=1",
+            "clear": "synchronous clear of accumulators and spikes (thresholds kept); "
+                     "priority over strobe",
+            "cfg_we": "threshold write enable",
+            "cfg_addr": f"accumulator index (s*{c.height}+y)*{c.width}+x, 0..{n_acc - 1}",
+            "cfg_data": f"threshold, 1..{top}",
+            "spike_pos": "+1 spikes, accumulator (s*H+y)*W+x at that bit",
+            "spike_neg": "-1 spikes, same ordering (always 0 for unsigned models)",
+            "valid": f"spikes of a strobed step are valid (latency {self.LATENCY} cycle(s))",
+        }
 
     def elaborate(self, platform: object) -> Module:
         """Weighted sums, cells, threshold address decode, valid pipeline."""
@@ -117,8 +137,8 @@ class RvsmArray(wiring.Component):
                         cell.sum_in.eq(weighted_sum(taps, wts, lo, hi)),
                         cell.strobe.eq(self.strobe),
                         cell.clear.eq(self.clear),
-                        cell.thr_we.eq(self.cfg_we & (self.cfg_addr == a)),
-                        cell.thr_data.eq(self.cfg_data),
+                        cell.thr.we.eq(self.cfg.we & (self.cfg.addr == a)),
+                        cell.thr.data.eq(self.cfg.data),
                         self.spike_pos[a].eq(cell.spike_pos),
                         self.spike_neg[a].eq(cell.spike_neg),
                     ]
@@ -153,11 +173,11 @@ def simulate(
 
     async def bench(ctx) -> None:  # noqa: ANN001 - amaranth's SimulatorContext
         for a, value in enumerate(thr.ravel()):
-            ctx.set(dut.cfg_we, 1)
-            ctx.set(dut.cfg_addr, a)
-            ctx.set(dut.cfg_data, int(value))
+            ctx.set(dut.cfg.we, 1)
+            ctx.set(dut.cfg.addr, a)
+            ctx.set(dut.cfg.data, int(value))
             await ctx.tick()
-        ctx.set(dut.cfg_we, 0)
+        ctx.set(dut.cfg.we, 0)
         for t in range(steps):
             if t in clears:
                 ctx.set(dut.clear, 1)

@@ -11,9 +11,10 @@ Per strobe it implements steps 2..5 of the contract (:mod:`rvsm.model.fixed.core
     spike_pos, spike_neg <= pos, neg                    (registered; LATENCY = 1)
 
 Control, all synchronous: ``clear`` (priority) zeroes the accumulator and the spike
-outputs and keeps the threshold; ``thr_we`` loads ``thr_data`` into the threshold
-register (any time; it takes effect from the next strobe). The domain reset returns the
-threshold to its ``init`` value ``2**(W-1) - 1``.
+outputs and keeps the threshold; ``thr.we`` loads ``thr.data`` into the threshold
+register (any time; it takes effect from the next strobe). ``thr`` is the threshold-write
+bus (:class:`~rvsm.rtl.interfaces.ThresholdWriteSignature`, without address). The domain
+reset returns the threshold to its ``init`` value ``2**(W-1) - 1``.
 """
 
 from __future__ import annotations
@@ -24,6 +25,8 @@ from amaranth.lib.wiring import In, Out
 
 from rvsm.model.fixed.widths import signed_range
 
+from .interfaces import ThresholdWriteSignature
+
 __all__ = ["PixelCell"]
 
 
@@ -33,9 +36,10 @@ class PixelCell(wiring.Component):
     Parameters: ``sum_bits`` (signed width of ``sum_in``), ``shift``, ``accumulator_bits``
     (W), ``signed_model`` (fire -1 spikes), ``reset`` (``"zero"`` or ``"subtract"``).
 
-    Ports: ``sum_in`` In(signed(sum_bits)); ``strobe``, ``clear``, ``thr_we`` In(1);
-    ``thr_data`` In(W-1); ``spike_pos``, ``spike_neg`` Out(1), registered, valid
-    :attr:`LATENCY` cycles after the strobe; ``acc`` Out(signed(W)) for observation.
+    Ports: ``sum_in`` In(signed(sum_bits)); ``strobe``, ``clear`` In(1); ``thr``
+    In(ThresholdWriteSignature(W-1)): ``thr.we``, ``thr.data``; ``spike_pos``,
+    ``spike_neg`` Out(1), registered, valid :attr:`LATENCY` cycles after the strobe;
+    ``acc`` Out(signed(W)) for observation.
     """
 
     #: Clock cycles from the strobe edge that samples ``sum_in`` to valid spike outputs.
@@ -60,8 +64,7 @@ class PixelCell(wiring.Component):
             "sum_in": In(signed(sum_bits)),
             "strobe": In(1),
             "clear": In(1),
-            "thr_we": In(1),
-            "thr_data": In(unsigned(accumulator_bits - 1)),
+            "thr": In(ThresholdWriteSignature(accumulator_bits - 1)),
             "spike_pos": Out(1),
             "spike_neg": Out(1),
             "acc": Out(signed(accumulator_bits)),
@@ -98,8 +101,8 @@ class PixelCell(wiring.Component):
         else:
             after = Mux(pos, sat - thr, Mux(neg, sat + thr, sat))
 
-        with m.If(self.thr_we):
-            m.d.sync += thr.eq(self.thr_data)
+        with m.If(self.thr.we):
+            m.d.sync += thr.eq(self.thr.data)
         with m.If(self.clear):
             m.d.sync += [acc.eq(0), self.spike_pos.eq(0), self.spike_neg.eq(0)]
         with m.Elif(self.strobe):

@@ -26,9 +26,10 @@ from amaranth.back import verilog as amaranth_verilog
 from rvsm.model.atomic import write_text_atomic
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.fixed.widths import index_bits, unsigned_max
 
 from .array import RvsmArray
+from .ports import port_map as signature_port_map
+from .ports import verilog_ports
 
 __all__ = [
     "LINT_WAIVERS",
@@ -75,40 +76,18 @@ def generate_verilog(contract: ArrayContract, top: str = DEFAULT_TOP) -> Generat
     """Convert the array built from ``contract`` to Verilog (no ``src`` attributes)."""
     t0 = time.perf_counter()
     dut = RvsmArray(contract)
-    text = amaranth_verilog.convert(dut, name=top, emit_src=False)
+    text = amaranth_verilog.convert(dut, name=top, emit_src=False, ports=verilog_ports(dut))
     return GeneratedVerilog(text, top, dut.latency, time.perf_counter() - t0)
 
 
 def port_map(contract: ArrayContract) -> list[dict]:
-    """Top-level ports: name, direction, width and meaning (with bit ordering)."""
-    c = contract
-    n_acc = c.num_scales * c.height * c.width
-    addr_bits = index_bits(n_acc)
-    return [
-        {"name": "clk", "dir": "in", "width": 1, "desc": "clock (rising edge)"},
-        {"name": "rst", "dir": "in", "width": 1,
-         "desc": "synchronous reset: accumulators and spikes to 0, thresholds to "
-                 f"{unsigned_max(c.threshold_bits)}"},
-        {"name": "codes", "dir": "in", "width": c.height * c.width * c.adc_bits,
-         "desc": f"ADC codes, pixel (y, x) at bits [(y*{c.width}+x)*{c.adc_bits} +: "
-                 f"{c.adc_bits}]"},
-        {"name": "strobe", "dir": "in", "width": 1,
-         "desc": "sample strobe: one contract step per rising edge with strobe=1"},
-        {"name": "clear", "dir": "in", "width": 1,
-         "desc": "synchronous clear of accumulators and spikes (thresholds kept); "
-                 "priority over strobe"},
-        {"name": "cfg_we", "dir": "in", "width": 1, "desc": "threshold write enable"},
-        {"name": "cfg_addr", "dir": "in", "width": addr_bits,
-         "desc": f"accumulator index (s*{c.height}+y)*{c.width}+x, 0..{n_acc - 1}"},
-        {"name": "cfg_data", "dir": "in", "width": c.threshold_bits,
-         "desc": f"threshold, 1..{unsigned_max(c.threshold_bits)}"},
-        {"name": "spike_pos", "dir": "out", "width": n_acc,
-         "desc": "+1 spikes, accumulator (s*H+y)*W+x at that bit"},
-        {"name": "spike_neg", "dir": "out", "width": n_acc,
-         "desc": "-1 spikes, same ordering (always 0 for unsigned models)"},
-        {"name": "valid", "dir": "out", "width": 1,
-         "desc": f"spikes of a strobed step are valid (latency {RvsmArray.LATENCY} cycle(s))"},
-    ]
+    """Top-level ports: name, direction, width and meaning (with bit ordering).
+
+    Names, directions and widths come from :class:`RvsmArray`'s signature
+    (:func:`rvsm.rtl.ports.port_map`), meanings from :meth:`RvsmArray.port_docs`.
+    """
+    dut = RvsmArray(contract)
+    return signature_port_map(dut, dut.port_docs())
 
 
 def port_map_markdown(contract: ArrayContract, top: str = DEFAULT_TOP) -> str:

@@ -19,10 +19,10 @@ def run_cell(
     out: list[int] = []
 
     async def bench(ctx) -> None:  # noqa: ANN001
-        ctx.set(cell.thr_we, 1)
-        ctx.set(cell.thr_data, thr)
+        ctx.set(cell.thr.we, 1)
+        ctx.set(cell.thr.data, thr)
         await ctx.tick()
-        ctx.set(cell.thr_we, 0)
+        ctx.set(cell.thr.we, 0)
         for t, s in enumerate(sums):
             if t in clear_at:
                 ctx.set(cell.clear, 1)

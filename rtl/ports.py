@@ -1,0 +1,61 @@
+"""Top-level ports of any ``wiring.Component``, derived from its signature.
+
+:func:`verilog_ports` names every flattened signature member by its path joined with
+``_`` (``cfg.we`` -> ``cfg_we``) for Verilog generation; :func:`port_map` lists the same
+ports with direction and width, plus the clock and reset of the ``sync`` domain, and
+attaches a description to each from the component's own table, refusing ports without
+one (and descriptions without a port), so the documentation cannot drift from the RTL.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from amaranth.hdl import Value, ValueCastable
+from amaranth.hdl._ir import PortDirection
+from amaranth.lib import wiring
+
+__all__ = ["port_map", "verilog_ports"]
+
+#: Implicit ports of the ``sync`` domain in Amaranth's generated Verilog.
+SYNC_PORTS = ("clk", "rst")
+
+
+def _flat(component: wiring.Component, sep: str) -> list[tuple[str, str, Value]]:
+    out = []
+    for path, member, value in component.signature.flatten(component):
+        if isinstance(value, ValueCastable):
+            value = value.as_value()
+        direction = "in" if member.flow == wiring.In else "out"
+        out.append((sep.join(map(str, path)), direction, value))
+    return out
+
+
+def verilog_ports(
+    component: wiring.Component, sep: str = "_"
+) -> dict[str, tuple[Value, PortDirection]]:
+    """``{name: (value, direction)}`` for ``amaranth.back.verilog.convert(ports=...)``."""
+    return {
+        name: (value, PortDirection.Input if d == "in" else PortDirection.Output)
+        for name, d, value in _flat(component, sep)
+    }
+
+
+def port_map(
+    component: wiring.Component, docs: Mapping[str, str], sep: str = "_"
+) -> list[dict]:
+    """Ports in Verilog order: ``name``, ``dir`` (in/out), ``width``, ``desc``.
+
+    ``docs`` maps every port name (``clk`` and ``rst`` of the ``sync`` domain included) to
+    its meaning; a port without a description, or a description without a port, raises
+    :class:`ValueError`.
+    """
+    rows = [{"name": n, "dir": "in", "width": 1} for n in SYNC_PORTS]
+    rows += [{"name": n, "dir": d, "width": len(v)} for n, d, v in _flat(component, sep)]
+    names = [r["name"] for r in rows]
+    missing = [n for n in names if n not in docs]
+    extra = [n for n in docs if n not in names]
+    if missing or extra:
+        raise ValueError(f"port descriptions out of step with the signature: missing "
+                         f"{missing}, unknown {extra}")
+    return [{**r, "desc": docs[r["name"]]} for r in rows]
