@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import re
@@ -38,6 +39,7 @@ __all__ = [
     "generate_verilog",
     "port_map",
     "port_map_markdown",
+    "rtl_digest",
     "verilator_env",
     "verilator_lint",
     "write_outputs",
@@ -70,6 +72,16 @@ class GeneratedVerilog:
     top: str
     latency: int
     seconds: float
+
+
+def rtl_digest(contract: ArrayContract) -> str:
+    """Short digest (16 hex digits) of ``contract`` and the RTL sources that build it:
+    equal digests give the same Verilog, so it keys caches of generated or synthesised
+    RTL."""
+    h = hashlib.sha256(repr(contract).encode())
+    for src in sorted(Path(__file__).parent.glob("*.py")):
+        h.update(src.read_bytes())
+    return h.hexdigest()[:16]
 
 
 def generate_verilog(contract: ArrayContract, top: str = DEFAULT_TOP) -> GeneratedVerilog:

@@ -19,10 +19,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from rvsm import rtl as rtl_pkg
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.rtl.verilog import DEFAULT_TOP, GeneratedVerilog, verilator_env, write_outputs
+from rvsm.rtl.verilog import (
+    DEFAULT_TOP,
+    GeneratedVerilog,
+    rtl_digest,
+    verilator_env,
+    write_outputs,
+)
 
 from . import SIMULATORS
 
@@ -34,8 +39,6 @@ __all__ = ["SIMULATORS", "SimBuild", "build", "check_simulator", "run_testbench"
 TB_MODULE = "rvsm.sim.cosim.tb_array"
 #: Verilator flags for Amaranth's netlist (warnings are the lint's job, not the build's).
 VERILATOR_BUILD_ARGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style", "-O2")
-#: Expose only the top-level ports to VPI in Verilator builds (see :func:`_runner`).
-VERILATOR_PUBLIC_TOP_ONLY = True
 _BUILD_VERSION = "4"  # bump when the RTL or the build flags change
 #: gcc optimisation of Verilator's generated C++ (its Makefile's OPT_FAST/OPT_SLOW/OPT_GLOBAL).
 #: -O0 builds an 8x8 dog4 array 6x faster than Verilator's default -Os (47 s vs 297 s) and
@@ -77,11 +80,9 @@ def check_simulator(sim: str) -> None:
 
 
 def contract_digest(contract: ArrayContract) -> str:
-    """Short digest of the contract and the RTL sources (keys the build cache)."""
-    h = hashlib.sha256(f"{_BUILD_VERSION}:{contract!r}".encode())
-    for src in sorted(Path(rtl_pkg.__file__).parent.glob("*.py")):
-        h.update(src.read_bytes())
-    return h.hexdigest()[:16]
+    """Short digest of the RTL (:func:`rvsm.rtl.verilog.rtl_digest`) and the build
+    flags (``_BUILD_VERSION``): keys the simulator build cache."""
+    return hashlib.sha256(f"{_BUILD_VERSION}:{rtl_digest(contract)}".encode()).hexdigest()[:16]
 
 
 @contextlib.contextmanager
@@ -124,7 +125,7 @@ def _runner(sim: str) -> Runner:
         def _build_command(self) -> list:
             cmds = super()._build_command()
             first = list(cmds[0])
-            if VERILATOR_PUBLIC_TOP_ONLY and "--public-flat-rw" in first:
+            if "--public-flat-rw" in first:
                 i = first.index("--public-flat-rw")
                 first[i:i + 1] = ["--public-depth", "1"]
             return [first, *cmds[1:]]

@@ -78,10 +78,10 @@ def hw_point(point: DesignPoint, size: tuple[int, int]) -> DesignPoint:
 
 
 def hw_digest(point: DesignPoint, size: tuple[int, int]) -> str:
-    """Cache key of a design's RTL at ``size``: the build digest of its contract."""
-    from rvsm.sim.cosim.runner import contract_digest
+    """Cache key of a design's synthesis at ``size``: the digest of its RTL contract."""
+    from rvsm.rtl.verilog import rtl_digest
 
-    return contract_digest(hw_point(point, size).contract())
+    return rtl_digest(hw_point(point, size).contract())
 
 
 def synthesise_task(point: DesignPoint, size: tuple[int, int]) -> dict[str, Any]:

@@ -183,12 +183,6 @@ class SweepStore:
             rows.append(d)
         return rows
 
-    def count(self, table: str = "results") -> int:
-        """Rows in ``table``."""
-        if table not in ("results", "points", "hw_cost", "sweeps"):
-            raise ValueError(table)
-        return int(self.db.execute(f"SELECT COUNT(*) FROM {table}").fetchone()[0])
-
 
 def open_existing(path: str | os.PathLike) -> SweepStore:
     """Open a results database that must already exist (for reports)."""

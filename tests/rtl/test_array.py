@@ -10,8 +10,22 @@ from rvsm.rtl.array import RvsmArray, simulate
 from rvsm.rtl.pixel_cell import PixelCell
 
 
-def test_latency_is_named() -> None:
-    assert RvsmArray.LATENCY == PixelCell.LATENCY == 1
+def test_valid_rises_latency_cycles_after_the_strobe(small_contract, amaranth_sim) -> None:
+    """Measured, not read off the constant: cycles from a strobe edge to ``valid``."""
+    dut = RvsmArray(small_contract("dog1", 2, 3))
+    seen: list[int] = []
+
+    async def bench(ctx) -> None:  # noqa: ANN001
+        ctx.set(dut.strobe, 1)
+        await ctx.tick()
+        ctx.set(dut.strobe, 0)
+        for cycle in range(1, 6):
+            if ctx.get(dut.valid):
+                seen.append(cycle)
+            await ctx.tick()
+
+    amaranth_sim.run(dut, bench)
+    assert seen == [RvsmArray.LATENCY] == [PixelCell.LATENCY]
 
 
 @pytest.mark.parametrize("model", MODEL_NAMES)

@@ -8,7 +8,6 @@ both simulators, every model on Icarus, the checker-can-fail proof and tool erro
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -168,5 +167,17 @@ def test_long_stream_8x12(small_contract, sim: str, cosim_work: Path, rtl_builds
     check_all(c, sim, cosim_work, rtl_builds, seed=22, steps=2000)
 
 
-def test_tools_present() -> None:
-    assert shutil.which("iverilog"), "apt-get install iverilog"
+def test_simulator_check_finds_tools_on_path(tmp_path: Path,
+                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    """``check_simulator`` accepts Icarus when both of its tools are on PATH."""
+    for tool in ("iverilog", "vvp"):
+        exe = tmp_path / tool
+        exe.write_text("#!/bin/sh\n")
+        exe.chmod(0o755)
+    monkeypatch.setenv("PATH", str(tmp_path))
+    check_simulator("icarus")
+    (tmp_path / "vvp").unlink()
+    with pytest.raises(RvsmError, match="apt-get install iverilog"):
+        check_simulator("icarus")
+    with pytest.raises(RvsmError, match="unknown simulator 'xcelium'"):
+        check_simulator("xcelium")
