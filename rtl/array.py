@@ -63,16 +63,22 @@ class RvsmArray(wiring.Component):
 
     def __init__(self, contract: ArrayContract):
         self.contract = contract
-        c = contract
-        self.num_accumulators = c.num_scales * c.height * c.width
+        self.num_accumulators = contract.num_scales * contract.height * contract.width
         self.addr_bits = index_bits(self.num_accumulators)
-        super().__init__({
+        super().__init__(self.interface(contract))
+
+    @staticmethod
+    def interface(contract: ArrayContract) -> wiring.Signature:
+        """The array's signature for ``contract`` (no component needed)."""
+        c = contract
+        n_acc = c.num_scales * c.height * c.width
+        return wiring.Signature({
             "codes": In(unsigned(c.height * c.width * c.adc_bits)),
             "strobe": In(1),
             "clear": In(1),
-            "cfg": In(ThresholdWriteSignature(c.threshold_bits, self.addr_bits)),
-            "spike_pos": Out(unsigned(self.num_accumulators)),
-            "spike_neg": Out(unsigned(self.num_accumulators)),
+            "cfg": In(ThresholdWriteSignature(c.threshold_bits, index_bits(n_acc))),
+            "spike_pos": Out(unsigned(n_acc)),
+            "spike_neg": Out(unsigned(n_acc)),
             "valid": Out(1),
         })
 
@@ -81,10 +87,11 @@ class RvsmArray(wiring.Component):
         """Clock cycles from the strobe edge sampling ``codes`` to valid spike outputs."""
         return self.LATENCY
 
-    def port_docs(self) -> dict[str, str]:
+    @classmethod
+    def port_docs(cls, contract: ArrayContract) -> dict[str, str]:
         """Meaning of every Verilog port (names as :func:`rvsm.rtl.ports.port_map`)."""
-        c = self.contract
-        n_acc = self.num_accumulators
+        c = contract
+        n_acc = c.num_scales * c.height * c.width
         top = unsigned_max(c.threshold_bits)
         return {
             "clk": "clock (rising edge)",
@@ -100,7 +107,7 @@ class RvsmArray(wiring.Component):
             "cfg_data": f"threshold, 1..{top}",
             "spike_pos": "+1 spikes, accumulator (s*H+y)*W+x at that bit",
             "spike_neg": "-1 spikes, same ordering (always 0 for unsigned models)",
-            "valid": f"spikes of a strobed step are valid (latency {self.LATENCY} cycle(s))",
+            "valid": f"spikes of a strobed step are valid (latency {cls.LATENCY} cycle(s))",
         }
 
     def elaborate(self, platform: object) -> Module:

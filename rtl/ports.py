@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from amaranth.hdl import Value, ValueCastable
+from amaranth.hdl import Shape, Value, ValueCastable
 from amaranth.hdl._ir import PortDirection
 from amaranth.lib import wiring
 
@@ -42,16 +42,22 @@ def verilog_ports(
 
 
 def port_map(
-    component: wiring.Component, docs: Mapping[str, str], sep: str = "_"
+    interface: wiring.Signature | wiring.Component, docs: Mapping[str, str], sep: str = "_"
 ) -> list[dict]:
     """Ports in Verilog order: ``name``, ``dir`` (in/out), ``width``, ``desc``.
 
-    ``docs`` maps every port name (``clk`` and ``rst`` of the ``sync`` domain included) to
-    its meaning; a port without a description, or a description without a port, raises
+    ``interface`` is a component's signature (or the component). ``docs`` maps every
+    port name (``clk`` and ``rst`` of the ``sync`` domain included) to its meaning; a
+    port without a description, or a description without a port, raises
     :class:`ValueError`.
     """
+    signature = interface if isinstance(interface, wiring.Signature) else interface.signature
     rows = [{"name": n, "dir": "in", "width": 1} for n in SYNC_PORTS]
-    rows += [{"name": n, "dir": d, "width": len(v)} for n, d, v in _flat(component, sep)]
+    rows += [
+        {"name": sep.join(map(str, path)), "dir": "in" if member.flow == wiring.In else "out",
+         "width": Shape.cast(member.shape).width}
+        for path, member in signature.members.flatten() if member.is_port
+    ]
     names = [r["name"] for r in rows]
     missing = [n for n in names if n not in docs]
     extra = [n for n in docs if n not in names]

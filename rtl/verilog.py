@@ -98,8 +98,7 @@ def port_map(contract: ArrayContract) -> list[dict]:
     Names, directions and widths come from :class:`RvsmArray`'s signature
     (:func:`rvsm.rtl.ports.port_map`), meanings from :meth:`RvsmArray.port_docs`.
     """
-    dut = RvsmArray(contract)
-    return signature_port_map(dut, dut.port_docs())
+    return signature_port_map(RvsmArray.interface(contract), RvsmArray.port_docs(contract))
 
 
 def port_map_markdown(contract: ArrayContract, top: str = DEFAULT_TOP) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from amaranth.hdl import Fragment
 from amaranth.lib import wiring
 
 from rvsm.rtl.array import RvsmArray
@@ -23,12 +24,15 @@ def test_cell_and_array_share_the_threshold_bus(small_contract) -> None:
     assert thr.signature == ThresholdWriteSignature(11)
     assert list(cfg.signature.members) == ["we", "addr", "data"]
     assert list(thr.signature.members) == ["we", "data"]
+    assert array.signature == RvsmArray.interface(c)
+    Fragment.get(array, None), Fragment.get(cell, None)  # both elaborate with it
 
 
 def test_verilog_ports_follow_the_signature(small_contract) -> None:
     c = small_contract("dog2", 3, 4, acc_bits=12)
     dut = RvsmArray(c)
     ports = verilog_ports(dut)
+    Fragment.get(dut, None)
     assert list(ports) == ["codes", "strobe", "clear", "cfg_we", "cfg_addr", "cfg_data",
                            "spike_pos", "spike_neg", "valid"]
     rows = array_port_map(c)
@@ -45,6 +49,8 @@ def test_port_map_of_any_component_refuses_missing_or_stale_docs() -> None:
              "spike_neg", "acc"]
     docs = {n: n.upper() for n in names}
     rows = port_map(cell, docs)
+    assert port_map(cell.signature, docs) == rows
+    Fragment.get(cell, None)
     assert [r["name"] for r in rows] == names and rows[2]["width"] == 10
     with pytest.raises(ValueError, match="missing"):
         port_map(cell, {k: v for k, v in docs.items() if k != "acc"})
