@@ -7,3 +7,11 @@ class RvsmError(Exception):
     The CLI prints ``rvsm: error: <message>`` on one line and exits non-zero; the message
     must name what is wrong and, where possible, how to fix it.
     """
+
+
+class ToolError(RvsmError):
+    """An external tool (synthesis, place-and-route, simulator) failed or is missing.
+
+    The CLI prints it like :class:`RvsmError` but exits with status 3 (tool/environment
+    failure) instead of 2 (bad input).
+    """

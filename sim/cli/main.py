@@ -12,7 +12,7 @@ import argparse
 import sys
 from types import ModuleType
 
-from rvsm.model.errors import RvsmError
+from rvsm.model.errors import RvsmError, ToolError
 
 from . import demo, fixed, rtl, sampling, scenes, studies, sweep
 
@@ -43,6 +43,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return int(args.func(args) or 0)
+    except ToolError as exc:
+        print(f"rvsm: error: {exc}", file=sys.stderr)
+        return 3
     except RvsmError as exc:
         print(f"rvsm: error: {exc}", file=sys.stderr)
         return 2
