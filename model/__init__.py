@@ -8,6 +8,10 @@ Submodules, one concept each:
 - :mod:`noise` -- dark current and fixed-pattern threshold noise (SPEC section 3).
 - :mod:`samplers` -- the float FSM / RVSM samplers (SPEC section 2).
 - :mod:`spike_files` -- ``.npz`` spike files and the spike camera's ``.dat`` layout.
-- :mod:`reconstruction`, :mod:`metrics` -- TFI/TFP, the RVSM inverse, PSNR/SSIM, robustness.
+- :mod:`reconstruction`, :mod:`metrics` -- TFI/TFP, the RVSM adjoint, PSNR/SSIM, robustness.
+- :mod:`inverse` -- the least-squares inverse of the RVSM filter bank (CG).
+- :mod:`thresholds` -- per-scale threshold rules: equal, equal response time.
+- :mod:`noise_presets` / :mod:`noise_calibration` -- named noise regimes and the
+  calibration of the ``paper`` preset on FSM.
 - :mod:`fixed` -- the bit-accurate fixed-point twin (SPEC section 5).
 """

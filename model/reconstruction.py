@@ -1,4 +1,4 @@
-"""Images from spikes (SPEC section 4, paper section 3.2): TFI / TFP for FSM, the RVSM inverse.
+"""Images from spikes (SPEC section 4, paper section 3.2): TFI / TFP for FSM, RVSM decoding.
 
 Conventions shared by every method here:
 
@@ -23,7 +23,7 @@ from .filtering import adjoint_sums
 from .kernels import ModelSpec, model_spec
 from .spike_files import single_scale_spikes
 
-METHODS = ("auto", "tfi", "tfp", "rvsm")
+METHODS = ("auto", "tfi", "tfp", "rvsm", "inverse")
 MATCH_MODES = ("gain", "affine")
 DEFAULT_TFP_WINDOW = 32
 _EPS = 1e-12
@@ -201,7 +201,8 @@ def rvsm_image(coeffs: np.ndarray, model: str | ModelSpec) -> np.ndarray:
 
 
 def resolve_method(method: str, model: str | ModelSpec) -> str:
-    """``auto`` -> ``tfi`` for FSM, ``rvsm`` otherwise; validates the name."""
+    """``auto`` -> ``tfi`` for FSM, ``rvsm`` otherwise; validates the name. ``rvsm`` is the
+    paper's adjoint (eq. 11), ``inverse`` the least-squares inverse (:mod:`.inverse`)."""
     if method not in METHODS:
         raise RvsmError(f"unknown reconstruction method {method!r}; choose one of {METHODS}")
     spec = _spec(model)
@@ -222,8 +223,10 @@ def reconstruct(
     """Raw (unmatched) reconstruction ``(N, H, W) float64`` at ``steps`` (all if None).
 
     ``spikes`` is ``(T, S, H, W)`` (or ``(T, H, W)`` for FSM); ``phis`` the nominal
-    threshold(s). ``method``: ``auto`` (TFI for FSM, RVSM inverse otherwise), ``tfi``,
-    ``tfp`` or ``rvsm``.
+    threshold(s). ``method``: ``auto`` (TFI for FSM, RVSM adjoint otherwise), ``tfi``,
+    ``tfp``, ``rvsm`` (the paper's eq. 11, the adjoint of the filters) or ``inverse`` (the
+    regularised least-squares inverse of the filters, :func:`rvsm.model.inverse.inverse_images`,
+    steps decoded in the order given, each warm-started from the previous one).
     """
     spec = _spec(model)
     how = resolve_method(method, spec)
@@ -235,7 +238,12 @@ def reconstruct(
         return tfp(arr, float(phi_arr[0]), steps)
     if arr.ndim == 3:
         arr = arr[:, None]
-    return rvsm_image(rvsm_coefficients(arr, phi_arr, steps), spec)
+    coeffs = rvsm_coefficients(arr, phi_arr, steps)
+    if how == "inverse":
+        from .inverse import inverse_images
+
+        return inverse_images(coeffs, spec)
+    return rvsm_image(coeffs, spec)
 
 
 def match_brightness(recon: np.ndarray, truth: np.ndarray, mode: str = "gain") -> np.ndarray:

@@ -27,10 +27,23 @@ import numpy as np
 from ..errors import RvsmError
 from ..kernels import MODEL_NAMES, ModelSpec, model_spec
 from ..noise import NoiseParams, NoiseSource
+from ..noise_presets import NOISE_PRESETS, preset_noise
 from ..samplers import RESET_MODES, SamplerConfig
+from ..scene_library import SCENE_NAMES
+from ..thresholds import DEFAULT_CALIBRATION_SCENE, THRESHOLD_RULES, calibration_thresholds
 from .adc import ADC_CLIPS, ROUNDINGS, adc_gain
 from .core import ArrayContract
-from .fields import Choice, Field, Flag, Integer, Number, PositiveNumbers, declare, fields_of
+from .fields import (
+    Choice,
+    Field,
+    Flag,
+    Integer,
+    Number,
+    OptionalChoice,
+    PositiveNumbers,
+    declare,
+    fields_of,
+)
 from .weights import quantise_model
 from .widths import signed_bits, signed_range
 
@@ -85,11 +98,20 @@ class DesignPoint:
                                       "ceil", "threshold -> LSB rounding")
     reset: str = declare("threshold", "reset", Choice(RESET_MODES), "zero",
                          "after a spike: acc = 0, or acc -= +-threshold")
+    threshold_rule: str | None = declare(
+        "threshold", "rule", OptionalChoice(THRESHOLD_RULES), None,
+        "per-scale thresholds: phi each (default), or FSM's response time")
+    calibration_scene: str | None = declare(
+        "threshold", "calibration_scene", OptionalChoice(SCENE_NAMES), None,
+        f"scene of the response rule (default {DEFAULT_CALIBRATION_SCENE})", sweep=False)
     noise: bool = declare("noise", "enabled", Flag(), False,
                           "SPEC section 3 noise on or off", sweep=False)
     noise_k: float = declare("noise", "k", Number(allow_zero=True), 1.0, "noise intensity k")
     seed: int = declare("noise", "seed", Integer(0, (1 << 63) - 1), 0,
                         "numpy seed, shared with the float model", sweep=False)
+    noise_preset: str | None = declare(
+        "noise", "preset", OptionalChoice(tuple(NOISE_PRESETS)), None,
+        "named noise regime replacing k", sweep=False)
 
     def __post_init__(self) -> None:
         for f in FIELDS:
@@ -99,6 +121,11 @@ class DesignPoint:
                 f"{FIELD_PATH['scale_phi']} has {len(self.scale_phi)} value(s) but model "
                 f"{self.model} has {self.spec.num_scales} scale(s); give one per scale "
                 "or remove it to use threshold.phi for every scale"
+            )
+        if self.threshold_rule == "response" and self.scale_phi is not None:
+            raise RvsmError(
+                f"{FIELD_PATH['threshold_rule']} = \"response\" computes the per-scale "
+                f"thresholds; remove {FIELD_PATH['scale_phi']} or use rule \"equal\""
             )
         self._check_weights()
         self._check_thresholds()
@@ -169,10 +196,22 @@ class DesignPoint:
         return self.height, self.width
 
     @property
+    def rule(self) -> str:
+        """The threshold rule in force: ``threshold.rule``, ``"equal"`` when unset."""
+        return self.threshold_rule or "equal"
+
+    @property
     def phis(self) -> np.ndarray:
-        """Nominal float threshold per scale, ``(S,) float64`` (8-bit brightness units)."""
+        """Nominal float threshold per scale, ``(S,) float64`` (8-bit brightness units):
+        ``scale_phi``, or under ``threshold.rule = "response"`` the response-rule
+        thresholds on ``threshold.calibration_scene`` at this size
+        (:func:`rvsm.model.thresholds.calibration_thresholds`), else ``phi``."""
         if self.scale_phi is not None:
             return np.array(self.scale_phi, dtype=np.float64)
+        if self.rule == "response":
+            scene = self.calibration_scene or DEFAULT_CALIBRATION_SCENE
+            return np.array(calibration_thresholds(scene, self.model, float(self.phi),
+                                                   self.shape))
         return np.full(self.num_scales, float(self.phi))
 
     @property
@@ -223,8 +262,13 @@ class DesignPoint:
         return self.to_threshold_lsbs(self.phis)
 
     def noise_params(self) -> NoiseParams | None:
-        """The float model's noise parameters (SPEC defaults, this point's k and seed)."""
-        return NoiseParams(k=float(self.noise_k), seed=int(self.seed)) if self.noise else None
+        """The float model's noise parameters (SPEC defaults, this point's k and seed; a
+        ``noise.preset`` replaces k, :mod:`rvsm.model.noise_presets`)."""
+        if not self.noise:
+            return None
+        if self.noise_preset is not None:
+            return preset_noise(self.noise_preset, int(self.seed))
+        return NoiseParams(k=float(self.noise_k), seed=int(self.seed))
 
     def noise_source(self) -> NoiseSource | None:
         """A fresh seeded noise source for this array (None when noise is off)."""
@@ -255,7 +299,7 @@ class DesignPoint:
         return SamplerConfig(
             model=self.model,
             phi=float(self.phi),
-            scale_phi=self.scale_phi,
+            scale_phi=tuple(self.phis) if self.rule == "response" else self.scale_phi,
             reset=self.reset,
             noise=self.noise_params(),
         )

@@ -24,8 +24,8 @@ import numpy as np
 from ..errors import RvsmError
 
 __all__ = [
-    "Choice", "Field", "Flag", "Integer", "Kind", "Number", "PositiveNumbers", "declare",
-    "fields_of",
+    "Choice", "Field", "Flag", "Integer", "Kind", "Number", "OptionalChoice",
+    "PositiveNumbers", "declare", "fields_of",
 ]
 
 _META = "rvsm.field"
@@ -97,6 +97,19 @@ class Choice:
 
     def describe(self) -> str:
         return " | ".join(self.choices)
+
+
+@dataclass(frozen=True)
+class OptionalChoice:
+    """``None`` (not set: the field's documented default applies) or one of ``choices``."""
+
+    choices: tuple[str, ...]
+
+    def check(self, path: str, value: Any) -> str | None:
+        return None if value is None else Choice(self.choices).check(path, value)
+
+    def describe(self) -> str:
+        return "optional: " + " | ".join(self.choices)
 
 
 @dataclass(frozen=True)

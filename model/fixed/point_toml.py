@@ -22,6 +22,7 @@ else:  # pragma: no cover
 
 from ..atomic import write_text_atomic
 from ..errors import RvsmError
+from ..thresholds import DEFAULT_CALIBRATION_SCENE
 from .design_point import FIELDS, DesignPoint
 
 __all__ = [
@@ -47,6 +48,9 @@ SECTION_COMMENTS = {
     "# the integer thresholds), intensity k, numpy seed (same seed as the float model).",
 }
 SECTIONS: tuple[str, ...] = tuple(dict.fromkeys(f.section for f in FIELDS))
+#: What an unset optional choice looks like, commented out, in ``rvsm config new``.
+_EXAMPLES = {"threshold_rule": "response", "calibration_scene": DEFAULT_CALIBRATION_SCENE,
+             "noise_preset": "paper"}
 
 
 def _toml_value(value: Any) -> Any:
@@ -88,7 +92,9 @@ def design_point_toml(point: DesignPoint) -> str:
     """The point as a commented TOML document (what ``rvsm config new`` prints).
 
     Every key is preceded by its declared comment and valid values; an unset
-    ``scale_phi`` is shown commented out with this point's per-scale thresholds.
+    ``scale_phi`` is shown commented out with this point's per-scale thresholds, the other
+    optional keys (``threshold.rule``, ``threshold.calibration_scene``, ``noise.preset``)
+    commented out with an example value.
     """
     lines = [
         "# rvsm fixed-point design point (SPEC section 5); see docs/fixed-point.md.",
@@ -101,7 +107,9 @@ def design_point_toml(point: DesignPoint) -> str:
             lines += ["", f"# {SECTION_COMMENTS[section]}", f"[{section}]"]
         value = getattr(point, f.name)
         lines.append(f"# {f.key}: {f.comment()}")
-        if value is None:
+        if value is None and f.name in _EXAMPLES:
+            lines.append(f"# {tomli_w.dumps({f.key: _EXAMPLES[f.name]}).rstrip()}")
+        elif value is None:
             example = ", ".join(repr(float(v)) for v in point.phis)
             lines.append(f"# {f.key} = [{example}]")
         else:

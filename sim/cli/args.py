@@ -6,6 +6,7 @@ import argparse
 
 from rvsm.model.errors import RvsmError
 from rvsm.model.noise import NoiseParams
+from rvsm.model.noise_presets import NOISE_PRESETS, preset_noise
 from rvsm.model.scene import DEFAULT_STEPS_PER_FRAME, Scene
 
 
@@ -30,19 +31,28 @@ def add_scene_arguments(parser: argparse.ArgumentParser, positional: bool = True
 
 
 def add_noise_arguments(parser: argparse.ArgumentParser) -> None:
-    """``--noise``, ``--k`` and ``--seed`` (SPEC section 3)."""
+    """``--noise``, ``--k``, ``--noise-preset`` and ``--seed`` (SPEC section 3)."""
     parser.add_argument("--noise", action="store_true", default=None,
                         help="add dark current and fixed-pattern threshold noise")
     parser.add_argument("--k", type=float, default=None, help="noise intensity k (default 1)")
+    parser.add_argument("--noise-preset", default=None, choices=tuple(NOISE_PRESETS),
+                        help="named noise regime instead of --k: spec (k=1) or paper "
+                        f"(k={NOISE_PRESETS['paper']:g}, calibrated on FSM)")
     parser.add_argument("--seed", type=int, default=None, help="noise seed (default 0)")
 
 
 def noise_from_args(args: argparse.Namespace) -> NoiseParams | None:
     """The noise asked for on the command line, or ``None`` for a noiseless sensor."""
+    preset = getattr(args, "noise_preset", None)
     if not args.noise:
-        if args.k is not None or args.seed is not None:
-            raise RvsmError("--k and --seed only apply with --noise; add --noise")
+        if args.k is not None or args.seed is not None or preset is not None:
+            raise RvsmError("--k, --noise-preset and --seed only apply with --noise; "
+                            "add --noise")
         return None
+    if preset is not None:
+        if args.k is not None:
+            raise RvsmError("--noise-preset sets k; give --k or --noise-preset, not both")
+        return preset_noise(preset, 0 if args.seed is None else args.seed)
     return NoiseParams(
         k=1.0 if args.k is None else args.k, seed=0 if args.seed is None else args.seed
     )

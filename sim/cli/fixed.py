@@ -9,6 +9,7 @@ from pathlib import Path
 
 from rvsm.model.errors import RvsmError
 from rvsm.model.reconstruction import MATCH_MODES, METHODS
+from rvsm.model.thresholds import THRESHOLD_RULES
 
 from .args import add_scene_arguments, load_scene_from_args, parse_size_arg
 
@@ -51,6 +52,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     _common(p)
     p.add_argument("--method", default="auto", choices=METHODS)
     p.add_argument("--match", default="gain", choices=MATCH_MODES)
+    p.add_argument("--thresholds", default=None, choices=THRESHOLD_RULES,
+                   help="override the point's threshold.rule (response: per-scale thresholds "
+                   "from threshold.calibration_scene)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run_cost)
 
@@ -152,6 +156,10 @@ def run_cost(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.cost import format_cost, quantisation_cost
 
     point, scene = _point_and_scene(args)
+    if args.thresholds is not None:
+        import dataclasses
+
+        point = dataclasses.replace(point, threshold_rule=args.thresholds)
     result = quantisation_cost(scene, point, method=args.method, match=args.match,
                                progress=not args.json)
     print(json.dumps(result) if args.json else format_cost(result))

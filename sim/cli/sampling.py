@@ -11,6 +11,7 @@ from rvsm.model.errors import RvsmError
 from rvsm.model.reconstruction import MATCH_MODES, METHODS
 from rvsm.model.samplers import DEFAULT_PHI, RESET_MODES, SamplerConfig, sample
 from rvsm.model.spike_files import export_dat, import_dat, load_spikes, save_spikes
+from rvsm.model.thresholds import THRESHOLD_RULES, rule_thresholds
 
 from .args import (
     add_noise_arguments,
@@ -34,6 +35,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--scale-phi", default=None, metavar="P1,P2,..",
                    help="per-scale thresholds, comma-separated")
     p.add_argument("--reset", choices=RESET_MODES, default=None, help="reset mode (default zero)")
+    p.add_argument("--thresholds", choices=THRESHOLD_RULES, default=None,
+                   help="per-scale threshold rule: equal (every scale phi, default) or "
+                   "response (each scale gets FSM's response time on this scene)")
     add_noise_arguments(p)
     p.add_argument("--fixed", metavar="POINT.toml",
                    help="run the bit-accurate fixed-point twin of this design point instead")
@@ -43,8 +47,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run_simulate)
 
     p = sub.add_parser("evaluate", help="reconstruct a spike file and score it",
-                       description="Reconstruct spikes (TFI for FSM, the RVSM inverse "
-                       "otherwise), match brightness and print MSE, PSNR and SSIM.")
+                       description="Reconstruct spikes (TFI for FSM, the paper's RVSM "
+                       "adjoint otherwise; --method inverse for the least-squares inverse), "
+                       "match brightness and print MSE, PSNR and SSIM.")
     p.add_argument("spikes", help=".npz spike file")
     p.add_argument("scene", nargs="?", default=None,
                    help="scene to score against (default: the one in the file's meta)")
@@ -69,8 +74,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.set_defaults(func=run_dat_import)
 
 
-def _float_config(args: argparse.Namespace) -> SamplerConfig:
+def _float_config(args: argparse.Namespace, scene=None) -> SamplerConfig:
     scale_phi = None
+    model = args.model or "dog4"
+    phi = DEFAULT_PHI if args.phi is None else args.phi
+    if args.thresholds == "response":
+        if args.scale_phi:
+            raise RvsmError("--thresholds response computes the per-scale thresholds; "
+                            "drop --scale-phi")
+        scale_phi = rule_thresholds("response", scene, model, phi)
     if args.scale_phi:
         try:
             scale_phi = tuple(float(v) for v in args.scale_phi.split(","))
@@ -79,8 +91,8 @@ def _float_config(args: argparse.Namespace) -> SamplerConfig:
                 f"--scale-phi must be comma-separated numbers, got {args.scale_phi!r}"
             ) from None
     return SamplerConfig(
-        model=args.model or "dog4",
-        phi=DEFAULT_PHI if args.phi is None else args.phi,
+        model=model,
+        phi=phi,
         scale_phi=scale_phi,
         reset=args.reset or "zero",
         noise=noise_from_args(args),
@@ -93,7 +105,8 @@ def run_simulate(args: argparse.Namespace) -> int:
         raise RvsmError(f"--dat expects a .dat path, got {args.dat!r}")
     if args.fixed:
         given = [f"--{n.replace('_', '-')}" for n in
-                 ("model", "phi", "scale_phi", "reset", "noise", "k", "seed")
+                 ("model", "phi", "scale_phi", "reset", "thresholds", "noise", "k",
+                  "noise_preset", "seed")
                  if getattr(args, n) is not None]
         if given:
             raise RvsmError(f"{', '.join(given)} come(s) from the design point with --fixed; "
@@ -109,8 +122,8 @@ def run_simulate(args: argparse.Namespace) -> int:
         run = simulate_fixed(scene, point, progress=True)
         spikes, meta = run.spikes, dict(run.meta)
     else:
-        config = _float_config(args)
         scene = load_scene_from_args(args)
+        config = _float_config(args, scene)
         train = sample(scene, config, progress=True)
         spikes, meta = train.spikes, dict(train.meta)
     if args.dat:

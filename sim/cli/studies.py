@@ -8,8 +8,11 @@ from pathlib import Path
 
 from rvsm.model.atomic import atomic_path, write_text_atomic
 from rvsm.model.errors import RvsmError
+from rvsm.model.noise_presets import NOISE_PRESETS
 from rvsm.model.samplers import DEFAULT_PHI
-from rvsm.sim.studies import robustness, table
+from rvsm.model.thresholds import DEFAULT_CALIBRATION_SCENE, THRESHOLD_RULES
+from rvsm.sim.studies import claims, robustness, table
+from rvsm.sim.studies.settings_table import run_settings_table, settings_csv
 
 from .args import parse_size_arg
 
@@ -60,20 +63,50 @@ def cmd_table(args: argparse.Namespace) -> int:
         _positive("--frames", args.frames),
         _positive("--steps-per-frame", args.steps_per_frame),
     )
-    result = table.run_table(scenes, seed=args.seed, phi=args.phi, progress=not args.quiet)
+    rules = _choices("--thresholds", args.thresholds, THRESHOLD_RULES)
+    presets = _choices("--noise-preset", args.noise_preset, tuple(NOISE_PRESETS))
+    decoders = _choices("--decoder", args.decoder, ("rvsm", "inverse"))
+    results = run_settings_table(scenes, rules, presets, decoders, seed=args.seed,
+                                 phi=args.phi, progress=not args.quiet)
     out = Path(args.output)
     h, w = scenes[0].shape
-    note = (
-        f"\n{len(scenes)} scenes at {h}x{w}, {scenes[0].num_frames} frames x "
-        f"{scenes[0].steps_per_frame} steps/frame ({scenes[0].num_steps} steps), "
-        f"phi={args.phi:g}, noise NoiseParams(k=1, seed={args.seed}); "
-        f"{len(result.rows)} runs in {result.seconds:.0f} s.\n"
-    )
-    write_text_atomic(out / "table.md", table.table_markdown(result) + note)
-    write_text_atomic(out / "table.csv", table.table_csv(result))
-    save_figure(table.table_figure(result), out / "fig6.png")
-    print(f"wrote {out / 'table.md'}, table.csv, fig6.png ({result.seconds:.0f} s)")
+    single = len(results) == 1
+    verdicts = ["| setting | 1: Four Gauss(N) > FSM(N) | 2: Three/Four DoG > FSM clean | "
+                "3: One -> Four (N) rises |", "|---|---|---|---|"]
+    for setting, result in results.items():
+        note = (
+            f"\n{len(scenes)} scenes at {h}x{w}, {scenes[0].num_frames} frames x "
+            f"{scenes[0].steps_per_frame} steps/frame ({scenes[0].num_steps} steps), "
+            f"phi={args.phi:g}, thresholds {setting.thresholds}, noise preset "
+            f"{setting.noise_preset} (k={result.settings['noise_k']:g}, seed={args.seed}), "
+            f"RVSM decoder {setting.decoder}; {len(result.rows)} runs, whole command "
+            f"{result.seconds:.0f} s.\n"
+        )
+        suffix = "" if single else f"-{setting.tag}"
+        write_text_atomic(out / f"table{suffix}.md", table.table_markdown(result) + note)
+        save_figure(table.table_figure(result), out / f"fig6{suffix}.png")
+        v = claims.table_claims(result)
+        verdicts.append(f"| {setting.tag} | " + " | ".join(
+            f"{'holds' if v[i]['holds'] else 'fails'} ({v[i]['detail']})" for i in (1, 2, 3))
+            + " |")
+    if single:
+        write_text_atomic(out / "table.csv", table.table_csv(next(iter(results.values()))))
+    else:
+        write_text_atomic(out / "settings.csv", settings_csv(results))
+    write_text_atomic(out / "verdicts.md", "\n".join(verdicts) + "\n")
+    seconds = next(iter(results.values())).seconds
+    print(f"wrote {len(results)} setting(s) to {out} ({seconds:.0f} s)")
     return 0
+
+
+def _choices(flag: str, text: str, valid: tuple[str, ...]) -> list[str]:
+    """Comma-separated values of ``flag``, each one of ``valid``, order kept, no repeats."""
+    values = list(dict.fromkeys(v.strip() for v in str(text).split(",") if v.strip()))
+    bad = [v for v in values if v not in valid]
+    if not values or bad:
+        raise RvsmError(f"{flag} takes a comma-separated list of {', '.join(valid)}; "
+                        f"got {text!r}")
+    return values
 
 
 def cmd_robustness(args: argparse.Namespace) -> int:
@@ -81,12 +114,16 @@ def cmd_robustness(args: argparse.Namespace) -> int:
     size = scored_size(args.size)
     result = robustness.run_robustness(
         parse_floats(args.ks), size, _positive("--steps", args.steps), seed=args.seed,
-        phi=args.phi, progress=not args.quiet,
+        phi=args.phi, progress=not args.quiet, thresholds=args.thresholds,
+        calibration_scene=args.calibration_scene,
     )
     out = Path(args.output)
     write_text_atomic(out / "robustness.csv", robustness.robustness_csv(result))
     write_text_atomic(out / "robustness.json", json.dumps(result.rows, indent=1) + "\n")
     save_figure(robustness.robustness_figure(result), out / "fig8.png")
+    verdict = claims.robustness_claim(result)
+    write_text_atomic(out / "verdict.md", f"claim 4 {'holds' if verdict['holds'] else 'fails'}: "
+                      f"{verdict['detail']}\n")
     print(f"wrote {out / 'robustness.csv'}, robustness.json, fig8.png "
           f"({result.seconds:.0f} s)")
     return 0
@@ -107,6 +144,14 @@ def register(subparsers) -> None:
                    help="sampling steps per frame (default %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="noise seed (default %(default)s)")
     p.add_argument("--phi", type=float, default=DEFAULT_PHI, help="threshold (default %(default)s)")
+    p.add_argument("--thresholds", default="equal", metavar="RULE[,RULE]",
+                   help="threshold rule(s): equal, response (default %(default)s)")
+    p.add_argument("--noise-preset", default="spec", metavar="PRESET[,PRESET]",
+                   help="noise preset(s) of the (N) columns: spec (k=1), paper "
+                   "(default %(default)s)")
+    p.add_argument("--decoder", default="rvsm", metavar="DEC[,DEC]",
+                   help="RVSM decoder(s): rvsm (paper's adjoint), inverse (least squares) "
+                   "(default %(default)s)")
     p.add_argument("-o", "--output", default="out/table",
                    help="output folder (default %(default)s)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -121,6 +166,11 @@ def register(subparsers) -> None:
                    help="comma-separated noise intensities (default %(default)s)")
     p.add_argument("--size", default="100x100", help="HxW (default %(default)s)")
     p.add_argument("--steps", type=int, default=1000, help="steps T (default %(default)s)")
+    p.add_argument("--thresholds", default="equal", choices=THRESHOLD_RULES,
+                   help="threshold rule (default %(default)s); response uses the thresholds "
+                   "of --calibration-scene at --size")
+    p.add_argument("--calibration-scene", default=DEFAULT_CALIBRATION_SCENE,
+                   help="built-in scene for --thresholds response (default %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="noise seed (default %(default)s)")
     p.add_argument("--phi", type=float, default=DEFAULT_PHI, help="threshold (default %(default)s)")
     p.add_argument("-o", "--output", default="out/robustness",

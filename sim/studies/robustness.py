@@ -14,11 +14,17 @@ from dataclasses import dataclass
 
 from matplotlib.figure import Figure
 
+from rvsm.model.errors import RvsmError
 from rvsm.model.kernels import model_spec
 from rvsm.model.metrics import robustness_indices
 from rvsm.model.noise import NoiseParams
 from rvsm.model.samplers import DEFAULT_PHI, SamplerConfig, sample
 from rvsm.model.scene_library import black_scene
+from rvsm.model.thresholds import (
+    DEFAULT_CALIBRATION_SCENE,
+    THRESHOLD_RULES,
+    calibration_thresholds,
+)
 
 from .labels import method_label
 
@@ -45,12 +51,21 @@ def run_robustness(
     phi: float = DEFAULT_PHI,
     models: Sequence[str] = ROBUST_MODELS,
     progress: bool = False,
+    thresholds: str = "equal",
+    calibration_scene: str = DEFAULT_CALIBRATION_SCENE,
 ) -> RobustnessResult:
     """Paper section 4.3: spikes of a black scene under noise of intensity ``k``.
 
-    Every model sees ``NoiseParams(k, seed)``; returns ASS, ASAS and ASASS per run.
+    Every model sees ``NoiseParams(k, seed)``; returns ASS, ASAS and ASASS per run. With
+    ``thresholds="response"`` each RVSM model's per-scale thresholds are those of the
+    response rule on the built-in ``calibration_scene`` at ``size`` (a black scene has no
+    response of its own; :func:`rvsm.model.thresholds.calibration_thresholds`).
     """
     from tqdm.auto import tqdm
+
+    if thresholds not in THRESHOLD_RULES:
+        raise RvsmError(f"unknown threshold rule {thresholds!r}; choose one of "
+                        f"{THRESHOLD_RULES}")
 
     scene = black_scene(size, num_steps)
     models = [model_spec(m).name for m in models]
@@ -60,7 +75,12 @@ def run_robustness(
               disable=not progress) as bar:
         for k in ks:
             for model in models:
-                config = SamplerConfig(model=model, phi=phi, noise=NoiseParams(k=k, seed=seed))
+                scale_phi = None
+                if thresholds == "response" and model_spec(model).family != "fsm":
+                    scale_phi = calibration_thresholds(calibration_scene, model, phi,
+                                                       tuple(size))
+                config = SamplerConfig(model=model, phi=phi, scale_phi=scale_phi,
+                                       noise=NoiseParams(k=k, seed=seed))
                 idx = robustness_indices(sample(scene, config).spikes)
                 rows.append({"k": float(k), "model": model, **idx})
                 bar.update(1)

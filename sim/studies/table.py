@@ -85,7 +85,7 @@ def run_table(
     """Sample every scene with every model, without and with noise, and score it.
 
     Noise is ``NoiseParams(k=noise_k, seed=seed)`` (same dark current and fixed pattern for
-    every model). Reconstruction: TFI for FSM, the RVSM inverse otherwise; one gain per
+    every model). Reconstruction: TFI for FSM, the RVSM adjoint otherwise; one gain per
     frame; scored on original-frame steps after the warm-up (:mod:`rvsm.model.evaluation`).
     """
     from tqdm.auto import tqdm
