@@ -1,0 +1,212 @@
+"""Verilog and port map of the streaming array (:mod:`rvsm.rtl.stream_array`).
+
+* :func:`generate_stream_verilog` converts :class:`RvsmStreamArray` with Amaranth's
+  bundled yosys (``emit_src=False``) without all-zero memory initialisers: the array
+  never relies on memory contents at power-up (accumulators read as zero in the first
+  frame after reset or ``clear``; line-buffer rows outside the frame are masked;
+  thresholds must be loaded), and at sensor size building those initialisers was most
+  of the conversion time and their ``initial`` blocks most of the file.
+* :func:`stream_port_map` derives the port list from the component's signature:
+  one entry per port (``codes__payload``, ...), with the bit fields of structured
+  payloads; :func:`write_stream_outputs` writes ``<top>.v``, ``<top>.ports.json``
+  (ports, timing properties, state memory) and ``<top>.ports.md``.
+* Lint with :func:`rvsm.rtl.verilog.verilator_lint` (the same documented waivers).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import re
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+from amaranth.back import verilog as amaranth_verilog
+from amaranth.hdl import Shape, Signal, Value
+from amaranth.lib import data, wiring
+
+from rvsm.model.atomic import write_text_atomic
+from rvsm.model.fixed.core import ArrayContract
+
+from .stream_array import RvsmStreamArray
+from .verilog import GeneratedVerilog
+
+__all__ = [
+    "STREAM_TOP",
+    "generate_stream_verilog",
+    "stream_port_map",
+    "stream_port_map_markdown",
+    "strip_zero_memory_init",
+    "write_stream_outputs",
+]
+
+STREAM_TOP = "rvsm_stream_array"
+
+_ZERO_INIT = re.compile(
+    r"^[ \t]*initial begin\n(?:[ \t]*\\?[\w$.]+ ?\[\d+\] = \d+'h0+;\n)+[ \t]*end\n",
+    re.MULTILINE)
+
+
+def strip_zero_memory_init(text: str) -> tuple[str, int]:
+    """Remove ``initial begin mem[i] = N'h0; ... end`` blocks; return text and count.
+
+    Only blocks made entirely of all-zero memory-word assignments are removed, so any
+    non-zero initial contents stay.
+    """
+    return _ZERO_INIT.subn("", text)
+
+
+@contextlib.contextmanager
+def _no_zero_meminit() -> Iterator[None]:
+    """Let Amaranth's RTLIL emitter skip the ``$meminit_v2`` cell of all-zero memories.
+
+    Amaranth 0.5 builds that cell bit by bit (about 90 % of the conversion time at
+    sensor size) and yosys turns it into ``initial`` blocks; without it the memory is
+    uninitialised, which this array allows. Non-zero initial contents are emitted as
+    usual. If Amaranth's internals differ, nothing is patched (only slower).
+    """
+    from amaranth.back import rtlil
+
+    emitter = getattr(rtlil, "ModuleEmitter", None)
+    original = getattr(emitter, "emit_memory", None)
+    if original is None:
+        yield
+        return
+
+    def emit_memory(self, cell_idx, cell):  # noqa: ANN001, ANN202 - Amaranth's signature
+        if any(cell.init):
+            return original(self, cell_idx, cell)
+        return None
+
+    emitter.emit_memory = emit_memory
+    try:
+        yield
+    finally:
+        emitter.emit_memory = original
+
+
+def generate_stream_verilog(contract: ArrayContract, lanes: int, top: str = STREAM_TOP,
+                            dut: RvsmStreamArray | None = None) -> GeneratedVerilog:
+    """Verilog of ``RvsmStreamArray(contract, lanes)`` (or of ``dut``, built from them):
+    no src attributes, no zero memory initialisers."""
+    t0 = time.perf_counter()
+    dut = RvsmStreamArray(contract, lanes) if dut is None else dut
+    # The always-ready output stream has a constant ``ready``: list the real ports.
+    values = (Value.cast(v) for _, _, v in dut.signature.flatten(dut))
+    ports = [v for v in values if isinstance(v, Signal)]
+    with _no_zero_meminit():
+        text = amaranth_verilog.convert(dut, name=top, ports=ports, emit_src=False)
+    text, _ = strip_zero_memory_init(text)
+    return GeneratedVerilog(text, top, dut.latency, time.perf_counter() - t0)
+
+
+_DESCRIPTIONS = {
+    ("codes", "payload"): "ADC codes of one beat: lane i = pixel (y, g*P + i) at bits "
+                          "[i*N +: N], raster order (frame, row, group)",
+    ("codes", "valid"): "the input beat is valid",
+    ("codes", "ready"): "the array accepts a beat (low only while clear is high)",
+    ("spikes", "payload"): "one output beat (fields below)",
+    ("spikes", "valid"): "high for one cycle when a position is released",
+    ("thr_write", "en"): "threshold write enable (one word per rising edge)",
+    ("thr_write", "scale"): "scale s of the word",
+    ("thr_write", "addr"): "word address y*G + g",
+    ("thr_write", "data"): "P thresholds, lane i at bits [i*(W-1) +: W-1]",
+    ("clear",): "synchronous restart of the stream: positions in flight dropped, "
+                "accumulators zero in the next frame, thresholds kept",
+}
+
+_FIELD_DESCRIPTIONS = {
+    "row": "row y of the position",
+    "group": "column group g of the position (columns g*P .. g*P+P-1)",
+    "last": "last beat of a frame",
+    "pos": "+1 spikes: bit s*P + i = accumulator (s, y, g*P + i)",
+    "neg": "-1 spikes, same ordering (always 0 for unsigned models)",
+}
+
+
+def stream_port_map(dut: RvsmStreamArray) -> list[dict]:
+    """Top-level ports from ``dut.signature``: name, dir, width, desc, and ``fields``
+    (``name, offset, width, desc``) for struct-layout payloads."""
+    ports = [
+        {"name": "clk", "dir": "in", "width": 1, "desc": "clock (rising edge)"},
+        {"name": "rst", "dir": "in", "width": 1,
+         "desc": "synchronous reset: the state of a clear (memories untouched)"},
+    ]
+    for path, member in dut.signature.members.flatten():
+        if not member.is_port:
+            continue
+        shape = member.shape
+        entry = {"name": "__".join(path),
+                 "dir": "in" if member.flow == wiring.In else "out",
+                 "width": Shape.cast(shape).width,
+                 "desc": _DESCRIPTIONS.get(tuple(path), "")}
+        if isinstance(shape, data.StructLayout):
+            entry["fields"] = [{"name": name, "offset": field.offset, "width": field.width,
+                                "desc": _FIELD_DESCRIPTIONS.get(name, "")}
+                               for name, field in shape]
+        ports.append(entry)
+    return ports
+
+
+def _meta(dut: RvsmStreamArray, top: str) -> dict:
+    geo = dut.geometry
+    return {"top": top, "arch": "stream", "latency": geo.latency, "timing": geo.timing(),
+            "bank_sizes": geo.bank_sizes, "state_bits": geo.state_bits,
+            "ports": stream_port_map(dut)}
+
+
+def stream_port_map_markdown(dut: RvsmStreamArray, top: str = STREAM_TOP) -> str:
+    """The port map as Markdown: design point, timing properties, ports, payload fields."""
+    c, geo = dut.contract, dut.geometry
+    t = geo.timing()
+    lines = [
+        f"# `{top}` port map (streaming array)",
+        "",
+        f"Array {c.height}x{c.width}, {c.num_scales} scale(s), ADC {c.adc_bits} bits, "
+        f"accumulator {c.accumulator_bits} bits ({'signed' if c.signed else 'unsigned'}"
+        f" model, reset {c.reset}), shift {c.shift}; {geo.lanes} lane(s), "
+        f"{geo.groups} beat(s) per row, {geo.beats_per_frame} per frame.",
+        "",
+        f"Timing (beats): window lag {t['window_lag']}, pipeline depth "
+        f"{t['pipeline_depth']} (latency {t['latency']} cycles back to back), lag "
+        f"{t['lag']} (output p follows input beat p + lag; flush with lag beats), "
+        f"threshold lag {t['threshold_lag']}, read-modify-write depth {t['rmw_depth']}.",
+        "",
+        "| port | dir | width | meaning |",
+        "|---|---|---|---|",
+    ]
+    ports = stream_port_map(dut)
+    lines += [f"| `{p['name']}` | {p['dir']} | {p['width']} | {p['desc']} |" for p in ports]
+    for p in ports:
+        if "fields" in p:
+            lines += ["", f"Fields of `{p['name']}`:", "",
+                      "| field | bits | meaning |", "|---|---|---|"]
+            lines += [f"| `{f['name']}` | [{f['offset'] + f['width'] - 1}:{f['offset']}] "
+                      f"| {f['desc']} |" for f in p["fields"]]
+    s = geo.state_bits
+    lines += ["", f"State memory: accumulators {s['accumulators']} bits, thresholds "
+              f"{s['thresholds']} bits, line buffer {s['line_buffer']} bits; banks of "
+              f"{geo.bank_sizes} words per scale and kind."]
+    return "\n".join(lines) + "\n"
+
+
+def write_stream_outputs(
+    contract: ArrayContract, lanes: int, out_dir: str | os.PathLike, top: str = STREAM_TOP
+) -> tuple[dict[str, Path], GeneratedVerilog]:
+    """Write ``<top>.v``, ``<top>.ports.json`` and ``<top>.ports.md`` into ``out_dir``."""
+    out = Path(out_dir)
+    dut = RvsmStreamArray(contract, lanes)
+    gen = generate_stream_verilog(contract, lanes, top, dut)
+    paths = {
+        "verilog": out / f"{top}.v",
+        "ports_json": out / f"{top}.ports.json",
+        "ports_md": out / f"{top}.ports.md",
+    }
+    meta = _meta(dut, top)
+    meta["generation_seconds"] = round(gen.seconds, 3)
+    write_text_atomic(paths["verilog"], gen.text)
+    write_text_atomic(paths["ports_json"], json.dumps(meta, indent=2) + "\n")
+    write_text_atomic(paths["ports_md"], stream_port_map_markdown(dut, top))
+    return paths, gen
