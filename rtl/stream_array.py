@@ -23,9 +23,10 @@ L is the kernel radius (:func:`~rvsm.rtl.pipelined_sum.kernel_radius`), E =
 
 **State.** Per scale one accumulator memory (word = P signed W-bit accumulators) and one
 threshold memory (word = P thresholds of W-1 bits), depth ``H*G``, address ``y*G + g``,
-split into banks of at most :attr:`RvsmStreamArray.BANK_WORDS` words whose read data is
-registered before the bank multiplexer (ECP5 block-RAM timing). Each address is read
-and written once per frame, :attr:`~RvsmStreamArray.rmw_depth` beats apart, so the
+split into banks of at most :attr:`StreamGeometry.bank_words` words (a power of two,
+1024 by default) whose read data is registered before the bank multiplexer (ECP5
+block-RAM timing). Each address is read and written once per frame,
+:attr:`StreamGeometry.rmw_depth` beats apart, so the
 read-modify-write needs no forwarding as long as ``H*G > rmw_depth`` (checked).
 
 **Streams.** ``codes`` (:func:`code_beat_signature`): ``payload`` lane ``i`` = pixel
@@ -138,13 +139,18 @@ class StreamGeometry:
 
     #: Adder levels between pipeline registers in the receptive-sum trees.
     LEVELS_PER_STAGE = 2
-    #: Largest number of words in one bank of a state memory.
+    #: Default largest number of words in one bank of a state memory (one ECP5 DP16KD
+    #: holds 1024 words of up to 18 bits; wider words use several in parallel).
     BANK_WORDS = 1024
     #: Stages from the sums' register to the output register: add, compare, reset.
     TAIL_STAGES = 3
 
-    def __init__(self, contract: ArrayContract, lanes: int = 1):
+    def __init__(self, contract: ArrayContract, lanes: int = 1,
+                 bank_words: int = BANK_WORDS):
         c = contract
+        if bank_words < 1 or bank_words & (bank_words - 1):
+            raise RvsmError(f"bank_words must be a power of two, got {bank_words}")
+        self.bank_words = int(bank_words)
         if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) \
                 or lanes < 1 or c.width % lanes:
             raise RvsmError(f"lanes must be a positive divisor of the width {c.width}, "
@@ -197,7 +203,7 @@ class StreamGeometry:
     @property
     def bank_sizes(self) -> list[int]:
         """Words per bank of each state memory (every bank but the last is full)."""
-        n, b = self.beats_per_frame, self.BANK_WORDS
+        n, b = self.beats_per_frame, self.bank_words
         return [min(b, n - i) for i in range(0, n, b)]
 
     @property
@@ -269,8 +275,9 @@ class RvsmStreamArray(wiring.Component):
     and the named timing properties are in :attr:`geometry` (:class:`StreamGeometry`).
     """
 
-    def __init__(self, contract: ArrayContract, lanes: int = 1):
-        geo = StreamGeometry(contract, lanes)
+    def __init__(self, contract: ArrayContract, lanes: int = 1,
+                 bank_words: int = StreamGeometry.BANK_WORDS):
+        geo = StreamGeometry(contract, lanes, bank_words)
         self.geometry = geo
         self.contract = c = contract
         self.lanes = geo.lanes
@@ -311,7 +318,7 @@ class RvsmStreamArray(wiring.Component):
         """
         sizes = self.geometry.bank_sizes
         banked = len(sizes) > 1
-        offset_bits = (self.geometry.BANK_WORDS - 1).bit_length()
+        offset_bits = (self.geometry.bank_words - 1).bit_length()
         outs = []
         for b, depth in enumerate(sizes):
             mem = Memory(shape=unsigned(width), depth=depth, init=[])
@@ -451,7 +458,7 @@ class RvsmStreamArray(wiring.Component):
         addr0, fresh_t, row_t = pipe.timed(ac), pipe.timed(fresh0), pipe.timed(yc)
         group_t, last_t = pipe.timed(gc), pipe.timed(last0)
         rd_addr = pipe.at(addr0, stage_q - 2).value
-        bank_q = pipe.at(addr0, stage_q).value >> (geo.BANK_WORDS - 1).bit_length()
+        bank_q = pipe.at(addr0, stage_q).value >> (geo.bank_words - 1).bit_length()
         fresh_q = pipe.at(fresh_t, stage_q).value
         tail = stage_q + geo.TAIL_STAGES - 1  # the stage that writes back
         wr_addr = pipe.at(addr0, tail).value
@@ -515,6 +522,7 @@ def simulate(
     clear_before: Sequence[int] = (),
     threshold_updates: Mapping[int, np.ndarray] | None = None,
     idle_every: int = 0,
+    bank_words: int = StreamGeometry.BANK_WORDS,
 ) -> OutputBeats:
     """Run :class:`RvsmStreamArray` in ``amaranth.sim``; return every output beat.
 
@@ -524,19 +532,21 @@ def simulate(
     first segment) to thresholds written while the stream is paused at
     :meth:`StreamSchedule.threshold_pause_beat` ``(t)``. ``idle_every = k > 0`` drops
     ``valid`` for one cycle after every ``k``-th beat (a paused stream). Compare the
-    result with :func:`~rvsm.rtl.stream_schedule.check_beats`.
+    result with :func:`~rvsm.rtl.stream_schedule.check_beats`; its ``accepted`` holds,
+    per output beat, the index (within its segment) of the input beat that released it.
     """
     from amaranth.sim import Simulator
 
     c = contract
     codes = np.asarray(codes, dtype=np.int64)
-    dut = RvsmStreamArray(c, lanes)
+    StreamGeometry(c, lanes, bank_words)  # validate before building a component
+    dut = RvsmStreamArray(c, lanes, bank_words)
     sched = dut.schedule
     layout = dut.geometry.spike_layout
     fields = {name: (layout[name].offset, layout[name].width)
               for name in ("row", "group", "last", "pos", "neg")}
     updates = dict(threshold_updates or {})
-    got: dict[str, list[int]] = {k: [] for k in fields}
+    got: dict[str, list[int]] = {k: [] for k in (*fields, "accepted")}
 
     def thr_words(thr: np.ndarray) -> list[tuple[int, int, int]]:
         w = sched.threshold_words(np.asarray(thr, dtype=np.int64))
@@ -553,11 +563,12 @@ def simulate(
             await ctx.tick()
         ctx.set(dut.thr_write.en, 0)
 
-    def collect(ctx) -> None:  # noqa: ANN001
+    def collect(ctx, beat: int) -> None:  # noqa: ANN001
         if ctx.get(dut.spikes.valid):
             word = ctx.get(dut.spikes.payload.as_value())
             for k, (off, width) in fields.items():
                 got[k].append((word >> off) & ((1 << width) - 1))
+            got["accepted"].append(beat)
 
     async def bench(ctx) -> None:  # noqa: ANN001
         await write_thresholds(ctx, thresholds)
@@ -576,18 +587,18 @@ def simulate(
                 ctx.set(dut.codes.payload.as_value(), word)
                 ctx.set(dut.codes.valid, 1)
                 await ctx.tick()
-                collect(ctx)
+                collect(ctx, k)
                 if idle_every and (k + 1) % idle_every == 0:
                     ctx.set(dut.codes.valid, 0)
                     await ctx.tick()
-                    collect(ctx)
+                    collect(ctx, -1)
             ctx.set(dut.codes.valid, 0)
             await ctx.tick()
-            collect(ctx)
+            collect(ctx, -1)
 
     sim = Simulator(dut)
     sim.add_clock(1e-6)
     sim.add_testbench(bench)
     sim.run()
     return OutputBeats.from_words(got["row"], got["group"], got["last"], got["pos"],
-                                  got["neg"], c.num_scales, lanes)
+                                  got["neg"], c.num_scales, lanes, got["accepted"])

@@ -69,30 +69,38 @@ def unpack_bits(words: Sequence[int], bits: int) -> np.ndarray:
 @dataclass(frozen=True)
 class OutputBeats:
     """Received output beats: positions ``rows, groups (K,)``, ``last (K,) bool``,
-    spikes ``(K, S, P) int8`` (+1, -1, 0)."""
+    spikes ``(K, S, P) int8`` (+1, -1, 0); optionally ``accepted (K,)``, the index of
+    the input beat (from the stream's start) whose acceptance released each beat, -1
+    when it came in a cycle without an accepted beat."""
 
     rows: np.ndarray
     groups: np.ndarray
     last: np.ndarray
     spikes: np.ndarray
+    accepted: np.ndarray | None = None
 
     @classmethod
     def from_words(cls, rows: Sequence[int], groups: Sequence[int], last: Sequence[int],
                    pos: Sequence[int], neg: Sequence[int], num_scales: int,
-                   lanes: int) -> OutputBeats:
+                   lanes: int, accepted: Sequence[int] | None = None) -> OutputBeats:
         """From per-beat integers; bit ``s*P + i`` of ``pos``/``neg`` is scale s, lane i."""
         n = num_scales * lanes
         p = unpack_bits(pos, n).astype(np.int8)
         q = unpack_bits(neg, n).astype(np.int8)
         return cls(np.asarray(rows, dtype=np.int64), np.asarray(groups, dtype=np.int64),
                    np.asarray(last, dtype=bool),
-                   (p - q).reshape(len(rows), num_scales, lanes))
+                   (p - q).reshape(len(rows), num_scales, lanes),
+                   None if accepted is None else np.asarray(accepted, dtype=np.int64))
 
     @classmethod
     def concatenate(cls, parts: Sequence[OutputBeats]) -> OutputBeats:
         """The beats of several runs one after the other."""
-        return cls(*(np.concatenate([getattr(b, f) for b in parts])
-                     for f in ("rows", "groups", "last", "spikes")))
+        cols = [np.concatenate([getattr(b, f) for b in parts])
+                for f in ("rows", "groups", "last", "spikes")]
+        acc = None
+        if parts and all(b.accepted is not None for b in parts):
+            acc = np.concatenate([b.accepted for b in parts])
+        return cls(*cols, acc)
 
 
 @dataclass(frozen=True)

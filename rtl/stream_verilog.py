@@ -30,7 +30,7 @@ from amaranth.lib import data, wiring
 from rvsm.model.atomic import write_text_atomic
 from rvsm.model.fixed.core import ArrayContract
 
-from .stream_array import RvsmStreamArray
+from .stream_array import RvsmStreamArray, StreamGeometry
 from .verilog import GeneratedVerilog
 
 __all__ = [
@@ -92,7 +92,9 @@ def generate_stream_verilog(contract: ArrayContract, lanes: int, top: str = STRE
     """Verilog of ``RvsmStreamArray(contract, lanes)`` (or of ``dut``, built from them):
     no src attributes, no zero memory initialisers."""
     t0 = time.perf_counter()
-    dut = RvsmStreamArray(contract, lanes) if dut is None else dut
+    if dut is None:
+        StreamGeometry(contract, lanes)  # validate before building a component
+        dut = RvsmStreamArray(contract, lanes)
     # The always-ready output stream has a constant ``ready``: list the real ports.
     values = (Value.cast(v) for _, _, v in dut.signature.flatten(dut))
     ports = [v for v in values if isinstance(v, Signal)]
@@ -134,9 +136,9 @@ def stream_port_map(dut: RvsmStreamArray) -> list[dict]:
         {"name": "rst", "dir": "in", "width": 1,
          "desc": "synchronous reset: the state of a clear (memories untouched)"},
     ]
-    for path, member in dut.signature.members.flatten():
-        if not member.is_port:
-            continue
+    for path, member, value in dut.signature.flatten(dut):
+        if not isinstance(Value.cast(value), Signal):
+            continue  # e.g. the constant ``ready`` of the always-ready output stream
         shape = member.shape
         entry = {"name": "__".join(path),
                  "dir": "in" if member.flow == wiring.In else "out",
@@ -197,6 +199,7 @@ def write_stream_outputs(
 ) -> tuple[dict[str, Path], GeneratedVerilog]:
     """Write ``<top>.v``, ``<top>.ports.json`` and ``<top>.ports.md`` into ``out_dir``."""
     out = Path(out_dir)
+    StreamGeometry(contract, lanes)  # validate before building a component
     dut = RvsmStreamArray(contract, lanes)
     gen = generate_stream_verilog(contract, lanes, top, dut)
     paths = {

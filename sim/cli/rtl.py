@@ -20,7 +20,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("point", help="design point TOML")
     p.add_argument("-o", "--out", default="build", help="output folder (default: build)")
     p.add_argument("--size", metavar="HxW", help="override the array size")
-    p.add_argument("--top", default="rvsm_array", help="top module name")
+    p.add_argument("--top", help="top module name (default: rvsm_array, or "
+                   "rvsm_stream_array with --arch stream)")
+    p.add_argument("--arch", choices=("parallel", "stream"), default="parallel",
+                   help="fully parallel array (small in-pixel designs) or the "
+                   "lane-parallel streaming array (sensor size)")
+    p.add_argument("--lanes", type=int, default=1,
+                   help="pixels per beat of the streaming array (divides the width)")
     p.add_argument("--lint", action="store_true", help="run verilator --lint-only")
     p.add_argument("--stats", action="store_true",
                    help="synthesise with yosys (synth; stat) and print cells/flip-flops")
@@ -54,10 +60,17 @@ def _verilog(args: argparse.Namespace) -> int:
     if size is not None:
         point = point.with_size(*size)
     contract = point.contract()
-    if max(contract.height, contract.width) > 64:
-        print(f"rvsm: note: a {contract.height}x{contract.width} fully parallel array "
-              "takes long to generate; consider --size", file=sys.stderr)
-    paths, gen = write_outputs(contract, args.out, args.top)
+    if args.arch == "stream":
+        from rvsm.rtl.stream_verilog import STREAM_TOP, write_stream_outputs
+
+        args.top = args.top or STREAM_TOP
+        paths, gen = write_stream_outputs(contract, args.lanes, args.out, args.top)
+    else:
+        args.top = args.top or "rvsm_array"
+        if max(contract.height, contract.width) > 64:
+            print(f"rvsm: note: a {contract.height}x{contract.width} fully parallel array "
+                  "takes long to generate; consider --size or --arch stream", file=sys.stderr)
+        paths, gen = write_outputs(contract, args.out, args.top)
     print(f"wrote {paths['verilog']} ({gen.seconds:.1f} s), {paths['ports_json']}, "
           f"{paths['ports_md']}; latency {gen.latency} cycle(s)")
     if args.lint:

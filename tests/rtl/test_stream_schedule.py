@@ -1,0 +1,108 @@
+"""The numpy beat schedule: oracle tests against explicit loops, and the checker."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rvsm.rtl.stream_schedule import (
+    OutputBeats,
+    StreamSchedule,
+    check_beats,
+    pack_lanes,
+    unpack_bits,
+)
+
+
+@pytest.fixture
+def sched() -> StreamSchedule:
+    return StreamSchedule(height=3, width=6, lanes=2, lag=5, threshold_lag=2)
+
+
+def test_beat_order_is_raster(sched: StreamSchedule) -> None:
+    codes = np.arange(2 * 3 * 6).reshape(2, 3, 6)
+    beats = sched.frame_beats(codes)
+    k = 0
+    for t in range(2):
+        for y in range(3):
+            for g in range(3):
+                assert list(beats[k]) == [codes[t, y, g * 2 + i] for i in range(2)]
+                k += 1
+    full = sched.input_beats(codes)
+    assert full.shape == (2 * 9 + sched.lag, 2)
+    assert not full[18:].any()
+
+
+def test_expected_beats_oracle_and_round_trip(sched: StreamSchedule) -> None:
+    rng = np.random.default_rng(1)
+    spikes = rng.integers(-1, 2, (2, 3, 3, 6)).astype(np.int8)
+    beats = sched.expected_beats(spikes)
+    rows, groups = sched.positions(len(beats))
+    for k in range(len(beats)):
+        t = k // sched.beats_per_frame
+        for s in range(3):
+            for i in range(2):
+                assert beats[k, s, i] == spikes[t, s, rows[k], groups[k] * 2 + i]
+    assert np.array_equal(sched.spikes_from_beats(beats), spikes)
+    with pytest.raises(ValueError, match="whole frames"):
+        sched.spikes_from_beats(beats[:-1])
+
+
+def test_threshold_words_and_pause(sched: StreamSchedule) -> None:
+    thr = np.arange(2 * 3 * 6).reshape(2, 3, 6)
+    words = sched.threshold_words(thr)
+    assert words.shape == (2, 9, 2)
+    assert list(words[1, 4]) == [thr[1, 1, 2], thr[1, 1, 3]]  # address y*G + g = 1*3 + 1
+    assert sched.threshold_pause_beat(2) == 2 * 9 + sched.threshold_lag
+    assert sched.release_beat(4) == 4 + sched.lag
+
+
+def test_segments() -> None:
+    assert StreamSchedule.segments(7, (5, 2, 0, 9)) == [(0, 2), (2, 5), (5, 7)]
+    assert StreamSchedule.segments(3) == [(0, 3)]
+
+
+def test_lanes_must_divide_width() -> None:
+    with pytest.raises(ValueError, match="divide"):
+        StreamSchedule(3, 6, 4, lag=1)
+
+
+def test_pack_unpack_round_trip() -> None:
+    rng = np.random.default_rng(2)
+    vals = rng.integers(0, 1 << 7, (5, 9))
+    words = pack_lanes(vals, 7)
+    for row, w in zip(vals, words, strict=True):
+        assert w == sum(int(v) << (7 * i) for i, v in enumerate(row))
+    bits = unpack_bits(words, 63)
+    back = (bits.reshape(5, 9, 7) << np.arange(7)).sum(axis=2)
+    assert np.array_equal(back, vals)
+
+
+def _beats(sched: StreamSchedule, spikes: np.ndarray) -> OutputBeats:
+    b = sched.expected_beats(spikes)
+    rows, groups = sched.positions(len(b))
+    last = (rows == sched.height - 1) & (groups == sched.groups - 1)
+    return OutputBeats(rows, groups, last, b)
+
+
+def test_checker_passes_and_catches(sched: StreamSchedule) -> None:
+    rng = np.random.default_rng(3)
+    spikes = rng.integers(-1, 2, (2, 2, 3, 6)).astype(np.int8)
+    good = _beats(sched, spikes)
+    ok = check_beats(sched, spikes, good)
+    assert ok["mismatches"] == 0 and ok["compared"] == spikes.size
+
+    wrong = spikes.copy()
+    wrong[1, 0, 2, 5] = 1 - abs(wrong[1, 0, 2, 5])
+    bad = check_beats(sched, wrong, good)
+    assert bad["mismatches"] == 1
+    assert bad["first_mismatch"] == {"step": 1, "scale": 0, "row": 2, "column": 5,
+                                     "expected": int(wrong[1, 0, 2, 5]),
+                                     "got": int(spikes[1, 0, 2, 5])}
+
+    swapped = OutputBeats(good.rows[::-1].copy(), good.groups, good.last, good.spikes)
+    assert check_beats(sched, spikes, swapped)["mismatches"] > 0
+
+    short = OutputBeats(good.rows[:-1], good.groups[:-1], good.last[:-1], good.spikes[:-1])
+    res = check_beats(sched, spikes, short)
+    assert res["mismatches"] == 2 * 2 and "received 17 beats" in res["mismatch_list"][0]["error"]
