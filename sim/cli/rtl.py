@@ -48,6 +48,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--waves", action="store_true", help="keep a waveform (FST/VCD)")
     p.add_argument("--work", default="build/verify", help="build/run folder")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--arch", choices=("parallel", "stream"), default="parallel",
+                   help="verify the fully parallel or the streaming array")
+    p.add_argument("--lanes", type=int, default=1, help="lanes of the streaming array")
     p.set_defaults(func=_verify)
 
 

@@ -1,0 +1,147 @@
+"""cocotb 2.x testbench: the streaming array against the fixed twin, beat for beat.
+
+Inputs (environment, or ``+rvsm_<name>=`` plusargs): ``RVSM_STIMULUS`` -- an ``.npz``
+with ``codes (T,H,W)``, ``thresholds (S,H,W)``, ``expected (T,S,H,W) int8`` and
+``clear_before``; ``RVSM_PORTS`` -- the build's ``<top>.ports.json`` (timing properties
+and payload bit fields, derived from the component); ``RVSM_RESULT`` -- where the JSON
+result goes.
+
+cocotb runs everything from Python, one clock cycle at a time (inputs driven on the
+falling edge): reset; every threshold word through ``thr_write``; then per segment
+between clears (:meth:`StreamSchedule.segments`) the frames as back-to-back beats, the
+``lag`` flush beats and one ``clear`` cycle. Every cycle with ``spikes__valid`` high
+records one output beat; at the end :func:`~rvsm.rtl.stream_schedule.check_beats` (the
+schedule model's checker) compares positions and spikes with the expectation. The
+per-cycle cost is a few handle accesses on vectors of a few hundred bits, so Python is
+not the bottleneck at sensor size (the result reports cycles per second).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+
+import cocotb
+import numpy as np
+from cocotb.clock import Clock
+from cocotb.simtime import get_sim_time
+from cocotb.triggers import FallingEdge
+
+from rvsm.rtl.stream_schedule import OutputBeats, StreamSchedule, check_beats, pack_lanes
+
+
+def _arg(name: str) -> str:
+    """Environment variable ``RVSM_<NAME>`` or plusarg ``+rvsm_<name>=``."""
+    plus = cocotb.plusargs.get(f"rvsm_{name}")
+    value = plus if isinstance(plus, str) else os.environ.get(f"RVSM_{name.upper()}")
+    if not value:
+        raise RuntimeError(f"set RVSM_{name.upper()} or +rvsm_{name}=")
+    return value
+
+
+def _bits(value: object) -> tuple[int, int]:
+    """A logic vector as ``(int with X/Z as 0, mask of X/Z bits)``."""
+    s = str(value)
+    if set(s) <= {"0", "1"}:
+        return int(s, 2), 0
+    clean = "".join(ch if ch in "01" else "0" for ch in s)
+    xmask = "".join("0" if ch in "01" else "1" for ch in s)
+    return int(clean, 2), int(xmask, 2)
+
+
+@cocotb.test()
+async def stream_matches_fixed_twin(dut: object) -> None:
+    """Stream every step, compare every output beat with the fixed twin's expectation."""
+    stim = np.load(_arg("stimulus"))
+    ports = json.loads(open(_arg("ports"), encoding="utf-8").read())
+    result_path = _arg("result")
+    codes = stim["codes"]
+    thresholds = stim["thresholds"]
+    expected = stim["expected"].astype(np.int8)
+    clears = [int(t) for t in stim["clear_before"]] if "clear_before" in stim else []
+    adc_bits = int(stim["adc_bits"])
+    steps, scales, height, width = expected.shape
+    timing = ports["timing"]
+    lanes = int(timing["lanes"])
+    sched = StreamSchedule(height, width, lanes, int(timing["lag"]),
+                           int(timing["threshold_lag"]))
+    by_name = {p["name"]: p for p in ports["ports"]}
+    fields = {f["name"]: (f["offset"], f["width"])
+              for f in by_name["spikes__payload"]["fields"]}
+    thr_bits = by_name["thr_write__data"]["width"] // lanes
+
+    clk = dut.clk  # type: ignore[attr-defined]
+    d = {name: getattr(dut, name) for name in (
+        "rst", "clear", "codes__valid", "codes__payload", "thr_write__en",
+        "thr_write__scale", "thr_write__addr", "thr_write__data", "spikes__valid",
+        "spikes__payload")}
+    cocotb.start_soon(Clock(clk, 10, unit="ns").start())
+    for name in ("rst", "clear", "codes__valid", "codes__payload", "thr_write__en",
+                 "thr_write__scale", "thr_write__addr", "thr_write__data"):
+        d[name].value = 1 if name == "rst" else 0
+    await FallingEdge(clk)
+    await FallingEdge(clk)
+    d["rst"].value = 0
+
+    t0 = time.perf_counter()
+    cycles = 0
+    words = sched.threshold_words(thresholds)
+    packed = pack_lanes(words.reshape(-1, lanes), thr_bits)
+    d["thr_write__en"].value = 1
+    for s in range(scales):
+        d["thr_write__scale"].value = s
+        for a in range(sched.beats_per_frame):
+            d["thr_write__addr"].value = a
+            d["thr_write__data"].value = packed[s * sched.beats_per_frame + a]
+            await FallingEdge(clk)
+            cycles += 1
+    d["thr_write__en"].value = 0
+
+    got: dict[str, list[int]] = {k: [] for k in fields}
+    x_beats: list[int] = []
+    out_valid, out_payload = d["spikes__valid"], d["spikes__payload"]
+    in_payload = d["codes__payload"]
+    for seg, (a, b) in enumerate(sched.segments(steps, clears)):
+        if seg:
+            d["clear"].value = 1
+            await FallingEdge(clk)
+            cycles += 1
+            d["clear"].value = 0
+        beats = pack_lanes(sched.input_beats(codes[a:b]), adc_bits)
+        d["codes__valid"].value = 1
+        for word in beats:
+            in_payload.value = word
+            await FallingEdge(clk)
+            cycles += 1
+            if str(out_valid.value) == "1":
+                value, xmask = _bits(out_payload.value)
+                if xmask:
+                    x_beats.append(len(got["row"]))
+                for k, (off, w) in fields.items():
+                    got[k].append((value >> off) & ((1 << w) - 1))
+        d["codes__valid"].value = 0
+    stream_seconds = time.perf_counter() - t0
+
+    out = OutputBeats.from_words(got["row"], got["group"], got["last"], got["pos"],
+                                 got["neg"], scales, lanes)
+    result = check_beats(sched, expected, out)
+    if x_beats:
+        result["mismatches"] += len(x_beats)
+        result["mismatch_list"].insert(0, {"beat": x_beats[0],
+                                           "error": f"X/Z in {len(x_beats)} output beat(s)"})
+        result["first_mismatch"] = result["mismatch_list"][0]
+    result.update({
+        "steps": steps,
+        "accumulators": scales * height * width,
+        "expected_spikes": int(np.count_nonzero(expected)),
+        "lanes": lanes,
+        "cycles": cycles,
+        "cycles_per_second": cycles / stream_seconds if stream_seconds else None,
+        "stream_seconds": stream_seconds,
+        "sim_time_ns": int(get_sim_time("ns")),
+    })
+    with open(result_path, "w", encoding="utf-8") as f:
+        json.dump(result, f)
+    assert result["mismatches"] == 0, \
+        f"{result['mismatches']} mismatches; first {result['first_mismatch']}"
