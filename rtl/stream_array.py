@@ -31,15 +31,18 @@ read-modify-write needs no forwarding as long as ``H*G > rmw_depth`` (checked).
 
 **Streams.** ``codes`` (:func:`code_beat_signature`): ``payload`` lane ``i`` = pixel
 ``(y, g*P + i)``; a beat is accepted at a rising edge with ``valid & ready``; ``ready``
-is low only while ``clear`` is high. The whole pipeline advances on accepted beats only
-(a clock enable), so a paused input holds everything in flight. ``spikes``
+is low only while ``clear`` is high. Accepted beats and ``clear`` pass an input
+register (no combinational path from the ports into the datapath), and the whole
+pipeline advances once per accepted beat, at the edge after its acceptance (a clock
+enable), so a paused input holds everything in flight. ``spikes``
 (:func:`spike_beat_signature`, no back-pressure): ``valid`` is high for the one cycle
 after the edge that releases a position; ``payload.row``/``group`` is the position,
 ``last`` marks the frame's last beat, bit ``s*P + i`` of ``pos``/``neg`` the +1/-1
 spike of accumulator ``(s, y, g*P + i)``. The output of position ``p`` (beats counted
-from the last clear) is released by input beat ``p + lag``; to drain a stream, send
-``lag`` more beats (any codes). :mod:`rvsm.rtl.stream_schedule` is the numpy model of
-this schedule.
+from the last clear) is released by input beat ``p + lag``: it is presented in the
+second cycle after that beat's acceptance. To drain a stream, send ``lag`` more beats
+(any codes) and wait one more cycle. :mod:`rvsm.rtl.stream_schedule` is the numpy model
+of this schedule.
 
 **Frame-boundary meaning of the controls.**
 
@@ -51,8 +54,9 @@ this schedule.
   equals :meth:`ArrayContract.run` restarted at that frame.
 * ``thr_write`` (``en``, ``scale``, ``addr = y*G + g``, ``data`` = P thresholds, lane
   ``i`` at ``[i*(W-1) +: W-1]``): writes one threshold word at the rising edge, at any
-  time. Position ``p`` reads its thresholds at the edge accepting input beat ``p +
-  threshold_lag`` (a write at that same edge is not seen). So thresholds written while
+  time. Position ``p`` reads its thresholds at the edge after the one accepting input
+  beat ``p + threshold_lag`` (a write at that same edge is not seen). So thresholds
+  written while
   the stream is paused after ``t*H*G + threshold_lag`` accepted beats apply exactly from
   frame ``t`` on (:meth:`StreamSchedule.threshold_pause_beat`); written after a clear
   and before the first beat (as a loader does), they apply from frame 0. The threshold
@@ -144,6 +148,8 @@ class StreamGeometry:
     BANK_WORDS = 1024
     #: Stages from the sums' register to the output register: add, compare, reset.
     TAIL_STAGES = 3
+    #: Registers between the input ports and the datapath (accepted beat, clear).
+    INPUT_STAGES = 1
 
     def __init__(self, contract: ArrayContract, lanes: int = 1,
                  bank_words: int = BANK_WORDS):
@@ -181,13 +187,14 @@ class StreamGeometry:
 
     @property
     def latency(self) -> int:
-        """Clock cycles from accepting beat ``p + window_lag`` to ``p``'s output, when
-        beats are back to back (= :attr:`pipeline_depth`)."""
-        return self.pipeline_depth
+        """Clock cycles from the edge accepting beat ``p + window_lag`` to the edge
+        presenting ``p``'s output, when beats are back to back."""
+        return self.INPUT_STAGES + self.pipeline_depth
 
     @property
     def lag(self) -> int:
-        """Output ``p`` is presented right after input beat ``p + lag`` is accepted."""
+        """Output ``p`` is released by input beat ``p + lag`` (presented in the second
+        cycle after that beat's acceptance)."""
         return self.window_lag + self.pipeline_depth
 
     @property
@@ -197,7 +204,8 @@ class StreamGeometry:
 
     @property
     def threshold_lag(self) -> int:
-        """Position ``p`` reads its thresholds at the edge accepting beat ``p + this``."""
+        """Position ``p`` reads its thresholds at the edge after the one accepting input
+        beat ``p + threshold_lag``."""
         return self.window_lag + self.sum_stage - 1
 
     @property
@@ -349,16 +357,21 @@ class RvsmStreamArray(wiring.Component):
         words = geo.beats_per_frame
         wa = c.accumulator_bits
 
-        advance = Signal()
-        m.d.comb += [self.codes.ready.eq(~self.clear),
-                     advance.eq(self.codes.valid & ~self.clear)]
+        # Input register: an accepted beat (and clear) acts one cycle later, so no
+        # combinational path runs from the ports into the datapath.
+        m.d.comb += self.codes.ready.eq(~self.clear)
+        advance = Signal(name="advance")
+        clear = Signal(name="clear_r")
+        codes_in = Signal(unsigned(p * n), name="codes_r")
+        m.d.sync += [advance.eq(self.codes.valid & ~self.clear), clear.eq(self.clear)]
+        with m.If(self.codes.valid & ~self.clear):
+            m.d.sync += codes_in.eq(self.codes.payload.as_value())
 
         # -- line buffer: word = 2L rows of P codes, row 0 the most recent -----------------
         row_bits = p * n
-        codes_in = self.codes.payload.as_value()
         g_in = Signal(range(g_count), name="in_group")
         g_in_next = Mux(g_in == g_count - 1, 0, g_in + 1)
-        with m.If(self.clear):
+        with m.If(clear):
             m.d.sync += g_in.eq(0)
         with m.Elif(advance):
             m.d.sync += g_in.eq(g_in_next)
@@ -373,8 +386,8 @@ class RvsmStreamArray(wiring.Component):
             m.submodules.line_buffer = lb
             wp, rp = lb.write_port(), lb.read_port()
             stored = rp.data
-            m.d.comb += [rp.addr.eq(Mux(self.clear, 0, g_in_next)),
-                         rp.en.eq(advance | self.clear),
+            m.d.comb += [rp.addr.eq(Mux(clear, 0, g_in_next)),
+                         rp.en.eq(advance | clear),
                          wp.addr.eq(g_in), wp.en.eq(advance),
                          wp.data.eq(Cat(codes_in, stored[:(2 * r - 1) * row_bits]))]
         # slab row d (0 = oldest, 2L = the input row): line-buffer row 2L-1-d
@@ -398,7 +411,7 @@ class RvsmStreamArray(wiring.Component):
         step = advance & primed & valid0
         g_end = gc == g_count - 1
         ny, ng, na = Signal.like(yc), Signal.like(gc), Signal.like(ac)
-        with m.If(self.clear):
+        with m.If(clear):
             m.d.comb += [ny.eq(0), ng.eq(0), na.eq(0)]
             m.d.sync += [prime.eq(0), valid0.eq(0), fresh0.eq(1)]
         with m.Else():
@@ -450,7 +463,7 @@ class RvsmStreamArray(wiring.Component):
         valid = [valid0]
         for s in range(1, stage_q + geo.TAIL_STAGES):
             v = Signal(name=f"valid_s{s}")
-            with m.If(self.clear):
+            with m.If(clear):
                 m.d.sync += v.eq(0)
             with m.Elif(advance):
                 m.d.sync += v.eq(valid[-1])
@@ -533,7 +546,8 @@ def simulate(
     :meth:`StreamSchedule.threshold_pause_beat` ``(t)``. ``idle_every = k > 0`` drops
     ``valid`` for one cycle after every ``k``-th beat (a paused stream). Compare the
     result with :func:`~rvsm.rtl.stream_schedule.check_beats`; its ``accepted`` holds,
-    per output beat, the index (within its segment) of the input beat that released it.
+    per output beat, the index (within its segment) of the input beat accepted two
+    cycles before it was presented, the beat that released it.
     """
     from amaranth.sim import Simulator
 
@@ -563,12 +577,16 @@ def simulate(
             await ctx.tick()
         ctx.set(dut.thr_write.en, 0)
 
+    accepted = [-1, -1]  # beats accepted at the previous and at the latest edge
+
     def collect(ctx, beat: int) -> None:  # noqa: ANN001
+        """After an edge that accepted ``beat`` (-1: none), record a presented output."""
+        accepted[:] = [accepted[1], beat]
         if ctx.get(dut.spikes.valid):
             word = ctx.get(dut.spikes.payload.as_value())
             for k, (off, width) in fields.items():
                 got[k].append((word >> off) & ((1 << width) - 1))
-            got["accepted"].append(beat)
+            got["accepted"].append(accepted[0])
 
     async def bench(ctx) -> None:  # noqa: ANN001
         await write_thresholds(ctx, thresholds)
@@ -576,6 +594,7 @@ def simulate(
             if seg:
                 ctx.set(dut.clear, 1)
                 await ctx.tick()
+                collect(ctx, -1)
                 ctx.set(dut.clear, 0)
             beats = pack_lanes(sched.input_beats(codes[a:b]), c.adc_bits)
             pauses = {sched.threshold_pause_beat(t): thr for t, thr in updates.items()} \
@@ -583,6 +602,8 @@ def simulate(
             for k, word in enumerate(beats):
                 if k in pauses:
                     ctx.set(dut.codes.valid, 0)
+                    await ctx.tick()
+                    collect(ctx, -1)
                     await write_thresholds(ctx, pauses[k])
                 ctx.set(dut.codes.payload.as_value(), word)
                 ctx.set(dut.codes.valid, 1)
@@ -593,8 +614,9 @@ def simulate(
                     await ctx.tick()
                     collect(ctx, -1)
             ctx.set(dut.codes.valid, 0)
-            await ctx.tick()
-            collect(ctx, -1)
+            for _ in range(2):
+                await ctx.tick()
+                collect(ctx, -1)
 
     sim = Simulator(dut)
     sim.add_clock(1e-6)

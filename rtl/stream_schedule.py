@@ -9,17 +9,19 @@
   order, one per position ``(t, y, g)``, carrying ``S*P`` spikes (scale ``s``, lane
   ``i`` = accumulator ``(s, y, g*P + i)``) and the position ``(y, g)``.
 * **Lag.** The output of position ``p`` (a beat index in the same numbering) is
-  presented in the clock cycle right after input beat ``p + lag`` is accepted
-  (:attr:`StreamSchedule.lag`, the array's ``lag`` property). The pipeline advances only
-  on accepted beats, so a paused stream holds every position in flight.
+  released by input beat ``p + lag`` (:attr:`StreamSchedule.lag`, the array's ``lag``
+  property): it is presented in the second clock cycle after that beat is accepted (the
+  input register takes one). The pipeline advances only on accepted beats, so a paused
+  stream holds every position in flight.
 * **Flush.** So the last ``lag`` positions of a stream come out only after ``lag`` more
-  beats: :meth:`input_beats` appends ``lag`` zero beats. Their codes never reach the
-  released outputs (they lie below the last frame, where the window is zero-padded).
+  beats (and one more cycle): :meth:`input_beats` appends ``lag`` zero beats. Their
+  codes never reach the released outputs (they lie below the last frame, where the
+  window is zero-padded).
 * **Clear.** ``clear`` restarts the stream at position 0 with every accumulator zero; a
   run with clears is a list of :meth:`segments`, each streamed and flushed on its own.
-* **Thresholds** of position ``p`` are read when input beat ``p + threshold_lag`` is
-  accepted; :meth:`threshold_pause_beat` gives where to pause the stream so that new
-  thresholds apply from a given frame on.
+* **Thresholds** of position ``p`` are read one edge after input beat
+  ``p + threshold_lag`` is accepted; :meth:`threshold_pause_beat` gives where to pause
+  the stream so that new thresholds apply from a given frame on.
 
 :meth:`expected_beats` turns :meth:`ArrayContract.run` spikes ``(T, S, H, W)`` into the
 beats the array must emit; :meth:`spikes_from_beats` turns beats back; :func:`check_beats`
@@ -171,7 +173,7 @@ class StreamSchedule:
         return thr.reshape(thr.shape[0], self.beats_per_frame, self.lanes)
 
     def release_beat(self, position: int) -> int:
-        """Index of the input beat whose acceptance presents output ``position``."""
+        """Index of the input beat that releases output ``position``."""
         return position + self.lag
 
     def threshold_pause_beat(self, frame: int) -> int:

@@ -117,6 +117,9 @@ def _verify(args: argparse.Namespace) -> int:
         if r["mismatches"]:
             f = r["first_mismatch"] or {}
             print("first mismatch: " + ", ".join(f"{k}={v}" for k, v in f.items()))
+        if r.get("cycles_per_second"):
+            print(f"stream: {r['lanes']} lane(s), {r['cycles']} cycles at "
+                  f"{r['cycles_per_second']:.0f} cycles/s (build {r['build_seconds']:.0f} s)")
         if r["waves"]:
             print(f"waveform kept: {r['waves']}")
     return 1 if r["mismatches"] else 0

@@ -9,7 +9,7 @@ result goes.
 cocotb runs everything from Python, one clock cycle at a time (inputs driven on the
 falling edge): reset; every threshold word through ``thr_write``; then per segment
 between clears (:meth:`StreamSchedule.segments`) the frames as back-to-back beats, the
-``lag`` flush beats and one ``clear`` cycle. Every cycle with ``spikes__valid`` high
+``lag`` flush beats, one idle cycle and one ``clear`` cycle. Every cycle with ``spikes__valid`` high
 records one output beat; at the end :func:`~rvsm.rtl.stream_schedule.check_beats` (the
 schedule model's checker) compares positions and spikes with the expectation. The
 per-cycle cost is a few handle accesses on vectors of a few hundred bits, so Python is
@@ -102,11 +102,21 @@ async def stream_matches_fixed_twin(dut: object) -> None:
     x_beats: list[int] = []
     out_valid, out_payload = d["spikes__valid"], d["spikes__payload"]
     in_payload = d["codes__payload"]
+
+    def record() -> None:
+        """After a falling edge: record the output beat presented, if any."""
+        if str(out_valid.value) == "1":
+            value, xmask = _bits(out_payload.value)
+            if xmask:
+                x_beats.append(len(got["row"]))
+            for k, (off, w) in fields.items():
+                got[k].append((value >> off) & ((1 << w) - 1))
     for seg, (a, b) in enumerate(sched.segments(steps, clears)):
         if seg:
             d["clear"].value = 1
             await FallingEdge(clk)
             cycles += 1
+            record()
             d["clear"].value = 0
         beats = pack_lanes(sched.input_beats(codes[a:b]), adc_bits)
         d["codes__valid"].value = 1
@@ -114,13 +124,11 @@ async def stream_matches_fixed_twin(dut: object) -> None:
             in_payload.value = word
             await FallingEdge(clk)
             cycles += 1
-            if str(out_valid.value) == "1":
-                value, xmask = _bits(out_payload.value)
-                if xmask:
-                    x_beats.append(len(got["row"]))
-                for k, (off, w) in fields.items():
-                    got[k].append((value >> off) & ((1 << w) - 1))
+            record()
         d["codes__valid"].value = 0
+        await FallingEdge(clk)  # the last released beat is presented one cycle later
+        cycles += 1
+        record()
     stream_seconds = time.perf_counter() - t0
 
     out = OutputBeats.from_words(got["row"], got["group"], got["last"], got["pos"],

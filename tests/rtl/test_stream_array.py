@@ -146,8 +146,9 @@ def test_output_released_after_lag_beats() -> None:
     geo = StreamGeometry(c, 2)
     got = simulate(c, codes, thr, 2)
     assert np.array_equal(got.accepted, np.arange(len(got.accepted)) + geo.lag)
-    assert geo.lag == geo.window_lag + geo.latency
-    assert geo.threshold_lag == geo.lag - geo.rmw_depth
+    # back to back, beat p + window_lag is accepted at edge p + window_lag and output p
+    # is presented by edge p + lag + 1 (the second cycle after beat p + lag's edge)
+    assert geo.latency == geo.lag + 1 - geo.window_lag
 
 
 def test_checker_catches_wrong_expectation() -> None:
