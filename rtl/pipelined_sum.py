@@ -129,16 +129,18 @@ class Pipeline:
 
     ``m`` is the module to add registers to, or ``None`` to plan only (values are
     ``None`` then). :meth:`emit` adds every register to ``m`` once building is done.
+    Registers are data: reset-less unless ``reset_less=False``.
     """
 
     def __init__(self, m: Module | None, enable: Value | None = None,
-                 levels_per_stage: int = 2, name: str = "p"):
+                 levels_per_stage: int = 2, name: str = "p", reset_less: bool = True):
         if levels_per_stage < 1:
             raise ValueError("levels_per_stage must be >= 1")
         self.m = m
         self.enable = enable
         self.levels_per_stage = levels_per_stage
         self.name = name
+        self.reset_less = reset_less
         self.registers = 0
         self._pending: list[tuple[Signal, Value]] = []
         self._seq = itertools.count()
@@ -159,7 +161,7 @@ class Pipeline:
             if self.planning:
                 value = None
             else:
-                reg = Signal(unsigned(len(t.value)),
+                reg = Signal(unsigned(len(t.value)), reset_less=self.reset_less,
                              name=name or f"{self.name}_r{self.registers}")
                 self._pending.append((reg, t.value))
                 value = reg

@@ -339,7 +339,7 @@ class RvsmStreamArray(wiring.Component):
             rp = mem.read_port()
             m.d.comb += [rp.addr.eq(read_addr[:offset_bits] if banked else read_addr),
                          rp.en.eq(advance)]
-            reg = Signal(unsigned(width), name=f"{name}_b{b}_q")
+            reg = Signal(unsigned(width), name=f"{name}_b{b}_q", reset_less=True)
             with m.If(advance):
                 m.d.sync += reg.eq(rp.data)
             outs.append(reg)
@@ -358,11 +358,13 @@ class RvsmStreamArray(wiring.Component):
         wa = c.accumulator_bits
 
         # Input register: an accepted beat (and clear) acts one cycle later, so no
-        # combinational path runs from the ports into the datapath.
+        # combinational path runs from the ports into the datapath. Datapath registers
+        # are reset-less (only control state and valid bits are reset): less reset
+        # fan-out, and no next-state logic of the datapath depends on the ``rst`` port.
         m.d.comb += self.codes.ready.eq(~self.clear)
         advance = Signal(name="advance")
         clear = Signal(name="clear_r")
-        codes_in = Signal(unsigned(p * n), name="codes_r")
+        codes_in = Signal(unsigned(p * n), name="codes_r", reset_less=True)
         m.d.sync += [advance.eq(self.codes.valid & ~self.clear), clear.eq(self.clear)]
         with m.If(self.codes.valid & ~self.clear):
             m.d.sync += codes_in.eq(self.codes.payload.as_value())
@@ -378,7 +380,7 @@ class RvsmStreamArray(wiring.Component):
         if r == 0:
             stored = Const(0, 0)
         elif g_count == 1:
-            stored = Signal(unsigned(2 * r * row_bits), name="line_buffer")
+            stored = Signal(unsigned(2 * r * row_bits), name="line_buffer", reset_less=True)
             with m.If(advance):
                 m.d.sync += stored.eq(Cat(codes_in, stored[:(2 * r - 1) * row_bits]))
         else:
@@ -393,7 +395,8 @@ class RvsmStreamArray(wiring.Component):
         # slab row d (0 = oldest, 2L = the input row): line-buffer row 2L-1-d
         slab = Cat(*[stored[(2 * r - 1 - d) * row_bits:(2 * r - d) * row_bits]
                      for d in range(2 * r)], codes_in)
-        slabs = [Signal(unsigned(len(slab)), name=f"slab{k}") for k in range(2 * e + 1)]
+        slabs = [Signal(unsigned(len(slab)), name=f"slab{k}", reset_less=True)
+                 for k in range(2 * e + 1)]
         with m.If(advance):
             m.d.sync += slabs[0].eq(slab)
             m.d.sync += [slabs[k].eq(slabs[k - 1]) for k in range(1, len(slabs))]
@@ -496,11 +499,14 @@ class RvsmStreamArray(wiring.Component):
             for i in range(p):
                 acc = Mux(fresh_q, 0, acc_q[i * wa:(i + 1) * wa].as_signed())
                 shifted = sums[i][s].value.as_signed() >> c.shift
-                total = Signal(signed(max(wa, len(shifted)) + 1), name=f"total_s{s}_l{i}")
-                thr1 = Signal(unsigned(tw), name=f"thr1_s{s}_l{i}")
-                sat = Signal(signed(wa), name=f"sat_s{s}_l{i}")
-                thr2 = Signal(unsigned(tw), name=f"thr2_s{s}_l{i}")
-                pos, neg = Signal(name=f"pos_s{s}_l{i}"), Signal(name=f"neg_s{s}_l{i}")
+                data = {"reset_less": True}
+                total = Signal(signed(max(wa, len(shifted)) + 1), name=f"total_s{s}_l{i}",
+                               **data)
+                thr1 = Signal(unsigned(tw), name=f"thr1_s{s}_l{i}", **data)
+                sat = Signal(signed(wa), name=f"sat_s{s}_l{i}", **data)
+                thr2 = Signal(unsigned(tw), name=f"thr2_s{s}_l{i}", **data)
+                pos = Signal(name=f"pos_s{s}_l{i}", **data)
+                neg = Signal(name=f"neg_s{s}_l{i}", **data)
                 fire_pos = total >= thr1
                 fire_neg = (~fire_pos & (total <= -thr1)) if c.signed else Const(0)
                 tail_stmts += [
