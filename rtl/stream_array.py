@@ -52,8 +52,9 @@ of this schedule.
   swept; that frame's read-modify-write overwrites each word). Thresholds are kept.
   The domain reset does the same. ``clear`` between frames, after draining, therefore
   equals :meth:`ArrayContract.run` restarted at that frame.
-* ``thr_write`` (``en``, ``scale``, ``addr = y*G + g``, ``data`` = P thresholds, lane
-  ``i`` at ``[i*(W-1) +: W-1]``): writes one threshold word at the rising edge, at any
+* ``thr`` (the shared :class:`~rvsm.rtl.interfaces.ThresholdWriteSignature`: ``we``,
+  ``addr = (s << word_bits) | (y*G + g)``, ``data`` = P thresholds, lane ``i`` at
+  ``[i*(W-1) +: W-1]``): writes one threshold word at the rising edge, at any
   time. Position ``p`` reads its thresholds at the edge after the one accepting input
   beat ``p + threshold_lag`` (a write at that same edge is not seen). So thresholds
   written while
@@ -79,6 +80,7 @@ from amaranth.lib.wiring import In, Out
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
 
+from .interfaces import ThresholdWriteSignature
 from .pipelined_sum import Pipeline, Timed, kernel_orbits, kernel_radius, orbit_terms
 from .receptive_sum import sum_width
 from .stream_schedule import OutputBeats, StreamSchedule, pack_lanes
@@ -90,6 +92,7 @@ __all__ = [
     "simulate",
     "spike_beat_layout",
     "spike_beat_signature",
+    "threshold_word_bits",
     "threshold_write_signature",
 ]
 
@@ -117,21 +120,27 @@ def spike_beat_layout(num_scales: int, lanes: int, height: int,
 
 
 def spike_beat_signature(num_scales: int, lanes: int, height: int,
-                         groups: int) -> stream.Signature:
-    """Output stream of :func:`spike_beat_layout` beats, without back-pressure."""
-    return stream.Signature(spike_beat_layout(num_scales, lanes, height, groups),
-                            always_ready=True)
+                         groups: int) -> wiring.Signature:
+    """Output stream of :func:`spike_beat_layout` beats: ``payload`` and ``valid``, no
+    ``ready`` (a sensor cannot be stopped: there is no back-pressure)."""
+    return wiring.Signature({
+        "payload": Out(spike_beat_layout(num_scales, lanes, height, groups)),
+        "valid": Out(1),
+    })
+
+
+def threshold_word_bits(words: int) -> int:
+    """Bits of the word part (``y*G + g``) of a threshold write address."""
+    return _bits(words - 1)
 
 
 def threshold_write_signature(num_scales: int, words: int, lanes: int,
-                              threshold_bits: int) -> wiring.Signature:
-    """Threshold write bus: ``en``, ``scale``, ``addr`` (word), ``data`` (P thresholds)."""
-    return wiring.Signature({
-        "en": Out(1),
-        "scale": Out(unsigned(_bits(num_scales - 1))),
-        "addr": Out(unsigned(_bits(words - 1))),
-        "data": Out(data.ArrayLayout(unsigned(threshold_bits), lanes)),
-    })
+                              threshold_bits: int) -> ThresholdWriteSignature:
+    """The shared threshold-write bus with one memory word (P thresholds) per write:
+    ``data`` lane ``i`` at ``[i*(W-1) +: W-1]``, ``addr = (s << word_bits) | (y*G + g)``
+    (:func:`threshold_word_bits`)."""
+    return ThresholdWriteSignature(lanes * threshold_bits,
+                                   _bits(num_scales - 1) + threshold_word_bits(words))
 
 
 class StreamGeometry:
@@ -278,26 +287,61 @@ class RvsmStreamArray(wiring.Component):
     """``S x H x W`` accumulators fed by a ``lanes``-wide raster stream of ADC codes.
 
     Members: ``codes`` In(:func:`code_beat_signature`), ``spikes``
-    Out(:func:`spike_beat_signature`), ``thr_write`` In(:func:`threshold_write_signature`),
-    ``clear`` In(1). See the module docstring for the schedule and the controls; sizes
-    and the named timing properties are in :attr:`geometry` (:class:`StreamGeometry`).
+    Out(:func:`spike_beat_signature`), ``thr`` In(:func:`threshold_write_signature`),
+    ``clear`` In(1); Verilog ports ``codes_payload``, ``codes_valid``, ``codes_ready``,
+    ``spikes_payload``, ``spikes_valid``, ``thr_we``, ``thr_addr``, ``thr_data``,
+    ``clear`` (:mod:`rvsm.rtl.ports`, described by :meth:`port_docs`). See the module
+    docstring for the schedule and the controls; sizes and the named timing properties
+    are in :attr:`geometry` (:class:`StreamGeometry`).
     """
 
     def __init__(self, contract: ArrayContract, lanes: int = 1,
                  bank_words: int = StreamGeometry.BANK_WORDS):
         geo = StreamGeometry(contract, lanes, bank_words)
         self.geometry = geo
-        self.contract = c = contract
+        self.contract = contract
         self.lanes = geo.lanes
         self.groups = geo.groups
-        super().__init__({
+        super().__init__(self.interface(contract, geo.lanes))
+
+    @staticmethod
+    def interface(contract: ArrayContract, lanes: int) -> wiring.Signature:
+        """The array's signature for ``contract`` and ``lanes`` (no component needed)."""
+        c = contract
+        geo = StreamGeometry(c, lanes)
+        return wiring.Signature({
             "codes": In(code_beat_signature(c.adc_bits, geo.lanes)),
             "spikes": Out(spike_beat_signature(c.num_scales, geo.lanes, c.height,
                                                geo.groups)),
-            "thr_write": In(threshold_write_signature(c.num_scales, geo.beats_per_frame,
-                                                      geo.lanes, c.threshold_bits)),
+            "thr": In(threshold_write_signature(c.num_scales, geo.beats_per_frame,
+                                                geo.lanes, c.threshold_bits)),
             "clear": In(1),
         })
+
+    @staticmethod
+    def port_docs(contract: ArrayContract, lanes: int) -> dict[str, str]:
+        """Meaning of every Verilog port (names as :func:`rvsm.rtl.ports.port_map`)."""
+        c = contract
+        geo = StreamGeometry(c, lanes)
+        p, n, g = geo.lanes, c.adc_bits, geo.groups
+        wb = threshold_word_bits(geo.beats_per_frame)
+        return {
+            "clk": "clock (rising edge)",
+            "rst": "synchronous reset: the state after a clear (memories untouched)",
+            "codes_payload": f"ADC codes of one beat: lane i = pixel (y, g*{p} + i) at bits "
+                             f"[i*{n} +: {n}]; beats in raster order (frame, row y, group "
+                             f"g = 0..{g - 1})",
+            "codes_valid": "the input beat is valid",
+            "codes_ready": "the array accepts a beat (low only while clear is high)",
+            "spikes_payload": "one output beat (fields below): position and S*P spikes",
+            "spikes_valid": "high for one cycle when a position is released",
+            "thr_we": "threshold write enable (one memory word per rising edge)",
+            "thr_addr": f"(scale s << {wb}) | (y*{g} + g)",
+            "thr_data": f"{p} thresholds, lane i at bits [i*{c.threshold_bits} +: "
+                        f"{c.threshold_bits}], each 1..{(1 << c.threshold_bits) - 1}",
+            "clear": "synchronous restart of the stream: positions in flight dropped, "
+                     "accumulators zero in the next frame, thresholds kept",
+        }
 
     @property
     def latency(self) -> int:
@@ -485,14 +529,17 @@ class RvsmStreamArray(wiring.Component):
         # -- state memories and the tail: add, compare/saturate, fire/reset ---------------
         lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
         tw = c.threshold_bits
-        bus = self.thr_write
+        bus = self.thr
+        word_bits = threshold_word_bits(words)
+        bus_word = bus.addr[:word_bits]
+        bus_scale = bus.addr[word_bits:]
         tail_stmts = []
         pos_bits, neg_bits = [], []
         for s in range(c.num_scales):
             after_lanes = []
             thr_q = self._banked(
                 m, f"thr_s{s}", p * tw, advance, rd_addr, bank_q,
-                [(bus.en & (bus.scale == s), bus.addr, bus.data.as_value())])
+                [(bus.we & (bus_scale == s), bus_word, bus.data)])
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
             acc_q = self._banked(m, f"acc_s{s}", p * wa, advance, rd_addr, bank_q,
                                  [(wr_en, wr_addr, after_flat)])
@@ -545,7 +592,7 @@ def simulate(
 ) -> OutputBeats:
     """Run :class:`RvsmStreamArray` in ``amaranth.sim``; return every output beat.
 
-    Thresholds ``(S, H, W)`` are written through ``thr_write``; each segment between
+    Thresholds ``(S, H, W)`` are written through ``thr``; each segment between
     ``clear_before`` steps is streamed back to back, flushed with ``lag`` beats and
     followed by a one-cycle ``clear``. ``threshold_updates`` maps a frame ``t`` (of the
     first segment) to thresholds written while the stream is paused at
@@ -563,6 +610,7 @@ def simulate(
     dut = RvsmStreamArray(c, lanes, bank_words)
     sched = dut.schedule
     layout = dut.geometry.spike_layout
+    word_bits = threshold_word_bits(sched.beats_per_frame)
     fields = {name: (layout[name].offset, layout[name].width)
               for name in ("row", "group", "last", "pos", "neg")}
     updates = dict(threshold_updates or {})
@@ -576,12 +624,11 @@ def simulate(
 
     async def write_thresholds(ctx, thr: np.ndarray) -> None:  # noqa: ANN001
         for s, a, word in thr_words(thr):
-            ctx.set(dut.thr_write.en, 1)
-            ctx.set(dut.thr_write.scale, s)
-            ctx.set(dut.thr_write.addr, a)
-            ctx.set(dut.thr_write.data.as_value(), word)
+            ctx.set(dut.thr.we, 1)
+            ctx.set(dut.thr.addr, (s << word_bits) | a)
+            ctx.set(dut.thr.data, word)
             await ctx.tick()
-        ctx.set(dut.thr_write.en, 0)
+        ctx.set(dut.thr.we, 0)
 
     accepted = [-1, -1]  # beats accepted at the previous and at the latest edge
 

@@ -6,9 +6,9 @@
   frame after reset or ``clear``; line-buffer rows outside the frame are masked;
   thresholds must be loaded), and at sensor size building those initialisers was most
   of the conversion time and their ``initial`` blocks most of the file.
-* :func:`stream_port_map` derives the port list from the component's signature:
-  one entry per port (``codes__payload``, ...), with the bit fields of structured
-  payloads; :func:`write_stream_outputs` writes ``<top>.v``, ``<top>.ports.json``
+* :func:`stream_port_map` derives the port list from the component's signature
+  (:mod:`rvsm.rtl.ports`: ``codes_payload``, ``thr_we``, ...), with the bit fields of
+  the output payload; :func:`write_stream_outputs` writes ``<top>.v``, ``<top>.ports.json``
   (ports, timing properties, state memory) and ``<top>.ports.md``.
 * Lint with :func:`rvsm.rtl.verilog.verilator_lint` (the same documented waivers).
 """
@@ -24,12 +24,12 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from amaranth.back import verilog as amaranth_verilog
-from amaranth.hdl import Shape, Signal, Value
-from amaranth.lib import data, wiring
 
 from rvsm.model.atomic import write_text_atomic
 from rvsm.model.fixed.core import ArrayContract
 
+from .ports import port_map as signature_port_map
+from .ports import verilog_ports
 from .stream_array import RvsmStreamArray, StreamGeometry
 from .verilog import GeneratedVerilog
 
@@ -95,29 +95,12 @@ def generate_stream_verilog(contract: ArrayContract, lanes: int, top: str = STRE
     if dut is None:
         StreamGeometry(contract, lanes)  # validate before building a component
         dut = RvsmStreamArray(contract, lanes)
-    # The always-ready output stream has a constant ``ready``: list the real ports.
-    values = (Value.cast(v) for _, _, v in dut.signature.flatten(dut))
-    ports = [v for v in values if isinstance(v, Signal)]
     with _no_zero_meminit():
-        text = amaranth_verilog.convert(dut, name=top, ports=ports, emit_src=False)
+        text = amaranth_verilog.convert(dut, name=top, ports=verilog_ports(dut),
+                                        emit_src=False)
     text, _ = strip_zero_memory_init(text)
     return GeneratedVerilog(text, top, dut.latency, time.perf_counter() - t0)
 
-
-_DESCRIPTIONS = {
-    ("codes", "payload"): "ADC codes of one beat: lane i = pixel (y, g*P + i) at bits "
-                          "[i*N +: N], raster order (frame, row, group)",
-    ("codes", "valid"): "the input beat is valid",
-    ("codes", "ready"): "the array accepts a beat (low only while clear is high)",
-    ("spikes", "payload"): "one output beat (fields below)",
-    ("spikes", "valid"): "high for one cycle when a position is released",
-    ("thr_write", "en"): "threshold write enable (one word per rising edge)",
-    ("thr_write", "scale"): "scale s of the word",
-    ("thr_write", "addr"): "word address y*G + g",
-    ("thr_write", "data"): "P thresholds, lane i at bits [i*(W-1) +: W-1]",
-    ("clear",): "synchronous restart of the stream: positions in flight dropped, "
-                "accumulators zero in the next frame, thresholds kept",
-}
 
 _FIELD_DESCRIPTIONS = {
     "row": "row y of the position",
@@ -128,35 +111,25 @@ _FIELD_DESCRIPTIONS = {
 }
 
 
-def stream_port_map(dut: RvsmStreamArray) -> list[dict]:
-    """Top-level ports from ``dut.signature``: name, dir, width, desc, and ``fields``
-    (``name, offset, width, desc``) for struct-layout payloads."""
-    ports = [
-        {"name": "clk", "dir": "in", "width": 1, "desc": "clock (rising edge)"},
-        {"name": "rst", "dir": "in", "width": 1,
-         "desc": "synchronous reset: the state of a clear (memories untouched)"},
-    ]
-    for path, member, value in dut.signature.flatten(dut):
-        if not isinstance(Value.cast(value), Signal):
-            continue  # e.g. the constant ``ready`` of the always-ready output stream
-        shape = member.shape
-        entry = {"name": "__".join(path),
-                 "dir": "in" if member.flow == wiring.In else "out",
-                 "width": Shape.cast(shape).width,
-                 "desc": _DESCRIPTIONS.get(tuple(path), "")}
-        if isinstance(shape, data.StructLayout):
-            entry["fields"] = [{"name": name, "offset": field.offset, "width": field.width,
-                                "desc": _FIELD_DESCRIPTIONS.get(name, "")}
-                               for name, field in shape]
-        ports.append(entry)
-    return ports
+def stream_port_map(contract: ArrayContract, lanes: int) -> list[dict]:
+    """Top-level ports from the array's signature (:func:`rvsm.rtl.ports.port_map`, with
+    :meth:`RvsmStreamArray.port_docs`); ``spikes_payload`` also lists its bit ``fields``
+    (``name, offset, width, desc``) from the payload layout."""
+    rows = signature_port_map(RvsmStreamArray.interface(contract, lanes),
+                              RvsmStreamArray.port_docs(contract, lanes))
+    layout = StreamGeometry(contract, lanes).spike_layout
+    for row in rows:
+        if row["name"] == "spikes_payload":
+            row["fields"] = [{"name": name, "offset": field.offset, "width": field.width,
+                              "desc": _FIELD_DESCRIPTIONS[name]} for name, field in layout]
+    return rows
 
 
 def _meta(dut: RvsmStreamArray, top: str) -> dict:
     geo = dut.geometry
     return {"top": top, "arch": "stream", "latency": geo.latency, "timing": geo.timing(),
             "bank_sizes": geo.bank_sizes, "state_bits": geo.state_bits,
-            "ports": stream_port_map(dut)}
+            "ports": stream_port_map(dut.contract, geo.lanes)}
 
 
 def stream_port_map_markdown(dut: RvsmStreamArray, top: str = STREAM_TOP) -> str:
@@ -179,7 +152,7 @@ def stream_port_map_markdown(dut: RvsmStreamArray, top: str = STREAM_TOP) -> str
         "| port | dir | width | meaning |",
         "|---|---|---|---|",
     ]
-    ports = stream_port_map(dut)
+    ports = stream_port_map(c, geo.lanes)
     lines += [f"| `{p['name']}` | {p['dir']} | {p['width']} | {p['desc']} |" for p in ports]
     for p in ports:
         if "fields" in p:

@@ -93,6 +93,7 @@ def _verify(args: argparse.Namespace) -> int:
 
     if args.steps is not None and args.steps < 1:
         raise RvsmError(f"--steps must be >= 1, got {args.steps}")
+    lanes = args.lanes if args.arch == "stream" else None
     if args.stimulus:
         given = [n for n, v in (("SCENE", args.scene), ("--fixed", args.fixed),
                                 ("--size", args.size)) if v is not None]
@@ -100,12 +101,12 @@ def _verify(args: argparse.Namespace) -> int:
             raise RvsmError(f"{', '.join(given)} cannot be combined with --stimulus: the "
                             "stimulus file holds the scene's codes and the contract")
         r = replay(args.stimulus, args.sim, steps=args.steps, waves=args.waves,
-                   work_dir=args.work)
+                   work_dir=args.work, lanes=lanes)
     else:
         if args.scene is None or args.fixed is None:
             raise RvsmError("rvsm verify needs SCENE --fixed POINT.toml, or --stimulus FILE")
         r = verify(args.scene, args.fixed, args.sim, steps=args.steps, waves=args.waves,
-                   size=parse_size_arg(args.size), work_dir=args.work)
+                   size=parse_size_arg(args.size), work_dir=args.work, lanes=lanes)
     if args.json:
         r = dict(r)
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
+from rvsm.rtl.stream_verilog import STREAM_TOP, write_stream_outputs
 from rvsm.rtl.verilog import (
     DEFAULT_TOP,
     GeneratedVerilog,
@@ -37,6 +38,8 @@ if TYPE_CHECKING:
 __all__ = ["SIMULATORS", "SimBuild", "build", "check_simulator", "run_testbench"]
 
 TB_MODULE = "rvsm.sim.cosim.tb_array"
+#: The streaming array's testbench (builds with ``lanes``).
+TB_STREAM_MODULE = "rvsm.sim.cosim.tb_stream"
 #: Verilator flags for Amaranth's netlist (warnings are the lint's job, not the build's).
 VERILATOR_BUILD_ARGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style", "-O2")
 _BUILD_VERSION = "4"  # bump when the RTL or the build flags change
@@ -60,6 +63,7 @@ class SimBuild:
     build_seconds: float
     cached: bool
     waves: bool = False
+    lanes: int | None = None  # the streaming array's lanes; None: fully parallel
 
 
 def check_simulator(sim: str) -> None:
@@ -79,10 +83,12 @@ def check_simulator(sim: str) -> None:
                             "`apt-get install build-essential`")
 
 
-def contract_digest(contract: ArrayContract) -> str:
-    """Short digest of the RTL (:func:`rvsm.rtl.verilog.rtl_digest`) and the build
-    flags (``_BUILD_VERSION``): keys the simulator build cache."""
-    return hashlib.sha256(f"{_BUILD_VERSION}:{rtl_digest(contract)}".encode()).hexdigest()[:16]
+def contract_digest(contract: ArrayContract, lanes: int | None = None) -> str:
+    """Short digest of the RTL (:func:`rvsm.rtl.verilog.rtl_digest`), the build flags
+    (``_BUILD_VERSION``) and the streaming array's ``lanes``: keys the build cache."""
+    arch = "" if lanes is None else f":stream{lanes}"
+    key = f"{_BUILD_VERSION}:{rtl_digest(contract)}{arch}"
+    return hashlib.sha256(key.encode()).hexdigest()[:16]
 
 
 @contextlib.contextmanager
@@ -135,7 +141,7 @@ def _runner(sim: str) -> Runner:
 
 def build(
     contract: ArrayContract, sim: str, build_root: str | os.PathLike,
-    top: str = DEFAULT_TOP, waves: bool = False,
+    top: str = DEFAULT_TOP, waves: bool = False, lanes: int | None = None,
 ) -> SimBuild:
     """Generate (or reuse) the Verilog and build it for ``sim``; cached per contract.
 
@@ -144,20 +150,25 @@ def build(
     A build happens in a private folder renamed into place when done, so concurrent
     processes (pytest-xdist workers) can share ``build_root`` safely. The Verilog of a
     contract already generated for another build is reused, not regenerated.
+    ``lanes`` builds the streaming array (:mod:`rvsm.rtl.stream_array`) instead.
     """
     check_simulator(sim)
+    if lanes is not None and top == DEFAULT_TOP:
+        top = STREAM_TOP
     traced = waves or sim == "icarus"
-    digest = contract_digest(contract)
+    digest = contract_digest(contract, lanes)
     suffix = "-trace" if (traced and sim == "verilator") else ""
     base = Path(build_root).resolve()
     final = base / f"{sim}-{digest}-{top}{suffix}"
-    cached = _cached(final, sim, top, traced)
+    cached = _cached(final, sim, top, traced, lanes)
     if cached is not None:
         return cached
     root = final.with_name(f"{final.name}.tmp{os.getpid()}")
     shutil.rmtree(root, ignore_errors=True)
     root.mkdir(parents=True, exist_ok=True)
-    paths, gen = _reuse_verilog(base, digest, top, root) or write_outputs(contract, root, top)
+    paths, gen = _reuse_verilog(base, digest, top, root) or (
+        write_outputs(contract, root, top) if lanes is None
+        else write_stream_outputs(contract, lanes, root, top))
     sim_build = root / "sim_build"
     runner = _runner(sim)
     t0 = time.perf_counter()
@@ -180,21 +191,22 @@ def build(
         os.rename(root, final)
     except OSError:  # another process finished the same build first
         shutil.rmtree(root, ignore_errors=True)
-    done = _cached(final, sim, top, traced)
+    done = _cached(final, sim, top, traced, lanes)
     if done is None:
         raise RvsmError(f"{sim} build folder {final} vanished")
     return SimBuild(sim, done.build_dir, top, done.verilog, gen.seconds, build_seconds,
-                    False, traced)
+                    False, traced, lanes)
 
 
-def _cached(root: Path, sim: str, top: str, traced: bool) -> SimBuild | None:
+def _cached(root: Path, sim: str, top: str, traced: bool,
+            lanes: int | None = None) -> SimBuild | None:
     """The finished build in ``root``, if any."""
     stamp = root / "build.json"
     if not stamp.exists():
         return None
     meta = json.loads(stamp.read_text())
     return SimBuild(sim, root / "sim_build", top, root / f"{top}.v",
-                    meta["generate_seconds"], meta["build_seconds"], True, traced)
+                    meta["generate_seconds"], meta["build_seconds"], True, traced, lanes)
 
 
 def _reuse_verilog(
@@ -234,11 +246,13 @@ def run_testbench(
     plusargs = [f"+dumpfile_path={wave_path}"] if (waves and sb.sim == "icarus") else []
     runner = _runner(sb.sim)
     log = test_dir / "sim.log"
-    extra = {"RVSM_STIMULUS": str(Path(stimulus).resolve()), "RVSM_RESULT": str(result_path)}
+    extra = {"RVSM_STIMULUS": str(Path(stimulus).resolve()), "RVSM_RESULT": str(result_path),
+             "RVSM_PORTS": str((sb.verilog.parent / f"{sb.top}.ports.json").resolve())}
     t0 = time.perf_counter()
     with contextlib.suppress(SystemExit), _environ(_sim_env(sb.sim)):
         runner.test(
-            test_module=TB_MODULE, hdl_toplevel=sb.top, hdl_toplevel_lang="verilog",
+            test_module=TB_MODULE if sb.lanes is None else TB_STREAM_MODULE,
+            hdl_toplevel=sb.top, hdl_toplevel_lang="verilog",
             build_dir=sb.build_dir,
             test_dir=test_dir, extra_env=extra, waves=waves, plusargs=plusargs,
             results_xml=str(test_dir / "results.xml"), timescale=("1ns", "1ps"),

@@ -1,19 +1,19 @@
 """cocotb 2.x testbench: the streaming array against the fixed twin, beat for beat.
 
-Inputs (environment, or ``+rvsm_<name>=`` plusargs): ``RVSM_STIMULUS`` -- an ``.npz``
-with ``codes (T,H,W)``, ``thresholds (S,H,W)``, ``expected (T,S,H,W) int8`` and
-``clear_before``; ``RVSM_PORTS`` -- the build's ``<top>.ports.json`` (timing properties
-and payload bit fields, derived from the component); ``RVSM_RESULT`` -- where the JSON
-result goes.
+Inputs (environment, or ``+rvsm_<name>=`` plusargs): ``RVSM_STIMULUS`` -- a stimulus
+file (:mod:`rvsm.model.fixed.stimulus`): codes, thresholds, expected spikes, the
+contract and ``clear_before``; ``RVSM_PORTS`` -- the build's ``<top>.ports.json`` (its
+lanes, timing properties and payload bit fields, derived from the component);
+``RVSM_RESULT`` -- where the JSON result goes.
 
 cocotb runs everything from Python, one clock cycle at a time (inputs driven on the
-falling edge): reset; every threshold word through ``thr_write``; then per segment
-between clears (:meth:`StreamSchedule.segments`) the frames as back-to-back beats, the
-``lag`` flush beats, one idle cycle and one ``clear`` cycle. Every cycle with ``spikes__valid`` high
-records one output beat; at the end :func:`~rvsm.rtl.stream_schedule.check_beats` (the
-schedule model's checker) compares positions and spikes with the expectation. The
-per-cycle cost is a few handle accesses on vectors of a few hundred bits, so Python is
-not the bottleneck at sensor size (the result reports cycles per second).
+falling edge): reset; every threshold word through ``thr``; then per segment between
+clears (:meth:`StreamSchedule.segments`) the frames as back-to-back beats, the ``lag``
+flush beats, one idle cycle and one ``clear`` cycle. Every cycle with ``spikes_valid``
+high records one output beat; at the end :func:`~rvsm.rtl.stream_schedule.check_beats`
+(the schedule model's checker) compares positions and spikes with the expectation. The
+per-cycle Python is a few handle accesses on vectors of a few hundred bits; the result
+reports ``cycles_per_second`` to show whether it or the simulator dominates.
 """
 
 from __future__ import annotations
@@ -28,7 +28,9 @@ from cocotb.clock import Clock
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
-from rvsm.rtl.stream_schedule import OutputBeats, StreamSchedule, check_beats, pack_lanes
+from rvsm.model.fixed.stimulus import load_stimulus
+from rvsm.rtl.stream_array import StreamGeometry, threshold_word_bits
+from rvsm.rtl.stream_schedule import OutputBeats, check_beats, pack_lanes
 
 
 def _arg(name: str) -> str:
@@ -53,32 +55,32 @@ def _bits(value: object) -> tuple[int, int]:
 @cocotb.test()
 async def stream_matches_fixed_twin(dut: object) -> None:
     """Stream every step, compare every output beat with the fixed twin's expectation."""
-    stim = np.load(_arg("stimulus"))
-    ports = json.loads(open(_arg("ports"), encoding="utf-8").read())
+    stim = load_stimulus(_arg("stimulus"))
+    with open(_arg("ports"), encoding="utf-8") as f:
+        ports = json.load(f)
     result_path = _arg("result")
-    codes = stim["codes"]
-    thresholds = stim["thresholds"]
-    expected = stim["expected"].astype(np.int8)
-    clears = [int(t) for t in stim["clear_before"]] if "clear_before" in stim else []
-    adc_bits = int(stim["adc_bits"])
+    c = stim.contract
+    codes = stim.codes.astype(np.int64)
+    expected = stim.spikes
     steps, scales, height, width = expected.shape
-    timing = ports["timing"]
-    lanes = int(timing["lanes"])
-    sched = StreamSchedule(height, width, lanes, int(timing["lag"]),
-                           int(timing["threshold_lag"]))
+    lanes = int(ports["timing"]["lanes"])
+    geo = StreamGeometry(c, lanes)
+    if geo.timing() != ports["timing"]:
+        raise RuntimeError(f"the build's timing {ports['timing']} is not this contract's "
+                           f"{geo.timing()}")
+    sched = geo.schedule
     by_name = {p["name"]: p for p in ports["ports"]}
     fields = {f["name"]: (f["offset"], f["width"])
-              for f in by_name["spikes__payload"]["fields"]}
-    thr_bits = by_name["thr_write__data"]["width"] // lanes
+              for f in by_name["spikes_payload"]["fields"]}
+    word_bits = threshold_word_bits(sched.beats_per_frame)
 
     clk = dut.clk  # type: ignore[attr-defined]
     d = {name: getattr(dut, name) for name in (
-        "rst", "clear", "codes__valid", "codes__payload", "thr_write__en",
-        "thr_write__scale", "thr_write__addr", "thr_write__data", "spikes__valid",
-        "spikes__payload")}
+        "rst", "clear", "codes_valid", "codes_payload", "thr_we", "thr_addr", "thr_data",
+        "spikes_valid", "spikes_payload")}
     cocotb.start_soon(Clock(clk, 10, unit="ns").start())
-    for name in ("rst", "clear", "codes__valid", "codes__payload", "thr_write__en",
-                 "thr_write__scale", "thr_write__addr", "thr_write__data"):
+    for name in ("rst", "clear", "codes_valid", "codes_payload", "thr_we", "thr_addr",
+                 "thr_data"):
         d[name].value = 1 if name == "rst" else 0
     await FallingEdge(clk)
     await FallingEdge(clk)
@@ -86,22 +88,21 @@ async def stream_matches_fixed_twin(dut: object) -> None:
 
     t0 = time.perf_counter()
     cycles = 0
-    words = sched.threshold_words(thresholds)
-    packed = pack_lanes(words.reshape(-1, lanes), thr_bits)
-    d["thr_write__en"].value = 1
+    words = sched.threshold_words(stim.thresholds)
+    packed = pack_lanes(words.reshape(-1, lanes), c.threshold_bits)
+    d["thr_we"].value = 1
     for s in range(scales):
-        d["thr_write__scale"].value = s
         for a in range(sched.beats_per_frame):
-            d["thr_write__addr"].value = a
-            d["thr_write__data"].value = packed[s * sched.beats_per_frame + a]
+            d["thr_addr"].value = (s << word_bits) | a
+            d["thr_data"].value = packed[s * sched.beats_per_frame + a]
             await FallingEdge(clk)
             cycles += 1
-    d["thr_write__en"].value = 0
+    d["thr_we"].value = 0
 
     got: dict[str, list[int]] = {k: [] for k in fields}
     x_beats: list[int] = []
-    out_valid, out_payload = d["spikes__valid"], d["spikes__payload"]
-    in_payload = d["codes__payload"]
+    out_valid, out_payload = d["spikes_valid"], d["spikes_payload"]
+    in_payload = d["codes_payload"]
 
     def record() -> None:
         """After a falling edge: record the output beat presented, if any."""
@@ -111,21 +112,21 @@ async def stream_matches_fixed_twin(dut: object) -> None:
                 x_beats.append(len(got["row"]))
             for k, (off, w) in fields.items():
                 got[k].append((value >> off) & ((1 << w) - 1))
-    for seg, (a, b) in enumerate(sched.segments(steps, clears)):
+    for seg, (a, b) in enumerate(sched.segments(steps, stim.clear_before)):
         if seg:
             d["clear"].value = 1
             await FallingEdge(clk)
             cycles += 1
             record()
             d["clear"].value = 0
-        beats = pack_lanes(sched.input_beats(codes[a:b]), adc_bits)
-        d["codes__valid"].value = 1
+        beats = pack_lanes(sched.input_beats(codes[a:b]), c.adc_bits)
+        d["codes_valid"].value = 1
         for word in beats:
             in_payload.value = word
             await FallingEdge(clk)
             cycles += 1
             record()
-        d["codes__valid"].value = 0
+        d["codes_valid"].value = 0
         await FallingEdge(clk)  # the last released beat is presented one cycle later
         cycles += 1
         record()

@@ -52,6 +52,16 @@ def _check_parallel_size(height: int, width: int) -> None:
             "--size, e.g. --size 16x16")
 
 
+def _check_size(contract: ArrayContract, lanes: int | None) -> None:
+    """The parallel array's size limit, or that ``lanes`` suit the streaming array."""
+    if lanes is None:
+        _check_parallel_size(contract.height, contract.width)
+    else:
+        from rvsm.rtl.stream_array import StreamGeometry
+
+        StreamGeometry(contract, lanes)
+
+
 def check_stimulus(
     stim: Stimulus,
     sim: str = "icarus",
@@ -59,8 +69,12 @@ def check_stimulus(
     work_dir: str | os.PathLike = DEFAULT_WORK,
     name: str = "run",
     build_root: str | os.PathLike | None = None,
+    lanes: int | None = None,
 ) -> dict:
     """Drive the RTL of ``stim.contract`` with ``stim`` and compare every spike.
+
+    ``lanes`` drives the streaming array (:mod:`rvsm.rtl.stream_array`) with that many
+    lanes instead of the fully parallel one.
 
     Writes ``work_dir/<sim>/<name>/stimulus.npz`` (the testbench's input). Returns the
     testbench result: ``compared``, ``mismatches``, ``first_mismatch``, ``simulator``,
@@ -73,7 +87,7 @@ def check_stimulus(
         raise RvsmError(f"expected spikes must be {want}, got {stim.spikes.shape}")
     work = Path(work_dir)
     root = work / "builds" if build_root is None else Path(build_root)
-    sb = build(contract, sim, root, waves=waves)
+    sb = build(contract, sim, root, waves=waves, lanes=lanes)
     run_dir = work / sim / name
     path = run_dir / "stimulus.npz"
     save_stimulus(path, stim)
@@ -84,11 +98,12 @@ def check_stimulus(
         again_dir = run_dir / "failure"
         again = again_dir / "stimulus.npz"
         save_stimulus(again, stim.first_steps(upto))
-        sbw = build(contract, sim, root, waves=True)
+        sbw = build(contract, sim, root, waves=True, lanes=lanes)
         result["waves"] = run_testbench(sbw, again, again_dir, waves=True)["waves"]
     result.update(
         build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
         build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),
+        arch="parallel" if lanes is None else "stream", lanes=lanes,
     )
     return result
 
@@ -104,11 +119,13 @@ def run_rtl(
     work_dir: str | os.PathLike = DEFAULT_WORK,
     name: str = "run",
     build_root: str | os.PathLike | None = None,
+    lanes: int | None = None,
 ) -> dict:
     """Simulate the RTL on ``codes``/``thresholds`` and compare with the expectation.
 
     ``expected`` defaults to ``contract.run(codes, thresholds, clear_before)`` (pass one
-    to test the checker). Returns :func:`check_stimulus`'s result.
+    to test the checker); ``lanes`` selects the streaming array. Returns
+    :func:`check_stimulus`'s result.
     """
     codes = np.asarray(codes, dtype=np.int64)
     thresholds = np.asarray(thresholds, dtype=np.int64)
@@ -118,7 +135,7 @@ def run_rtl(
     stim = Stimulus(codes, thresholds, np.asarray(expected, dtype=np.int8), contract,
                     clear_before=tuple(clear_before))
     return check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=name,
-                          build_root=build_root)
+                          build_root=build_root, lanes=lanes)
 
 
 def replay(
@@ -127,6 +144,7 @@ def replay(
     steps: int | None = None,
     waves: bool = False,
     work_dir: str | os.PathLike = DEFAULT_WORK,
+    lanes: int | None = None,
 ) -> dict:
     """Replay a stimulus file (``rvsm stimulus -o FILE``) on the RTL, spike for spike.
 
@@ -136,11 +154,11 @@ def replay(
     check_simulator(sim)
     stim = load_stimulus(stimulus)
     c = stim.contract
-    _check_parallel_size(c.height, c.width)
+    _check_size(c, lanes)
     if steps is not None and steps < stim.num_steps:
         stim = stim.first_steps(steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
-                            name=Path(stimulus).stem or "stimulus")
+                            name=Path(stimulus).stem or "stimulus", lanes=lanes)
     result.update(stimulus=str(stimulus), height=c.height, width=c.width)
     return result
 
@@ -153,8 +171,11 @@ def verify(
     waves: bool = False,
     size: tuple[int, int] | None = None,
     work_dir: str | os.PathLike = DEFAULT_WORK,
+    lanes: int | None = None,
 ) -> dict:
     """Verify the RTL of design point ``fixed`` (TOML) on ``scene``, spike for spike.
+
+    ``lanes`` verifies the streaming array with that many lanes (any array size).
 
     ``size = (H, W)`` overrides the point's array size (the scene is rendered or cropped
     to it); ``steps`` keeps the first steps. Returns :func:`check_stimulus`'s result plus
@@ -170,9 +191,9 @@ def verify(
     if size is not None:
         point = point.with_size(*size)
     h, w = point.height, point.width
-    _check_parallel_size(h, w)
+    _check_size(point.contract(), lanes)
     stim = make_stimulus(load_scene(scene, size=(h, w)), point, num_steps=steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
-                            name=Path(str(scene)).stem or "scene")
+                            name=Path(str(scene)).stem or "scene", lanes=lanes)
     result.update(scene=str(scene), point=str(fixed), height=h, width=w)
     return result

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from rvsm.model.errors import RvsmError
-from rvsm.model.fixed.config import DesignPoint
 from rvsm.model.fixed.core import (
     ArrayContract,
     FixedIntegrator,
     arithmetic_shift,
     integer_receptive_sums,
 )
+from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.weights import quantise_model
 from rvsm.model.kernels import MODEL_NAMES
 from rvsm.rtl.stream_array import StreamGeometry, simulate

@@ -10,7 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.model.fixed.config import DesignPoint, default_design_point, save_design_point
+from rvsm.model.fixed.design_point import DesignPoint, default_design_point
+from rvsm.model.fixed.point_toml import save_design_point
 from rvsm.rtl.stream_array import StreamGeometry
 from rvsm.rtl.stream_verilog import STREAM_TOP, strip_zero_memory_init, write_stream_outputs
 from rvsm.sim.cli import main
@@ -33,19 +34,20 @@ def test_ports_follow_the_signature(generated: tuple[Path, DesignPoint]) -> None
     ports = {p.strip() for p in header.split(",")}
     meta = json.loads((out / f"{STREAM_TOP}.ports.json").read_text())
     assert ports == {p["name"] for p in meta["ports"]}
-    assert {"codes__payload", "codes__valid", "codes__ready", "spikes__payload",
-            "spikes__valid", "thr_write__data", "clear"} <= ports
+    assert ports == {"clk", "rst", "codes_payload", "codes_valid", "codes_ready",
+                     "spikes_payload", "spikes_valid", "thr_we", "thr_addr", "thr_data",
+                     "clear"}
     c = point.contract()
     widths = {p["name"]: p["width"] for p in meta["ports"]}
-    assert widths["codes__payload"] == 2 * c.adc_bits
+    assert widths["codes_payload"] == 2 * c.adc_bits
     fields = {f["name"]: f for f in next(p for p in meta["ports"]
-                                         if p["name"] == "spikes__payload")["fields"]}
+                                         if p["name"] == "spikes_payload")["fields"]}
     assert fields["pos"]["width"] == c.num_scales * 2
-    assert sum(f["width"] for f in fields.values()) == widths["spikes__payload"]
+    assert sum(f["width"] for f in fields.values()) == widths["spikes_payload"]
     assert meta["timing"] == StreamGeometry(c, 2).timing()
     assert "src =" not in text and "initial begin" not in text
     md = (out / f"{STREAM_TOP}.ports.md").read_text()
-    assert md.startswith(f"# `{STREAM_TOP}` port map") and "`spikes__payload`" in md
+    assert md.startswith(f"# `{STREAM_TOP}` port map") and "`spikes_payload`" in md
 
 
 def test_verilator_lint_clean(generated: tuple[Path, DesignPoint]) -> None:

@@ -15,32 +15,20 @@ import numpy as np
 import pytest
 
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.fixed.weights import quantise_model
 from rvsm.model.kernels import MODEL_NAMES
-from rvsm.sim.verify import expected_spikes, run_rtl
+from rvsm.sim.cosim.verify import run_rtl
 
 SIMS = ["icarus", "verilator"]
 
 
-def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int = 10,
-                   shift: int = 1, reset: str = "subtract") -> ArrayContract:
-    """A small contract from a model's quantised kernels (4-bit ADC)."""
-    ks = quantise_model(model, frac_bits, "round-half-up")
-    weights = tuple(tuple(tuple(int(v) for v in row) for row in k) for k in ks)
-    return ArrayContract(h, w, 4, weights, shift, acc_bits, model != "fsm", reset)
+@pytest.fixture
+def work(cosim_work: Path) -> Path:
+    return cosim_work
 
 
-@pytest.fixture(scope="session")
-def work(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return tmp_path_factory.mktemp("cocotb_stream")
-
-
-@pytest.fixture(scope="session")
-def builds(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """Build cache shared by every xdist worker of this session (safe: atomic renames)."""
-    base = tmp_path_factory.getbasetemp()
-    root = base.parent if base.name.startswith("popen-gw") else base
-    return root / "rvsm-stream-builds"
+@pytest.fixture
+def builds(rtl_builds: Path) -> Path:
+    return rtl_builds
 
 
 def check_cases(c: ArrayContract, lanes: int, sim: str, work: Path, builds: Path,
@@ -65,7 +53,7 @@ def check_cases(c: ArrayContract, lanes: int, sim: str, work: Path, builds: Path
                     name=f"{name}_p{lanes}", build_root=builds, lanes=lanes)
         assert r["mismatches"] == 0, (name, r["first_mismatch"])
         assert r["compared"] == codes.size * s
-        signs |= set(np.unique(expected_spikes(c, codes, t, clears)).tolist())
+        signs |= set(np.unique(c.run(codes, t, clears)).tolist())
     assert 1 in signs
     if c.signed and any((k < 0).any() for k in c.weight_arrays):
         assert -1 in signs
@@ -73,23 +61,25 @@ def check_cases(c: ArrayContract, lanes: int, sim: str, work: Path, builds: Path
 
 @pytest.mark.parametrize("sim", SIMS)
 @pytest.mark.parametrize("lanes", [1, 3])
-def test_dog4_stream(sim: str, lanes: int, work: Path, builds: Path) -> None:
-    check_cases(model_contract("dog4", 5, 9), lanes, sim, work, builds, seed=lanes)
+def test_dog4_stream(small_contract, sim: str, lanes: int, work: Path,
+                     builds: Path) -> None:
+    check_cases(small_contract("dog4", 5, 9), lanes, sim, work, builds, seed=lanes)
 
 
 @pytest.mark.parametrize("model", ["fsm", "dog2", "gauss3"])
-def test_models_icarus(model: str, work: Path, builds: Path) -> None:
-    c = model_contract(model, 4, 6, reset="zero")
+def test_models_icarus(small_contract, model: str, work: Path, builds: Path) -> None:
+    c = small_contract(model, 4, 6, reset="zero")
     check_cases(c, 2, "icarus", work, builds, seed=5)
 
 
-def test_checker_catches_wrong_expectation(work: Path, builds: Path) -> None:
+def test_checker_catches_wrong_expectation(small_contract, work: Path,
+                                           builds: Path) -> None:
     """A deliberately wrong expectation is reported, named, and a waveform is kept."""
-    c = model_contract("dog3", 5, 6)
+    c = small_contract("dog3", 5, 6)
     rng = np.random.default_rng(14)
     codes = rng.integers(0, 16, (6, 5, 6))
     thr = rng.integers(1, 60, (c.num_scales, 5, 6))
-    wrong = expected_spikes(c, codes, thr)
+    wrong = c.run(codes, thr)
     step, scale, row, col = 3, 2, 4, 1
     good = int(wrong[step, scale, row, col])
     wrong[step, scale, row, col] = 1 if good != 1 else -1
@@ -105,7 +95,8 @@ def test_checker_catches_wrong_expectation(work: Path, builds: Path) -> None:
 def test_cli_verify_stream(work: Path, tmp_path: Path,
                            capsys: pytest.CaptureFixture) -> None:
     """``rvsm verify SCENE --fixed point.toml --arch stream --lanes P --json``."""
-    from rvsm.model.fixed.config import default_design_point, save_design_point
+    from rvsm.model.fixed.design_point import default_design_point
+    from rvsm.model.fixed.point_toml import save_design_point
     from rvsm.sim.cli import main
 
     point = tmp_path / "p.toml"
@@ -122,9 +113,9 @@ def test_cli_verify_stream(work: Path, tmp_path: Path,
 @pytest.mark.parametrize("sim", SIMS)
 @pytest.mark.parametrize("lanes", [1, 5, 15])
 @pytest.mark.parametrize("model", MODEL_NAMES)
-def test_every_model_and_lanes(model: str, lanes: int, sim: str, work: Path,
-                               builds: Path) -> None:
-    c = model_contract(model, 6, 15, reset="zero" if lanes == 5 else "subtract")
+def test_every_model_and_lanes(small_contract, model: str, lanes: int, sim: str,
+                               work: Path, builds: Path) -> None:
+    c = small_contract(model, 6, 15, reset="zero" if lanes == 5 else "subtract")
     check_cases(c, lanes, sim, work, builds, seed=21, steps=12)
 
 
@@ -132,7 +123,8 @@ def test_every_model_and_lanes(model: str, lanes: int, sim: str, work: Path,
 def test_full_sensor_verilator(work: Path, tmp_path: Path,
                                capsys: pytest.CaptureFixture) -> None:
     """The default 250x400 dog4 point at P=40 on Verilator, 20 steps (several minutes)."""
-    from rvsm.model.fixed.config import default_design_point, save_design_point
+    from rvsm.model.fixed.design_point import default_design_point
+    from rvsm.model.fixed.point_toml import save_design_point
     from rvsm.sim.cli import main
 
     point = tmp_path / "p.toml"
