@@ -68,10 +68,16 @@ class PortBits:
 
 
 def component_ports(component: wiring.Component) -> list[tuple[PortBits, Value]]:
-    """Every port of ``component`` with its Amaranth value, in signature order."""
+    """Every port of ``component`` with its Amaranth value, in signature order.
+
+    Members whose value is a constant (e.g. ``ready`` of an ``always_ready`` stream) are
+    not ports and are left out.
+    """
     out = []
     for path, member, value in component.signature.flatten(component):
         v = Value.cast(value)
+        if isinstance(v, Const):
+            continue
         direction = "in" if member.flow == wiring.In else "out"
         out.append((PortBits(tuple(path), direction, len(v)), v))
     return out
