@@ -117,7 +117,6 @@ def test_inputs_are_the_lfsr_stream_delayed_per_bit() -> None:
 @pytest.mark.parametrize("n_out", [3, 40, 300])
 def test_pins_are_registered_xor_of_outputs(n_out: int) -> None:
     h = IoHarness(Echo(9, n_out), pins=8)
-    dut = h.component
     depth = len(h.xor_stages)
 
     def probe(ctx):  # noqa: ANN001, ANN202

