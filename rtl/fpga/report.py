@@ -192,6 +192,7 @@ class FpgaReport:
     synth_cells: dict[str, int] = field(default_factory=dict)
     seconds: dict[str, float] = field(default_factory=dict)
     work_dir: str = ""
+    netlist: str = "verilog"
     step_hz: float = CAMERA_STEP_HZ
 
     @property

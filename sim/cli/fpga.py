@@ -42,6 +42,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="clock target for place and route, MHz (default 125)")
     p.add_argument("--synth-only", action="store_true",
                    help="stop after synthesis: area from yosys, no Fmax")
+    p.add_argument("--rtlil", action="store_true",
+                   help="hand yosys Amaranth's RTLIL instead of Verilog (faster to read; "
+                   "the same netlist)")
     p.add_argument("--seed", type=int, default=1, help="placer seed (default 1)")
     p.add_argument("--timeout", type=float, metavar="S",
                    help="stop a tool that runs longer than S seconds (exit 3)")
@@ -74,7 +77,8 @@ def _fpga(args: argparse.Namespace) -> int:
 
     report = run_fpga(point, args.out, arch=args.arch, lanes=args.lanes, size=args.size,
                       device=args.device, speed=args.speed, target_mhz=args.freq,
-                      synth_only=args.synth_only, seed=args.seed, on_progress=progress,
+                      synth_only=args.synth_only, seed=args.seed,
+                      netlist="rtlil" if args.rtlil else "verilog", on_progress=progress,
                       timeout=args.timeout)
     print(report.to_json() if args.json else report.table())
     return 0

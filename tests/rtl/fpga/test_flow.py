@@ -48,13 +48,14 @@ def test_synthesis_only_on_a_tiny_array(tmp_path: Path) -> None:
 def test_cli_synth_only_json(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     save_design_point(tmp_path / "p.toml", _point())
     code = main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",
-                 "--synth-only", "--json", "-o", str(tmp_path / "w")])
+                 "--synth-only", "--json", "--rtlil", "-o", str(tmp_path / "w")])
     out, err = capsys.readouterr()
     assert code == 0, err
     d = json.loads(out)
     assert d["mode"] == "synthesis-only" and d["lanes"] == 4 and d["fmax_mhz"] is None
     assert d["sensor_height"] == 250 and d["height"] == 2
     assert "synthesis (yosys): done" in err  # progress on stderr
+    assert d["netlist"] == "rtlil" and (tmp_path / "w" / "top.il").is_file()
 
 
 def test_failing_tool_is_a_tool_error_and_exit_3(tmp_path: Path, capsys: pytest.CaptureFixture,
