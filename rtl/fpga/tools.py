@@ -179,6 +179,9 @@ def run_tool(
         _kill_group(proc)
         raise
     finally:
+        reader.join(timeout=5.0)
+        if proc.stdout is not None:
+            proc.stdout.close()
         log.close()
     elapsed = time.monotonic() - t0
     if code != 0:
