@@ -45,6 +45,23 @@ def test_synthesis_only_on_a_tiny_array(tmp_path: Path) -> None:
     assert synthesis_script() in (tmp_path / "synth.ys").read_text()
 
 
+def test_synthesis_only_keeps_the_stream_arrays_state_memories(tmp_path: Path) -> None:
+    from rvsm.rtl.stream_array import StreamGeometry
+
+    point = dataclasses.replace(default_design_point(), model="dog1")
+    r = run_fpga(point, tmp_path, arch="stream", lanes=2, size=(6, 6), synth_only=True,
+                 netlist="rtlil")
+    assert r.lanes == 2 and r.arch == "stream"
+    geo = StreamGeometry(point.with_size(6, 6).contract(), lanes=2)
+    c = point.contract()
+    state = geo.state_bits["accumulators"] + geo.state_bits["thresholds"]
+    ram_bits = 64 * r.synth_cells.get("TRELLIS_DPR16X4", 0) \
+        + 18 * 1024 * r.synth_cells.get("DP16KD", 0)
+    # accumulator and threshold memories survive (as RAM, or as flip-flops)
+    assert ram_bits + r.ff.used - r.harness_ff >= state
+    assert r.ff.used - r.harness_ff > c.num_scales * 2 * c.accumulator_bits
+
+
 def test_cli_synth_only_json(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     save_design_point(tmp_path / "p.toml", _point())
     code = main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",

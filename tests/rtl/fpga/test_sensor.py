@@ -78,3 +78,14 @@ def test_bram_blocks_best_shape() -> None:
     assert bram_blocks(2048, 9) == 1 and bram_blocks(512, 72) == 2
     assert bram_blocks(25000, 18) == 25  # 1Kx18 banks
     assert bram_blocks(0, 5) == 0
+
+
+@pytest.mark.parametrize("model", ["fsm", "dog1", "dog4", "gauss3"])
+def test_state_memory_matches_the_stream_arrays_own_count(model: str) -> None:
+    from rvsm.rtl.stream_array import StreamGeometry
+
+    point = dataclasses.replace(default_design_point(), model=model)
+    st = state_memory(point.contract())
+    geo = StreamGeometry(point.contract(), lanes=40).state_bits
+    assert (st.accumulators, st.thresholds, st.line_buffers) == (
+        geo["accumulators"], geo["thresholds"], geo["line_buffer"])
