@@ -12,7 +12,8 @@
    --freq F --lpf-allow-unconstrained --timing-allow-fail --report report.json`` places
    and routes the netlist (fixed ``--seed``, so reruns agree).
 
-Each tool's output is kept in ``yosys.log`` / ``nextpnr.log`` beside its products.
+Each tool's full log is kept in ``yosys.log`` / ``nextpnr.log`` beside its products
+(its console output, warnings and errors, in ``yosys.out`` / ``nextpnr.out``).
 Expected run times come from :func:`expected_synthesis_seconds` and
 :func:`expected_pnr_seconds`, fits to runs on a 2-core machine (rough: a shared machine
 is slower).
@@ -174,8 +175,9 @@ def synthesise(
     for stale in ("synth.json", "stat.json", "report.json"):
         (work / stale).unlink(missing_ok=True)
     seconds["synthesis"] = run_tool(
-        [yosys, "-s", "synth.ys"], work, work / "yosys.log", "synthesis (yosys)",
-        on_progress, expected_synthesis_seconds(len(text), netlist), timeout)
+        [yosys, "-q", "-l", "yosys.log", "-s", "synth.ys"], work, work / "yosys.out",
+        "synthesis (yosys)", on_progress, expected_synthesis_seconds(len(text), netlist),
+        timeout, follow="yosys.log")
     stat = parse_yosys_stat(_read_json(work / "stat.json", "yosys statistics"))
     return Synthesis(work, stat, harness, len(text), seconds)
 
@@ -200,10 +202,11 @@ def place_and_route(
     argv = [nextpnr, device.nextpnr_flag, "--package", device.package, "--speed", str(speed),
             "--json", "synth.json", "--freq", f"{target_mhz:g}",
             "--lpf-allow-unconstrained", "--timing-allow-fail", "--seed", str(seed),
-            "--report", "report.json"]
+            "--report", "report.json", "-q", "--log", "nextpnr.log"]
     st = synthesis.stat
-    seconds = run_tool(argv, work, work / "nextpnr.log", "place & route (nextpnr)",
-                       on_progress, expected_pnr_seconds(st["lut4"] + st["ff"]), timeout)
+    seconds = run_tool(argv, work, work / "nextpnr.out", "place & route (nextpnr)",
+                       on_progress, expected_pnr_seconds(st["lut4"] + st["ff"]), timeout,
+                       follow="nextpnr.log")
     return parse_nextpnr_report(_read_json(work / "report.json", "nextpnr report")), seconds
 
 

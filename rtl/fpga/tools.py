@@ -119,18 +119,25 @@ def run_tool(
     expected: float | None = None,
     timeout: float | None = None,
     heartbeat: float = 30.0,
+    follow: str | os.PathLike | None = None,
 ) -> float:
     """Run ``argv`` in ``cwd`` in its own process group; return its wall time (s).
 
-    Output (stdout and stderr) goes line by line into ``log_path``. ``on_progress`` is
-    called when the phase changes, every ``heartbeat`` seconds, and once at the end.
-    Raises :class:`ToolError` when the tool exits non-zero or runs over ``timeout`` s.
+    Console output (stdout and stderr) goes line by line into ``log_path``. ``follow``
+    names a log file (relative to ``cwd``) the tool writes and flushes itself (``yosys
+    -l``, ``nextpnr --log``): progress is read from it, because a WebAssembly tool's
+    piped output arrives in blocks of kilobytes. ``on_progress`` is called when the
+    phase changes, every ``heartbeat`` seconds, and once at the end. Raises
+    :class:`ToolError` when the tool exits non-zero or runs over ``timeout`` s.
     """
     tool = Path(argv[0]).name
     phases = PHASES.get(tool, ())
     detail_re = DETAILS.get(tool)
     t0 = time.monotonic()
     lines: queue.Queue[str | None] = queue.Queue()
+    followed = Path(cwd, follow) if follow is not None else None
+    if followed is not None:
+        followed.unlink(missing_ok=True)
     log = open(log_path, "w", encoding="utf-8", errors="replace")  # noqa: SIM115
     try:
         proc = subprocess.Popen(
@@ -149,44 +156,57 @@ def run_tool(
 
     reader = threading.Thread(target=pump, daemon=True)
     reader.start()
-    phase, phase_index, last_line, last_report = "starting", -1, "", t0
-    detail = ""
+    state = {"phase": "starting", "index": -1, "detail": "", "reported": t0}
+    last_line = ""
+    tail = _Tail(followed) if followed is not None else None
+
+    def parse(text: str) -> None:
+        found = detail_re.search(text) if detail_re else None
+        if found:
+            state["detail"] = f"{int(found.group(1)):,} arcs left"
+        for index, (pattern, name) in enumerate(phases):
+            if index > state["index"] and pattern.search(text):
+                state.update(phase=name, index=index, detail="",
+                             reported=time.monotonic())
+                if on_progress:
+                    on_progress(Progress(step, name, time.monotonic() - t0, expected))
+                break
+
     try:
         if on_progress:
-            on_progress(Progress(step, phase, 0.0, expected))
+            on_progress(Progress(step, "starting", 0.0, expected))
         finished = False
         while not finished:
             try:
-                text = lines.get(timeout=1.0)
+                text = lines.get(timeout=0.5)
             except queue.Empty:
                 text = ""
+            while text is not None:
+                if text:
+                    log.write(text)
+                    if text.strip():
+                        last_line = text.strip()
+                    if tail is None:
+                        parse(text)
+                try:
+                    text = lines.get_nowait()
+                except queue.Empty:
+                    break
             if text is None:
                 finished = True
-                text = ""
-            if text:
-                log.write(text)
-                if text.strip():
-                    last_line = text.strip()
-                found = detail_re.search(text) if detail_re else None
-                if found:
-                    detail = f"{int(found.group(1)):,} arcs left"
-                for index, (pattern, name) in enumerate(phases):
-                    if index > phase_index and pattern.search(text):
-                        phase, phase_index, detail = name, index, ""
-                        if on_progress:
-                            on_progress(Progress(step, phase, time.monotonic() - t0,
-                                                 expected))
-                        last_report = time.monotonic()
-                        break
+            if tail is not None:
+                for followed_line in tail.read_lines():
+                    parse(followed_line)
             now = time.monotonic()
-            if on_progress and now - last_report >= heartbeat:
-                shown = f"{phase} ({detail})" if detail else phase
+            if on_progress and now - state["reported"] >= heartbeat:
+                detail = state["detail"]
+                shown = f"{state['phase']} ({detail})" if detail else state["phase"]
                 on_progress(Progress(step, shown, now - t0, expected))
-                last_report = now
+                state["reported"] = now
             if timeout is not None and now - t0 > timeout:
                 _kill_group(proc)
                 raise ToolError(f"{tool} ran over its time limit of {timeout:.0f} s and was "
-                                f"stopped; log: {log_path}")
+                                f"stopped; log: {followed or log_path}")
         code = proc.wait()
     except BaseException:
         _kill_group(proc)
@@ -196,13 +216,42 @@ def run_tool(
         if proc.stdout is not None:
             proc.stdout.close()
         log.close()
+        if tail is not None:
+            last_line = last_line or tail.last
+            tail.close()
     elapsed = time.monotonic() - t0
     if code != 0:
+        shown = followed if followed is not None and followed.is_file() else log_path
         raise ToolError(f"{tool} failed (exit {code}) after {elapsed:.0f} s; last line: "
-                        f"{last_line[:200]!r}; log: {log_path}")
+                        f"{last_line[:200]!r}; log: {shown}")
     if on_progress:
         on_progress(Progress(step, "done", elapsed, expected, done=True))
     return elapsed
+
+
+class _Tail:
+    """Complete new lines of a growing text file (which may not exist yet)."""
+
+    def __init__(self, path: Path):
+        self.path, self.handle, self.partial, self.last = path, None, "", ""
+
+    def read_lines(self) -> list[str]:
+        if self.handle is None:
+            try:
+                self.handle = open(self.path, encoding="utf-8", errors="replace")  # noqa: SIM115
+            except OSError:
+                return []
+        text = self.partial + self.handle.read()
+        *done, self.partial = text.split("\n")
+        for line in reversed(done):
+            if line.strip():
+                self.last = line.strip()
+                break
+        return done
+
+    def close(self) -> None:
+        if self.handle is not None:
+            self.handle.close()
 
 
 def _kill_group(proc: subprocess.Popen) -> None:

