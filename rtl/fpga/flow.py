@@ -34,8 +34,8 @@ from amaranth.lib import wiring
 
 from rvsm.model.atomic import write_text_atomic
 from rvsm.model.errors import RvsmError
-from rvsm.model.fixed.config import DesignPoint
 from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.design_point import DesignPoint
 
 from .devices import Device, get_device
 from .harness import IoHarness

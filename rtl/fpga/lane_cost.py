@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from rvsm.model.errors import RvsmError
-from rvsm.model.fixed.config import DesignPoint
+from rvsm.model.fixed.design_point import DesignPoint
 
 from .devices import get_device
 from .flow import build_component, place_and_route, synthesise

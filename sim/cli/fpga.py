@@ -56,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _fpga(args: argparse.Namespace) -> int:
-    from rvsm.model.fixed.config import load_design_point
+    from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.fpga.flow import run_fpga
 
     if args.lanes < 1:

@@ -14,11 +14,11 @@ from types import ModuleType
 
 from rvsm.model.errors import RvsmError, ToolError
 
-from . import demo, fixed, rtl, sampling, scenes, studies, sweep
+from . import demo, fixed, fpga, rtl, sampling, scenes, studies, sweep
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
-#: co-simulation, paper studies, the demo, design sweeps.
-FAMILIES: tuple[ModuleType, ...] = (sampling, scenes, fixed, rtl, studies, demo, sweep)
+#: co-simulation, FPGA timing and area, paper studies, the demo, design sweeps.
+FAMILIES: tuple[ModuleType, ...] = (sampling, scenes, fixed, rtl, fpga, studies, demo, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:

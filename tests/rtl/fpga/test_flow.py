@@ -1,9 +1,8 @@
-"""The FPGA flow end to end on a tiny array, tool failures, timeouts and the CLI."""
+"""The FPGA flow end to end on a tiny array, tool failures, timeouts and progress."""
 
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 import stat
 import time
@@ -12,10 +11,9 @@ from pathlib import Path
 import pytest
 
 from rvsm.model.errors import ToolError
-from rvsm.model.fixed.config import default_design_point, save_design_point
+from rvsm.model.fixed.design_point import default_design_point
 from rvsm.rtl.fpga.flow import run_fpga, synthesis_script
 from rvsm.rtl.fpga.tools import run_tool
-from rvsm.sim.cli import main
 
 TINY = (2, 2)
 
@@ -60,43 +58,6 @@ def test_synthesis_only_keeps_the_stream_arrays_state_memories(tmp_path: Path) -
     # accumulator and threshold memories survive (as RAM, or as flip-flops)
     assert ram_bits + r.ff.used - r.harness_ff >= state
     assert r.ff.used - r.harness_ff > c.num_scales * 2 * c.accumulator_bits
-
-
-def test_cli_synth_only_json(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
-    save_design_point(tmp_path / "p.toml", _point())
-    code = main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",
-                 "--synth-only", "--json", "--rtlil", "-o", str(tmp_path / "w")])
-    out, err = capsys.readouterr()
-    assert code == 0, err
-    d = json.loads(out)
-    assert d["mode"] == "synthesis-only" and d["lanes"] == 4 and d["fmax_mhz"] is None
-    assert d["sensor_height"] == 250 and d["height"] == 2
-    assert "synthesis (yosys): done" in err  # progress on stderr
-    assert d["netlist"] == "rtlil" and (tmp_path / "w" / "top.il").is_file()
-
-
-def test_failing_tool_is_a_tool_error_and_exit_3(tmp_path: Path, capsys: pytest.CaptureFixture,
-                                                 monkeypatch: pytest.MonkeyPatch) -> None:
-    fake = _script(tmp_path / "fake-yosys", "echo 'ERROR: something broke'\nexit 1\n")
-    monkeypatch.setenv("RVSM_YOSYS", str(fake))
-    with pytest.raises(ToolError, match="exit 1.*something broke"):
-        run_fpga(_point(), tmp_path / "a", arch="parallel", size=TINY, synth_only=True)
-    save_design_point(tmp_path / "p.toml", _point())
-    code = main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",
-                 "--synth-only", "--quiet", "-o", str(tmp_path / "b")])
-    _, err = capsys.readouterr()
-    assert code == 3
-    assert err.count("\n") == 1 and err.startswith("rvsm: error:") and "yosys.out" in err
-    monkeypatch.setenv("RVSM_YOSYS", str(tmp_path / "missing"))
-    assert main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",
-                 "--synth-only", "--quiet", "-o", str(tmp_path / "c")]) == 3
-
-
-def test_bad_input_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
-    save_design_point(tmp_path / "p.toml", _point())
-    assert main(["fpga", str(tmp_path / "p.toml"), "--lanes", "0", "--arch", "parallel"]) == 2
-    assert main(["fpga", str(tmp_path / "p.toml"), "--arch", "stream", "--size", "2x2",
-                 "--lanes", "3", "--synth-only", "-o", str(tmp_path / "w")]) == 2
 
 
 def test_timeout_kills_the_whole_process_group(tmp_path: Path) -> None:

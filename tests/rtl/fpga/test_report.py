@@ -7,7 +7,7 @@ import json
 import pytest
 
 from rvsm.model.errors import ToolError
-from rvsm.model.fixed.config import default_design_point
+from rvsm.model.fixed.design_point import default_design_point
 from rvsm.rtl.fpga.devices import DEVICES, get_device
 from rvsm.rtl.fpga.report import FpgaReport, Usage, parse_nextpnr_report, parse_yosys_stat
 from rvsm.rtl.fpga.sensor import state_memory

@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.config import default_design_point
+from rvsm.model.fixed.design_point import default_design_point
 from rvsm.rtl.fpga.devices import DEVICES
 from rvsm.rtl.fpga.sensor import (
     BRAM_SHAPES,
