@@ -4,10 +4,14 @@ A *design* is one combination of axis values; its rows are its scenes x noise x 
 Its PSNR cost is the worst deviation from the float model, ``max |psnr_float -
 psnr_fixed|`` over those rows, in dB (a fixed point that beats the float model by 1 dB
 does not model it either);
-its hardware cost is yosys cells per pixel of the RTL synthesised at the sweep's
-``[hardware] size`` (or, without synthesis, the proxy ``adc.bits + weights.bits +
-datapath.accumulator_bits`` bits). Figures are returned as matplotlib Figures; only
-:func:`write_report` writes files.
+its hardware cost is measured on the streaming array (``rvsm.rtl.fpga.lane_cost``):
+logic per lane (ECP5 LUT4 from yosys, the slope between the sweep's ``[hardware] lanes``
+at ``[hardware] size``; without synthesis, the proxy ``adc.bits + weights.bits +
+datapath.accumulator_bits`` bits), flip-flops per lane, optionally Fmax, and the exact
+state memory of the design point at its own (sensor) size: accumulators, thresholds and
+line buffers. The Pareto fronts put the PSNR cost against logic per lane and against
+memory bits. Figures are returned as matplotlib Figures; only :func:`write_report`
+writes files.
 """
 
 from __future__ import annotations
@@ -24,15 +28,18 @@ from rvsm.model.atomic import atomic_path, write_text_atomic
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.design_point import FIELD_BY_PATH, FIELD_PATH
 from rvsm.model.fixed.point_toml import parse_design_point
+from rvsm.rtl.fpga.sensor import state_memory
 
 from .store import open_existing
 
 PROXY_LABEL = "adc + weight + accumulator bits (proxy: no synthesis)"
+LOGIC_LABEL = "logic per lane (ECP5 LUT4, yosys)"
+MEMORY_LABEL = "state memory of the sensor (Mbit)"
 
 
 @dataclass
 class DesignSummary:
-    """Aggregate of one design over its rows (costs in dB, hardware per pixel)."""
+    """Aggregate of one design over its rows (costs in dB, logic per lane, memory bits)."""
 
     design_id: str
     axes: dict[str, Any]
@@ -46,15 +53,17 @@ class DesignSummary:
     worst_ssim_cost: float
     min_agreement: float
     max_saturation: float
-    cells_per_pixel: float | None
-    ff_per_pixel: float | None
+    lut4_per_lane: float | None
+    ff_per_lane: float | None
+    fmax_mhz: float | None
+    memory_bits: int
     proxy_bits: int
     complete: bool = True
 
     @property
     def hw(self) -> float:
-        """Hardware cost used for the Pareto front (cells/pixel, else the bit proxy)."""
-        return self.cells_per_pixel if self.cells_per_pixel is not None else self.proxy_bits
+        """Logic cost used for the Pareto front (LUT4 per lane, else the bit proxy)."""
+        return self.lut4_per_lane if self.lut4_per_lane is not None else self.proxy_bits
 
     @property
     def label(self) -> str:
@@ -77,7 +86,8 @@ def summarise(rows: list[dict[str, Any]]) -> list[DesignSummary]:
         values = {p: _value(point, p) for p in rs[0]["axes"]}
         costs = np.array([r["psnr_cost"] for r in rs], dtype=float)
         have = {(r["scene"], r["noise"], r["seed"], r["steps"], r["size"]) for r in rs}
-        cells = rs[0].get("cells_per_pixel")
+        logic = rs[0].get("lut4_per_lane")
+        ffs, fmax = rs[0].get("ff_per_lane"), rs[0].get("fmax_mhz")
         out.append(DesignSummary(
             design_id=did, axes=rs[0]["axes"], values=values, toml=rs[0]["design_toml"],
             model=point.model, rows=rs, worst_cost=float(np.abs(costs).max()),
@@ -86,15 +96,16 @@ def summarise(rows: list[dict[str, Any]]) -> list[DesignSummary]:
             worst_ssim_cost=float(max(r["ssim_cost"] for r in rs)),
             min_agreement=float(min(r["agreement"] for r in rs)),
             max_saturation=float(max(r["max_saturation_rate"] for r in rs)),
-            cells_per_pixel=None if cells is None else float(cells),
-            ff_per_pixel=None if rs[0].get("ff_per_pixel") is None
-            else float(rs[0]["ff_per_pixel"]),
+            lut4_per_lane=None if logic is None else float(logic),
+            ff_per_lane=None if ffs is None else float(ffs),
+            fmax_mhz=None if fmax is None else float(fmax),
+            memory_bits=state_memory(point.contract()).total,
             proxy_bits=point.adc_bits + point.weight_bits + point.accumulator_bits,
             complete=have >= runs,
         ))
-    if any(d.cells_per_pixel is None for d in out):  # mixed: compare like with like
+    if any(d.lut4_per_lane is None for d in out):  # mixed: compare like with like
         for d in out:
-            d.cells_per_pixel = None
+            d.lut4_per_lane = None
     return sorted(out, key=lambda d: (d.hw, d.worst_cost))
 
 
@@ -160,31 +171,35 @@ def width_cost_figure(designs: list[DesignSummary], tolerance: float = 0.1):
 
 
 def pareto_figure(designs: list[DesignSummary], tolerance: float = 0.1):
-    """Worst PSNR cost against hardware cost; the Pareto front in colour, dominated points
-    grey. Returns a matplotlib Figure."""
+    """Worst PSNR cost against logic per lane (left) and against the sensor's state memory
+    (right); each panel's Pareto front in colour, dominated points grey. Returns a
+    matplotlib Figure."""
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(6.4, 4.4))
-    ax = fig.subplots()
-    hw = np.array([d.hw for d in designs], dtype=float)
+    fig = Figure(figsize=(11.0, 4.4))
+    axs = fig.subplots(1, 2)
     cost = np.array([d.worst_cost for d in designs], dtype=float)
-    mask = pareto_mask(hw, cost) if designs else np.zeros(0, bool)
-    ax.scatter(hw[~mask], cost[~mask], s=14, color="0.7", label="dominated")  # grey
-    order = np.argsort(hw[mask])
-    ax.plot(hw[mask][order], cost[mask][order], "o-", color="tab:blue", drawstyle="steps-post",
-            label="Pareto front")
-    front = [d for d, m in zip(designs, mask, strict=True) if m]
-    for i, d in enumerate(front, 1):  # P-numbers as in the report's Pareto table
-        ax.annotate(f"P{i}", (d.hw, max(d.worst_cost, 1e-3)), fontsize=7, xytext=(3, 3),
-                    textcoords="offset points")
-    ax.axhline(tolerance, color="tab:red", lw=0.8, ls="--", label=f"{tolerance} dB")
-    uses_cells = bool(designs) and designs[0].cells_per_pixel is not None
-    ax.set_xlabel("yosys cells per pixel" if uses_cells else PROXY_LABEL)
-    if designs and cost.min() > 0:
-        ax.set_yscale("log")
-    ax.set_ylabel("max |PSNR float - fixed| (dB)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    uses_logic = bool(designs) and designs[0].lut4_per_lane is not None
+    panels = ((axs[0], [d.hw for d in designs], LOGIC_LABEL if uses_logic else PROXY_LABEL),
+              (axs[1], [d.memory_bits / 1e6 for d in designs], MEMORY_LABEL))
+    for k, (ax, xs, label) in enumerate(panels):
+        hw = np.array(xs, dtype=float)
+        mask = pareto_mask(hw, cost) if designs else np.zeros(0, bool)
+        ax.scatter(hw[~mask], cost[~mask], s=14, color="0.7", label="dominated")  # grey
+        order = np.argsort(hw[mask])
+        ax.plot(hw[mask][order], cost[mask][order], "o-", color="tab:blue",
+                drawstyle="steps-post", label="Pareto front")
+        front = [i for i, m in enumerate(mask) if m]
+        for n, i in enumerate(front, 1):  # numbers as in the report's Pareto tables
+            ax.annotate(f"{'PM'[k]}{n}", (hw[i], max(cost[i], 1e-3)), fontsize=7,
+                        xytext=(3, 3), textcoords="offset points")
+        ax.axhline(tolerance, color="tab:red", lw=0.8, ls="--", label=f"{tolerance} dB")
+        ax.set_xlabel(label)
+        if designs and cost.min() > 0:
+            ax.set_yscale("log")
+        ax.set_ylabel("max |PSNR float - fixed| (dB)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
     fig.tight_layout()
     return fig
 
@@ -194,7 +209,8 @@ def report_markdown(db_name: str, designs: list[DesignSummary], invalid: list[di
                     figures: dict[str, str]) -> str:
     """The markdown report (``figures``: caption -> relative file name)."""
     rec = recommend(designs, tolerance)
-    hw_sizes = sorted({r.get("hw_size") or "-" for d in designs for r in d.rows[:1]})
+    hw_sizes = sorted({f"{r.get('hw_size')} at lanes {r.get('hw_lanes')}"
+                       if r.get("hw_size") else "-" for d in designs for r in d.rows[:1]})
     runs = sorted({(r["scene"], r["noise"], r["seed"], r["size"], r["steps"])
                    for d in designs for r in d.rows})
     lines = [
@@ -208,9 +224,11 @@ def report_markdown(db_name: str, designs: list[DesignSummary], invalid: list[di
         "",
         f"PSNR cost = PSNR(float) - PSNR(fixed) in dB; `worst |cost|` is the largest "
         "deviation over a design's runs (used for the recommendation and the Pareto front), "
-        "`worst cost` the largest signed cost. Hardware "
-        f"cost = yosys cells per pixel of the RTL synthesised at {', '.join(hw_sizes)} "
-        "(see docs/design-space.md for the caveat).", "",
+        "`worst cost` the largest signed cost. Hardware cost is measured on the streaming "
+        "array: logic per lane = ECP5 LUT4 (LUT4 + 2 CCU2C) per extra lane from yosys "
+        f"`synth_ecp5`, synthesised at {', '.join(hw_sizes)} (the slope; the I/O harness "
+        "removed), and the exact state memory of the sensor at the design point "
+        "(accumulators + thresholds + line buffers); see docs/fpga.md.", "",
     ]
     for cap, f in figures.items():
         lines += [f"![{cap}]({f})", ""]
@@ -229,12 +247,18 @@ def report_markdown(db_name: str, designs: list[DesignSummary], invalid: list[di
                 f"{r['mse_cost']:+.2f} | {100 * r['agreement']:.1f} % | "
                 f"{100 * r['max_saturation_rate']:.3f} % |")
         lines.append("")
-    front = [d for d, m in zip(designs, pareto_mask([d.hw for d in designs],
-                                                    [d.worst_cost for d in designs]),
+    costs = [d.worst_cost for d in designs]
+    front = [d for d, m in zip(designs, pareto_mask([d.hw for d in designs], costs),
                                strict=True) if m]
-    lines += ["## Pareto points", "", _table(front), ""]
+    by_memory = sorted(designs, key=lambda d: (d.memory_bits, d.worst_cost))
+    mem_front = [d for d, m in zip(
+        by_memory, pareto_mask([d.memory_bits for d in by_memory],
+                               [d.worst_cost for d in by_memory]), strict=True) if m]
+    lines += ["## Pareto points: PSNR cost against logic per lane", "", _table(front), ""]
     for i, d in enumerate(front, 1):
         lines += [f"### P{i}: {d.label}", "", "```toml", d.toml.rstrip(), "```", ""]
+    lines += ["## Pareto points: PSNR cost against state memory", "",
+              _table(mem_front, "M"), ""]
     lines += ["## All designs", "", _table(designs), ""]
     if invalid:
         lines += ["## Invalid designs (refused by design point validation)", "",
@@ -254,21 +278,26 @@ def report_markdown(db_name: str, designs: list[DesignSummary], invalid: list[di
 
 
 def _hw_text(d: DesignSummary) -> str:
-    if d.cells_per_pixel is None:
-        return f"{d.proxy_bits} bits (proxy)"
-    return f"{d.cells_per_pixel:.0f} cells/pixel, {d.ff_per_pixel:.1f} flip-flops/pixel"
+    memory = f"{d.memory_bits / 1e6:.2f} Mbit of state"
+    if d.lut4_per_lane is None:
+        return f"{d.proxy_bits} bits (proxy), {memory}"
+    fmax = "" if d.fmax_mhz is None else f", Fmax {d.fmax_mhz:.1f} MHz"
+    return (f"{d.lut4_per_lane:.0f} LUT4 and {d.ff_per_lane:.0f} flip-flops per lane"
+            f"{fmax}, {memory}")
 
 
-def _table(designs: list[DesignSummary]) -> str:
-    head = ("| design | cells/px | FF/px | worst \\|cost\\| | worst cost | mean cost | worst SSIM "
-            "cost | min agreement | max saturation | complete |\n"
-            "|---|---|---|---|---|---|---|---|---|---|")
+def _table(designs: list[DesignSummary], prefix: str = "") -> str:
+    head = ("| design | LUT4/lane | FF/lane | Fmax | memory | worst \\|cost\\| | worst cost | "
+            "mean cost | worst SSIM cost | min agreement | max saturation | complete |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|")
     rows = [
-        f"| {d.label} | {_fmt(d.cells_per_pixel, '.0f')} | {_fmt(d.ff_per_pixel, '.1f')} | "
+        f"| {f'{prefix}{i}: ' if prefix else ''}{d.label} | {_fmt(d.lut4_per_lane, '.0f')} | "
+        f"{_fmt(d.ff_per_lane, '.0f')} | {_fmt(d.fmax_mhz, '.1f')} | "
+        f"{d.memory_bits / 1e6:.2f} Mbit | "
         f"{d.worst_cost:.3f} dB | {d.worst_signed:+.3f} | {d.mean_cost:+.3f} | "
         f"{d.worst_ssim_cost:+.4f} | "
         f"{100 * d.min_agreement:.1f} % | {100 * d.max_saturation:.3f} % | "
-        f"{'yes' if d.complete else 'no'} |" for d in designs]
+        f"{'yes' if d.complete else 'no'} |" for i, d in enumerate(designs, 1)]
     return "\n".join([head, *rows])
 
 
@@ -281,7 +310,7 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
     """Write ``report.md``, ``width-cost.png`` and ``pareto.png`` into ``out_dir``.
 
     Returns the files written and the recommended design (``label``, ``toml``,
-    ``worst_cost``, ``cells_per_pixel``) or None.
+    ``worst_cost``, ``lut4_per_lane``, ``ff_per_lane``, ``memory_bits``) or None.
     """
     with open_existing(db) as store:
         rows = store.results()
@@ -292,7 +321,8 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     figs = {"PSNR cost against each width": ("width-cost.png", width_cost_figure),
-            "Pareto front: PSNR cost against hardware cost": ("pareto.png", pareto_figure)}
+            "Pareto fronts: PSNR cost against logic per lane and against state memory":
+                ("pareto.png", pareto_figure)}
     files = []
     for _cap, (name, make) in figs.items():
         fig = make(designs, tolerance)
@@ -308,8 +338,9 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
     rec = recommend(designs, tolerance)
     info = None if rec is None else {"label": rec.label, "toml": rec.toml,
                                       "worst_cost": rec.worst_cost,
-                                      "cells_per_pixel": rec.cells_per_pixel,
-                                      "ff_per_pixel": rec.ff_per_pixel}
+                                      "lut4_per_lane": rec.lut4_per_lane,
+                                      "ff_per_lane": rec.ff_per_lane,
+                                      "memory_bits": rec.memory_bits}
     return files, info
 
 

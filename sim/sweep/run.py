@@ -1,7 +1,8 @@
 """Run a sweep on Dask: compute every missing row, write each as it completes.
 
-:func:`run_sweep` expands the sweep, skips every row already in the database, synthesises
-each distinct RTL not yet in ``hw_cost`` once, and runs the rest on a Dask cluster: a
+:func:`run_sweep` expands the sweep, skips every row already in the database, measures
+the hardware cost (logic per lane of the streaming array) of each distinct RTL not yet in
+``lane_cost`` once, and runs the rest on a Dask cluster: a
 :class:`~dask.distributed.LocalCluster` of ``workers`` processes (default: one per core),
 ``scheduler=ADDRESS`` for an existing cluster, or ``workers=0`` in this process without
 Dask. Only this (coordinating) process writes the database, one committed row per finished
@@ -11,9 +12,9 @@ future, so Ctrl-C keeps everything finished. The task functions :func:`evaluate_
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import os
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -23,7 +24,7 @@ from typing import Any
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.design_point import DesignPoint
 
-from .spec import SweepSpec, SweepTask
+from .spec import HardwareSettings, SweepSpec, SweepTask
 from .store import SweepStore
 
 
@@ -77,32 +78,34 @@ def hw_point(point: DesignPoint, size: tuple[int, int]) -> DesignPoint:
     return point.with_size(*size)
 
 
-def hw_digest(point: DesignPoint, size: tuple[int, int]) -> str:
-    """Cache key of a design's synthesis at ``size``: the digest of its RTL contract."""
+def hw_digest(point: DesignPoint, hardware: HardwareSettings) -> str:
+    """Cache key of a design's hardware cost: the digest of its RTL contract at
+    ``hardware.size`` (RTL sources included), the FPGA flow's sources, the lane counts
+    and whether Fmax is measured."""
+    import rvsm.rtl.fpga as fpga
     from rvsm.rtl.verilog import rtl_digest
 
-    return rtl_digest(hw_point(point, size).contract())
+    h = hashlib.sha256(rtl_digest(hw_point(point, hardware.size).contract()).encode())
+    for src in sorted(Path(fpga.__file__).parent.glob("*.py")):
+        h.update(src.read_bytes())
+    h.update(f"stream|{hardware.lanes}|{hardware.fmax}".encode())
+    return h.hexdigest()[:16]
 
 
-def synthesise_task(point: DesignPoint, size: tuple[int, int]) -> dict[str, Any]:
-    """Generate the RTL of ``point`` at ``size`` and synthesise it with yosys.
-
-    Returns ``cells``, ``flip_flops``, ``cell_types``, ``pixels``, ``size`` ("HxW"),
-    ``contract`` (repr) and ``seconds`` (generation + synthesis wall time).
-    """
-    from rvsm.rtl.verilog import generate_verilog, yosys_stats
+def synthesise_task(point: DesignPoint, hardware: HardwareSettings) -> dict[str, Any]:
+    """Hardware cost of ``point`` on the streaming array
+    (:func:`~rvsm.rtl.fpga.lane_cost.lane_cost` at ``hardware.size`` and ``.lanes``):
+    ``lut4_per_lane``, ``ff_per_lane``, ``lut4_base``, ``fmax_mhz`` (or None), the
+    memory bits, ``size`` ("HxW"), ``lanes``, ``contract`` (repr) and ``seconds``."""
+    from rvsm.rtl.fpga.lane_cost import lane_cost
 
     t0 = time.perf_counter()
-    contract = hw_point(point, size).contract()
-    gen = generate_verilog(contract)
-    with tempfile.TemporaryDirectory(prefix="rvsm-sweep-") as d:
-        path = Path(d) / "array.v"
-        path.write_text(gen.text, encoding="utf-8")
-        stats = yosys_stats(path, gen.top)
-    return {"cells": stats["cells"], "flip_flops": stats["flip_flops"],
-            "cell_types": stats["cell_types"], "pixels": size[0] * size[1],
-            "size": f"{size[0]}x{size[1]}", "contract": repr(contract),
-            "seconds": time.perf_counter() - t0}
+    cost = lane_cost(point, size=hardware.size, lanes=hardware.lanes, fmax=hardware.fmax)
+    rec = cost.to_dict()
+    rec.update(size=f"{hardware.size[0]}x{hardware.size[1]}", lanes=list(hardware.lanes),
+               contract=repr(hw_point(point, hardware.size).contract()),
+               seconds=time.perf_counter() - t0)
+    return rec
 
 
 def run_sweep(
@@ -131,7 +134,7 @@ def run_sweep(
         if hw.enabled:
             for d in spec.designs:
                 if d.point is not None:
-                    digests[d.design_id] = hw_digest(d.point, hw.size)
+                    digests[d.design_id] = hw_digest(d.point, hw)
             for did, dig in digests.items():
                 if dig in known:
                     continue
@@ -205,7 +208,7 @@ def _execute(spec, store, pending, hw_todo, digests, summary, workers, scheduler
         if workers == 0 and scheduler is None:
             summary.workers = 0
             for dig, point in hw_todo.items():
-                _call(finished, "hw", dig, synthesise_task, point, spec.hardware.size)
+                _call(finished, "hw", dig, synthesise_task, point, spec.hardware)
             for t in pending:
                 _call(finished, "pt", t, evaluate_task, t, *args)
         else:
@@ -247,7 +250,7 @@ def _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
         summary.workers = len(client.scheduler_info().get("workers", {}))
         items = {}
         for dig, point in hw_todo.items():
-            f = client.submit(synthesise_task, point, spec.hardware.size, key=f"hw-{dig}",
+            f = client.submit(synthesise_task, point, spec.hardware, key=f"hw-{dig}",
                               priority=10)
             items[f.key] = ("hw", dig)
             futures.append(f)

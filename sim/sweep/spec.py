@@ -55,7 +55,9 @@ RUN_ONLY: tuple[str, ...] = tuple(f.path for f in FIELDS if not f.sweep)
 AUTO_AXES: tuple[str, ...] = tuple(f.path for f in FIELDS if f.auto)
 SECTIONS = ("base", "axes", "run", "hardware")
 RUN_KEYS = ("scenes", "size", "frames", "steps_per_frame", "seeds", "noise", "method", "match")
-HARDWARE_KEYS = ("enabled", "size")
+HARDWARE_KEYS = ("enabled", "size", "lanes", "fmax")
+#: Largest array ``[hardware] size`` may synthesise (pixels).
+MAX_HARDWARE_PIXELS = 64 * 64
 MAX_POINTS = 100_000
 
 
@@ -81,10 +83,15 @@ class RunSettings:
 
 @dataclass(frozen=True)
 class HardwareSettings:
-    """``[hardware]``: synthesise the RTL of each distinct contract at ``size`` (pixels)."""
+    """``[hardware]``: the streaming array of each distinct contract, synthesised at
+    ``size`` (pixels) for two lane counts ``lanes`` (logic per lane = the slope), and, with
+    ``fmax``, placed and routed at the first (minutes per design);
+    :func:`rvsm.rtl.fpga.lane_cost.lane_cost`."""
 
     enabled: bool = True
-    size: tuple[int, int] = (4, 4)
+    size: tuple[int, int] = (16, 16)
+    lanes: tuple[int, int] = (1, 2)
+    fmax: bool = False
 
 
 @dataclass(frozen=True)
@@ -359,13 +366,26 @@ def _parse_hardware(raw: Any, source: str) -> HardwareSettings:
     if not isinstance(enabled, bool):
         raise RvsmError(f"{source}: hardware.enabled must be true or false")
     try:
-        size = parse_size(str(raw.get("size", "4x4")))
+        size = parse_size(str(raw.get("size", "16x16")))
     except RvsmError as exc:
         raise RvsmError(f"{source}: hardware.size: {exc}") from None
-    if size[0] * size[1] > 64:
-        raise RvsmError(f"{source}: hardware.size {size[0]}x{size[1]} is too large to "
-                        "synthesise (flat RTL); use at most 64 pixels, e.g. \"4x4\"")
-    return HardwareSettings(enabled, size)
+    if size[0] * size[1] > MAX_HARDWARE_PIXELS:
+        raise RvsmError(f"{source}: hardware.size {size[0]}x{size[1]} is larger than needed "
+                        f"for logic per lane; use at most {MAX_HARDWARE_PIXELS} pixels, e.g. "
+                        "\"16x16\"")
+    lanes = raw.get("lanes", [1, 2])
+    if not isinstance(lanes, list) or len(lanes) != 2 or any(
+            isinstance(v, bool) or not isinstance(v, int) for v in lanes) \
+            or not 1 <= lanes[0] < lanes[1]:
+        raise RvsmError(f"{source}: hardware.lanes must be two lane counts [P1, P2] with "
+                        f"1 <= P1 < P2, got {lanes!r}")
+    if size[1] % lanes[0] or size[1] % lanes[1]:
+        raise RvsmError(f"{source}: hardware.size width {size[1]} must be a multiple of "
+                        f"both hardware.lanes {lanes}")
+    fmax = raw.get("fmax", False)
+    if not isinstance(fmax, bool):
+        raise RvsmError(f"{source}: hardware.fmax must be true or false")
+    return HardwareSettings(enabled, size, (lanes[0], lanes[1]), fmax)
 
 
 def _pos_int(v: Any, where: str) -> int:

@@ -8,7 +8,10 @@ Tables (see docs/design-space.md):
   steps, size)``; ``status`` ``ok`` (metrics), ``invalid`` (validation refused the design;
   ``error`` says why) or ``error`` (the computation failed; retried on the next run). The
   full record (JSON) and the full design point (TOML) are stored with it.
-- ``hw_cost``: yosys cells / flip-flops per distinct RTL, keyed by the contract digest.
+- ``lane_cost``: hardware cost per distinct RTL on the streaming array, keyed by its
+  digest: logic (LUT4) and flip-flops per lane from yosys, optional Fmax, the memory bits
+  of the design point (:func:`rvsm.rtl.fpga.lane_cost.lane_cost`). Databases of schema 1
+  keep their old ``hw_cost`` table (fully parallel cells per pixel), no longer read.
 
 Only the coordinating process writes, one transaction per row, so an interrupted sweep
 keeps every finished row and a rerun adds exactly the missing ones.
@@ -27,7 +30,7 @@ from rvsm.model.errors import RvsmError
 
 from .spec import SweepSpec, SweepTask
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE IF NOT EXISTS sweeps (
@@ -52,11 +55,11 @@ CREATE TABLE IF NOT EXISTS results (
     PRIMARY KEY (point_id, scene, noise, seed, steps, size)
 );
 CREATE INDEX IF NOT EXISTS results_design ON results (design_id);
-CREATE TABLE IF NOT EXISTS hw_cost (
-    digest TEXT PRIMARY KEY, size TEXT NOT NULL, pixels INTEGER NOT NULL,
-    cells INTEGER NOT NULL, flip_flops INTEGER NOT NULL,
-    cells_per_pixel REAL NOT NULL, ff_per_pixel REAL NOT NULL,
-    seconds REAL NOT NULL, contract TEXT NOT NULL, cell_types TEXT, finished TEXT NOT NULL
+CREATE TABLE IF NOT EXISTS lane_cost (
+    digest TEXT PRIMARY KEY, size TEXT NOT NULL, lanes TEXT NOT NULL,
+    lut4_per_lane REAL NOT NULL, ff_per_lane REAL NOT NULL, lut4_base REAL NOT NULL,
+    fmax_mhz REAL, memory_bits INTEGER NOT NULL, seconds REAL NOT NULL,
+    contract TEXT NOT NULL, record TEXT NOT NULL, finished TEXT NOT NULL
 );
 """
 METRICS = ("agreement", "psnr_float", "psnr_fixed", "psnr_cost", "ssim_float", "ssim_fixed",
@@ -142,14 +145,15 @@ class SweepStore:
         return cur.rowcount == 1
 
     def write_hw_cost(self, digest: str, stats: dict[str, Any]) -> None:
-        """Store one synthesis result (ignored if the digest is already known)."""
+        """Store one hardware-cost result (``synthesise_task``'s record; ignored if the
+        digest is already known)."""
         with self.db:
             self.db.execute(
-                "INSERT OR IGNORE INTO hw_cost VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                (digest, stats["size"], stats["pixels"], stats["cells"], stats["flip_flops"],
-                 stats["cells"] / stats["pixels"], stats["flip_flops"] / stats["pixels"],
-                 stats["seconds"], stats["contract"], json.dumps(stats.get("cell_types", {})),
-                 _now()),
+                "INSERT OR IGNORE INTO lane_cost VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                (digest, stats["size"], json.dumps(stats["lanes"]), stats["lut4_per_lane"],
+                 stats["ff_per_lane"], stats["lut4_base"], stats.get("fmax_mhz"),
+                 stats["memory_bits"], stats["seconds"], stats["contract"],
+                 json.dumps(stats), _now()),
             )
 
     # -- reading ------------------------------------------------------------------------
@@ -161,13 +165,14 @@ class SweepStore:
         return {tuple(r) for r in cur}
 
     def known_digests(self) -> set[str]:
-        """Contract digests already synthesised."""
-        return {r[0] for r in self.db.execute("SELECT digest FROM hw_cost")}
+        """Hardware digests already measured."""
+        return {r[0] for r in self.db.execute("SELECT digest FROM lane_cost")}
 
     def results(self, status: str | None = None) -> list[dict[str, Any]]:
-        """Result rows as dicts (``record`` and ``axes`` decoded), joined with hw_cost."""
-        q = ("SELECT r.*, h.cells, h.flip_flops, h.cells_per_pixel, h.ff_per_pixel, "
-             "h.size AS hw_size FROM results r LEFT JOIN hw_cost h ON h.digest = r.hw_digest")
+        """Result rows as dicts (``record`` and ``axes`` decoded), joined with lane_cost."""
+        q = ("SELECT r.*, h.lut4_per_lane, h.ff_per_lane, h.lut4_base, h.fmax_mhz, "
+             "h.size AS hw_size, h.lanes AS hw_lanes "
+             "FROM results r LEFT JOIN lane_cost h ON h.digest = r.hw_digest")
         args: tuple = ()
         if status is not None:
             q += " WHERE r.status = ?"

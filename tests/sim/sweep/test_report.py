@@ -61,8 +61,49 @@ enabled = false
     for d in designs:
         assert d.worst_cost == max(abs(r["psnr_cost"]) for r in d.rows)
         assert d.proxy_bits == sum(d.values[k] for k in d.values if k != "weights.frac_bits")
+    from rvsm.model.fixed.point_toml import parse_design_point
+    from rvsm.rtl.fpga.sensor import state_memory
+
+    for d in designs:  # exact state memory of the sensor at each design point
+        point = parse_design_point(d.toml)
+        assert d.memory_bits == state_memory(point.contract()).total
+        assert d.lut4_per_lane is None and d.hw == d.proxy_bits  # hardware disabled
+    adc = {d.values["adc.bits"]: d.memory_bits for d in designs}
+    assert adc[8] > adc[5]  # wider codes, wider line buffers
     rec = recommend(designs, tolerance=1e9)
     assert rec is not None and rec.hw == min(d.hw for d in designs)
     assert recommend(designs, tolerance=-1.0) is None
     for fig in (width_cost_figure(designs), pareto_figure(designs)):
         assert isinstance(fig, Figure)
+
+
+def test_report_with_logic_per_lane_and_memory(tmp_path):
+    from rvsm.sim.sweep.report import write_report
+
+    spec = parse_sweep("""
+[base.array]
+model = "dog1"
+[axes]
+"datapath.accumulator_bits" = [18, 21]
+[run]
+scenes = ["coin"]
+size = "16x24"
+frames = 2
+[hardware]
+size = "4x4"
+""")
+    db = tmp_path / "r.sqlite"
+    s = run_sweep(spec, db, workers=0, progress=False)
+    assert s.hw_synthesised == 2 and not s.errors
+    with SweepStore(db) as store:
+        designs = summarise(store.results())
+    by_acc = {d.values["datapath.accumulator_bits"]: d for d in designs}
+    # wider accumulators: more state and more logic per lane (adders, compare, memory port)
+    assert by_acc[21].memory_bits > by_acc[18].memory_bits
+    assert by_acc[21].lut4_per_lane > by_acc[18].lut4_per_lane > 0
+    assert all(d.hw == d.lut4_per_lane for d in designs)
+    files, info = write_report(db, tmp_path / "report", tolerance=1e9)
+    text = (tmp_path / "report" / "report.md").read_text()
+    assert "LUT4/lane" in text and "PSNR cost against state memory" in text
+    assert info["lut4_per_lane"] == min(d.lut4_per_lane for d in designs)
+    assert info["memory_bits"] == by_acc[18].memory_bits

@@ -133,7 +133,7 @@ scenes = ["coin"]
 size = "8x8"
 frames = 2
 [hardware]
-size = "1x1"
+size = "4x4"
 """
     db = tmp_path / "r.sqlite"
     s = run_sweep(parse_sweep(text), db, workers=0, progress=False)
@@ -141,9 +141,14 @@ size = "1x1"
     s = run_sweep(parse_sweep(text.replace("400.0", "350.0")), db, workers=0, progress=False)
     assert s.hw_synthesised == 0 and s.hw_cached == 1 and s.computed == 1
     with sqlite3.connect(db) as con:
-        cells, ffs = con.execute("SELECT cells, flip_flops FROM hw_cost").fetchone()
-        assert cells > ffs > 0
-        assert con.execute("SELECT COUNT(*) FROM results r JOIN hw_cost h "
+        lut4, ffs, memory, lanes = con.execute(
+            "SELECT lut4_per_lane, ff_per_lane, memory_bits, lanes FROM lane_cost").fetchone()
+        assert lut4 > 0 and ffs > 0 and lanes == "[1, 2]"
+        from rvsm.model.fixed.design_point import default_design_point
+        from rvsm.rtl.fpga.sensor import state_memory
+
+        assert memory == state_memory(default_design_point().contract()).total
+        assert con.execute("SELECT COUNT(*) FROM results r JOIN lane_cost h "
                            "ON h.digest = r.hw_digest").fetchone()[0] == 3
 
 
@@ -168,7 +173,7 @@ enabled = false
 """
     db = tmp_path / "r.sqlite"
     run_sweep(parse_sweep(text), db, workers=0, progress=False)
-    s = run_sweep(parse_sweep(text.replace("enabled = false", 'size = "1x1"')), db,
+    s = run_sweep(parse_sweep(text.replace("enabled = false", 'size = "4x4"')), db,
                   workers=0, progress=False)
     assert s.computed == 0 and s.hw_synthesised == 1
     with sqlite3.connect(db) as con:

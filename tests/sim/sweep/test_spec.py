@@ -77,7 +77,11 @@ enabled = false
     ('[run]\nscenes = ["coin"]\nframez = 3', "run.framez"),
     ('[run]\nscenes = ["coin"]\nsize = "big"', "run.size"),
     ('[run]\nscenes = ["coin"]\nnoise = ["yes"]', "run.noise"),
-    ('[run]\nscenes = ["coin"]\n[hardware]\nsize = "16x16"', "hardware.size"),
+    ('[run]\nscenes = ["coin"]\n[hardware]\nsize = "128x128"', "hardware.size"),
+    ('[run]\nscenes = ["coin"]\n[hardware]\nsize = "4x6"\nlanes = [1, 4]', "hardware.size"),
+    ('[run]\nscenes = ["coin"]\n[hardware]\nlanes = [2, 1]', "hardware.lanes"),
+    ('[run]\nscenes = ["coin"]\n[hardware]\nlanes = [1]', "hardware.lanes"),
+    ('[run]\nscenes = ["coin"]\n[hardware]\nfmax = "yes"', "hardware.fmax"),
     ('[base.adc]\nbits = 99\n[run]\nscenes = ["coin"]', "adc.bits"),
     ('[bogus]\n[run]\nscenes = ["coin"]', "[bogus]"),
     ('[run\n', "not valid TOML"),
@@ -103,3 +107,13 @@ def test_axes_are_the_declared_sweepable_fields():
     for path in RUN_ONLY:
         with pytest.raises(RvsmError, match="set by \\[run\\]"):
             parse_sweep(f'[axes]\n"{path}" = [1]\n[run]\nscenes = ["coin"]\n')
+
+
+def test_hardware_settings_defaults_and_values():
+    spec = parse_sweep('[run]\nscenes = ["coin"]\n')
+    assert (spec.hardware.size, spec.hardware.lanes, spec.hardware.fmax) == \
+        ((16, 16), (1, 2), False)
+    spec = parse_sweep('[run]\nscenes = ["coin"]\n[hardware]\nsize = "8x12"\n'
+                       'lanes = [2, 4]\nfmax = true\n')
+    assert (spec.hardware.size, spec.hardware.lanes, spec.hardware.fmax) == \
+        ((8, 12), (2, 4), True)
