@@ -108,8 +108,10 @@ def synthesis_script(top: str = TOP, netlist: str = "verilog") -> str:
 
 
 def expected_synthesis_seconds(netlist_bytes: int, netlist: str = "verilog") -> float:
-    """Rough yosys ``synth_ecp5 -abc9`` wall time (s) for a netlist file of that size."""
-    per_mb = 40.0 if netlist == "verilog" else 15.0
+    """Rough yosys ``synth_ecp5 -abc9`` wall time (s) for a netlist file of that size
+    (fit to 64x64 dog4 at 1 and 4 lanes and 16x400 at 20 lanes on a shared 2-core machine,
+    without all-zero memory initialisers)."""
+    per_mb = 220.0 if netlist == "verilog" else 80.0
     return 5.0 + per_mb * netlist_bytes / 1e6
 
 
