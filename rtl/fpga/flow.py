@@ -255,6 +255,13 @@ def run_fpga(
                           Usage(stat["bram"], dev.bram))
         mode = "synthesis-only"
     else:
+        over = [f"{what} {stat[key]:,} > {avail:,}" for what, key, avail in (
+            ("DP16KD", "bram", dev.bram), ("LUT4", "lut4", dev.lut4), ("FF", "ff", dev.ff))
+            if stat[key] > avail]
+        if over:
+            raise RvsmError(f"the synthesised design does not fit the {dev.name} "
+                            f"({', '.join(over)}); place and route would fail: use "
+                            "--synth-only, a smaller --size or fewer --lanes")
         pnr, seconds["place_route"] = place_and_route(
             syn, dev, speed=speed, target_mhz=target_mhz, seed=seed,
             on_progress=on_progress, timeout=timeout)

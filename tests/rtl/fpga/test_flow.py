@@ -116,3 +116,16 @@ def test_place_and_route_on_a_tiny_array(tmp_path: Path) -> None:
     assert r.lut4.used > 0 and r.ff.used >= r.harness_ff
     assert r.pixel_steps_per_s == pytest.approx(4 * r.fmax_mhz * 1e6)
     assert (tmp_path / "nextpnr.log").is_file()
+
+
+def test_a_design_too_big_for_the_device_is_refused_before_place_and_route(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from rvsm.model.errors import RvsmError
+    from rvsm.rtl.fpga.devices import Device
+
+    tiny = Device("ecp5-tiny", "--25k", "CABGA381", lut4=10, ff=10, bram=0, lutram_slices=0)
+    fake = _script(tmp_path / "never-run", "exit 99\n")
+    monkeypatch.setenv("RVSM_NEXTPNR_ECP5", str(fake))
+    with pytest.raises(RvsmError, match="does not fit the ecp5-tiny.*--synth-only") as info:
+        run_fpga(_point(), tmp_path, arch="parallel", size=TINY, device=tiny)
+    assert not isinstance(info.value, ToolError)  # bad input (exit 2), nextpnr never ran
