@@ -33,8 +33,8 @@ def builds(rtl_builds: Path) -> Path:
 
 def check_cases(c: ArrayContract, lanes: int, sim: str, work: Path, builds: Path,
                 seed: int, steps: int = 8) -> None:
-    """Random, saturating and clear-mid-stream stimuli: zero mismatches, spikes of both
-    signs (for signed models)."""
+    """Random, saturating, checkerboard and clear-mid-stream stimuli: zero mismatches,
+    spikes of both signs (for signed models)."""
     rng = np.random.default_rng(seed)
     s, h, w = c.num_scales, c.height, c.width
     full = (1 << c.adc_bits) - 1
@@ -45,7 +45,11 @@ def check_cases(c: ArrayContract, lanes: int, sim: str, work: Path, builds: Path
                           rng.choice([0, full], (steps - steps // 2, h, w))])
     thr_rail = thr.copy()
     thr_rail.reshape(-1)[::3] = top  # the top rail fires only when saturated
+    # dark pixels ringed by full-scale ones: DoG sums go negative, so -1 spikes fire
+    yy, xx = np.indices((h, w))
+    checker = np.broadcast_to(((yy + xx) % 2) * full, (steps, h, w)).copy()
     cases = {"random": (rand, thr, ()), "saturating": (sat, thr_rail, ()),
+             "checkerboard": (checker, thr, ()),
              "clear_mid_stream": (rand, thr, (steps // 3, steps // 2 + 1))}
     signs = set()
     for name, (codes, t, clears) in cases.items():
