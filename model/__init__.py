@@ -15,3 +15,9 @@ Submodules, one concept each:
   calibration of the ``paper`` preset on FSM.
 - :mod:`fixed` -- the bit-accurate fixed-point twin (SPEC section 5).
 """
+
+import os as _os
+
+# Numba's fused kernels and the counter-based noise streams must round the same whether a
+# loop is vectorised or not: no Intel SVML vector maths (set before numba is imported).
+_os.environ.setdefault("NUMBA_DISABLE_INTEL_SVML", "1")

@@ -5,10 +5,13 @@
 - Fixed pattern per accumulator: offset ``V_OS ~ N(e2, (b2 k)^2)`` and gain
   ``theta ~ N(e3, (b3 k)^2)``; the accumulator's threshold is ``theta * phi + V_OS``.
 
-Streams (all from ``numpy.random.SeedSequence(seed)``): child 0 feeds the fixed pattern,
-with one grandchild per scale index (so ``dog1`` and ``dog4`` share scale 0's pattern);
-child 1 feeds the dark current, drawn step after step in row-major order, so FSM and every
-RVSM ladder with the same seed see the same dark current, whatever the block size.
+Streams: counter-based (:mod:`.noise_streams`), every deviate a pure function of
+``(seed, stream, step, row, column)``, so the same seed gives the same noise whatever the
+block, chunk, tile or thread count. Stream 0 is the dark current (step ``t``, pixel
+``(y, x)``); streams ``16 + s`` and ``32 + s`` are scale ``s``'s fixed-pattern offset and
+gain (drawn at step 0), so ``dog1`` and ``dog4`` share scale 0's pattern and FSM and every
+RVSM ladder with the same seed see the same dark current. The float and fixed twins draw
+from the same streams.
 """
 
 from __future__ import annotations
@@ -18,6 +21,14 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .errors import RvsmError
+from .noise_streams import (
+    STREAM_DARK,
+    STREAM_THETA,
+    STREAM_VOS,
+    check_coordinates,
+    normal_block,
+    stream_key,
+)
 
 MAX_SCALES = 4
 
@@ -53,7 +64,11 @@ class NoiseParams:
 
 
 class NoiseSource:
-    """Seeded noise for one array of ``(H, W)`` pixels and ``S`` accumulators per pixel."""
+    """Seeded noise for one array of ``(H, W)`` pixels and ``S`` accumulators per pixel.
+
+    :meth:`dark_current` continues where the previous call stopped (a step counter);
+    :meth:`dark_current_at` draws any step range without state.
+    """
 
     def __init__(self, params: NoiseParams, shape: tuple[int, int], num_scales: int):
         if not 1 <= num_scales <= MAX_SCALES:
@@ -61,19 +76,26 @@ class NoiseSource:
         self.params = params
         self.shape = (int(shape[0]), int(shape[1]))
         self.num_scales = int(num_scales)
-        fixed_seq, dark_seq = np.random.SeedSequence(params.seed).spawn(2)
-        self._scale_seqs = fixed_seq.spawn(MAX_SCALES)[: self.num_scales]
-        self._dark = np.random.Generator(np.random.PCG64(dark_seq))
+        check_coordinates(0, self.shape)
+        self.dark_key = stream_key(params.seed, STREAM_DARK)
+        self._next_step = 0
+
+    @property
+    def dark_mean_sd(self) -> tuple[float, float]:
+        """``(e1, b1 k)``: mean and standard deviation of the dark current."""
+        p = self.params
+        return float(p.e1), float(p.b1 * p.k)
 
     def fixed_pattern(self) -> tuple[np.ndarray, np.ndarray]:
         """``(theta, v_os)``, each ``(S, H, W) float64``; the same on every call."""
         p = self.params
         theta = np.empty((self.num_scales,) + self.shape)
         v_os = np.empty_like(theta)
-        for s, seq in enumerate(self._scale_seqs):
-            rng = np.random.Generator(np.random.PCG64(seq))
-            v_os[s] = rng.normal(p.e2, p.b2 * p.k, self.shape)
-            theta[s] = rng.normal(p.e3, p.b3 * p.k, self.shape)
+        for s in range(self.num_scales):
+            v_os[s] = normal_block(
+                stream_key(p.seed, STREAM_VOS + s), 0, 1, self.shape, p.e2, p.b2 * p.k)[0]
+            theta[s] = normal_block(
+                stream_key(p.seed, STREAM_THETA + s), 0, 1, self.shape, p.e3, p.b3 * p.k)[0]
         return theta, v_os
 
     def thresholds(self, phi: np.ndarray) -> np.ndarray:
@@ -84,7 +106,13 @@ class NoiseSource:
         theta, v_os = self.fixed_pattern()
         return theta * np.asarray(phi, dtype=np.float64)[:, None, None] + v_os
 
+    def dark_current_at(self, t0: int, num_steps: int) -> np.ndarray:
+        """Dark current of steps ``t0 .. t0 + B - 1``: ``(B, H, W) float64`` brightness."""
+        mean, sd = self.dark_mean_sd
+        return normal_block(self.dark_key, t0, num_steps, self.shape, mean, sd)
+
     def dark_current(self, num_steps: int) -> np.ndarray:
         """The next ``num_steps`` steps of dark current: ``(B, H, W) float64`` brightness."""
-        p = self.params
-        return self._dark.normal(p.e1, p.b1 * p.k, (num_steps,) + self.shape)
+        out = self.dark_current_at(self._next_step, num_steps)
+        self._next_step += int(num_steps)
+        return out

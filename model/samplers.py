@@ -4,10 +4,12 @@ Every model integrates per step, then compares, then resets; the spike of step `
 decided from the accumulation that includes step ``t``. FSM is the one-scale case with a
 1x1 kernel of weight 1 that only fires +1.
 
-Speed: receptive-field sums are linear, so the frames are filtered once and the per-step
-drive is interpolated between filtered frames (SPEC section 1's formula applied after the
-filter); only the dark current, new every step, is filtered per step, in blocks. The
-per-step loop then runs over whole ``(S, H, W)`` arrays.
+Two engines give bit-identical spikes: ``"fused"`` (default; numba kernels with the time
+loop inside, :mod:`.fused`, run chunk by chunk by :mod:`.sampling_stream`) and ``"numpy"``
+(the vectorised reference below). In both, receptive-field sums are linear, so the frames
+are filtered once and the per-step drive is interpolated between filtered frames (SPEC
+section 1's formula applied after the filter); only the dark current, new every step, is
+filtered per step. Filtering uses the fixed float order of :mod:`.orbits`.
 """
 
 from __future__ import annotations
@@ -18,13 +20,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import RvsmError
-from .filtering import receptive_field_sums
 from .kernels import ModelSpec, model_spec
 from .noise import NoiseParams, NoiseSource
+from .orbits import orbit_receptive_sums
 from .progress import progress_bar
 from .scene import Scene
 
 RESET_MODES = ("zero", "subtract")
+ENGINES = ("fused", "numpy")
 DEFAULT_PHI = 400.0
 DEFAULT_BLOCK_STEPS = 32
 
@@ -121,17 +124,17 @@ def iter_step_drives(
 
     Frames are filtered once; a step between frames is ``(1 - a) KF[f] + a KF[f+1]``
     (SPEC section 1's interpolation applied after the linear filter). Dark current is
-    drawn and filtered in blocks of ``block_steps``.
+    drawn and filtered in blocks of ``block_steps``. This is the numpy reference engine.
     """
     kernels = config.spec.kernels()
-    filtered = receptive_field_sums(scene.frames, kernels)  # (F, S, H, W)
+    filtered = orbit_receptive_sums(scene.frames, kernels)  # (F, S, H, W)
     noise = NoiseSource(config.noise, scene.shape, len(kernels)) if config.noise else None
     buf = np.empty(filtered.shape[1:])
     tmp = np.empty_like(buf)
     for t0, t1 in scene.blocks(block_steps):
         f, a = scene.frame_weights(t0, t1)
         dark = (
-            receptive_field_sums(noise.dark_current(t1 - t0), kernels)
+            orbit_receptive_sums(noise.dark_current(t1 - t0), kernels)
             if noise is not None else None
         )
         for b in range(t1 - t0):
@@ -198,11 +201,23 @@ def sample(
     config: SamplerConfig,
     block_steps: int = DEFAULT_BLOCK_STEPS,
     progress: bool = False,
+    engine: str = "fused",
 ) -> SpikeTrain:
     """Run a float sampler over a whole scene.
 
     Returns a :class:`SpikeTrain` with ``spikes (T, S, H, W) int8`` (S = 1 for FSM).
+    ``engine`` is ``"fused"`` (numba, default) or ``"numpy"`` (the reference); both give
+    the same spikes. For long runs use :func:`rvsm.model.sampling_stream.stream_float`.
     """
+    if engine not in ENGINES:
+        raise RvsmError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if engine == "fused":
+        from .sampling_stream import ArraySink, stream_float
+
+        sink = ArraySink()
+        train = stream_float(scene, config, sink, progress=progress)
+        train.spikes = sink.spikes
+        return train
     spec = config.spec
     thresholds = accumulator_thresholds(config, scene.shape)
     integrator = Integrator(thresholds, spec.signed, config.reset)

@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""Write ``model/orbit_kernels.py``: the per-half-width orbit sums, unrolled for numba.
+
+Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
+``model/orbits.py``; ``tests/model/test_fused.py`` checks the file is up to date.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+MAX_HALF = 4
+HEADER = '''"""Unrolled orbit sums for numba (written by scripts/gen_orbit_kernels.py; do not edit).
+
+``scale_sum_L(pairs, pr, w, width, out)``: ``out[x]`` = the receptive sum of padded row
+``pr`` for one scale of half-width ``L`` with orbit weights ``w``, where
+``pairs[b, r, x] = v(r, x - b) + v(r, x + b)`` (``pairs[0] = v``); the same float
+operations in the same order as :func:`rvsm.model.orbits.orbit_receptive_sums` (``t``
+starts at ``w[0] - w[0]``, i.e. 0 of the weights' type, so the same code sums integers
+exactly for the fixed twin). The weighted sum stays in a register, so the loop over
+``x`` vectorises.
+"""
+
+from numba import njit
+'''
+
+
+def _row(b: int, d: int) -> str:
+    return f"r{b}_{'m' if d < 0 else 'p'}{abs(d)}"
+
+
+def orbit_expr(a: int, b: int) -> tuple[str, set[tuple[int, int]]]:
+    """The expression of orbit ``(a, b)`` and the ``(pair, row offset)`` rows it reads."""
+    if a == 0:
+        rows = {(0, 0)}
+        expr = f"{_row(0, 0)}[x]"
+    elif b == 0:
+        rows = {(0, -a), (0, a), (a, 0)}
+        expr = f"(({_row(0, -a)}[x] + {_row(0, a)}[x]) + {_row(a, 0)}[x])"
+    elif a == b:
+        rows = {(a, -a), (a, a)}
+        expr = f"({_row(a, -a)}[x] + {_row(a, a)}[x])"
+    else:
+        rows = {(b, -a), (b, a), (a, -b), (a, b)}
+        expr = (f"(({_row(b, -a)}[x] + {_row(b, a)}[x]) + "
+                f"({_row(a, -b)}[x] + {_row(a, b)}[x]))")
+    return expr, rows
+
+
+def generate() -> str:
+    """The module's source text."""
+    out = [HEADER.rstrip("\n")]
+    for half in range(MAX_HALF + 1):
+        orbits = [(a, b) for a in range(half + 1) for b in range(a + 1)]
+        exprs, rows = [], set()
+        for a, b in orbits:
+            e, r = orbit_expr(a, b)
+            exprs.append(e)
+            rows |= r
+        out.append("")
+        out.append("")
+        out.append('@njit(inline="always", cache=True)')
+        out.append(f"def scale_sum_{half}(pairs, pr, w, width, out):")
+        for b, d in sorted(rows):
+            out.append(f"    {_row(b, d)} = pairs[{b}, pr {'-' if d < 0 else '+'} {abs(d)}]")
+        out.append("    for x in range(width):")
+        out.append("        t = w[0] - w[0]")
+        for n, e in enumerate(exprs):
+            out.append(f"        t = t + w[{n}] * {e}")
+        out.append("        out[x] = t")
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
+def main() -> None:
+    target = Path(__file__).resolve().parent.parent / "model" / "orbit_kernels.py"
+    target.write_text(generate())
+    print(f"wrote {target}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
