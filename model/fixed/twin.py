@@ -7,9 +7,10 @@ accumulator's integer threshold -> spike +1 / -1 -> reset (:mod:`.core`). The no
 from the same :class:`~rvsm.model.noise.NoiseSource` (same seed, same streams) as the float
 sampler, so float and fixed see identical analogue noise.
 
-Vectorised: steps are processed in blocks (ADC and sums for a whole block at once), and the
-per-step loop runs over whole ``(S, H, W)`` arrays. The spikes are exactly
-``point.contract().run(codes, thresholds)``.
+Two engines with identical spikes and statistics: ``"fused"`` (default; numba, the time
+loop inside, :mod:`.fused`) and ``"numpy"`` (vectorised: steps in blocks, ADC and sums for
+a whole block at once, the per-step loop over whole ``(S, H, W)`` arrays). The spikes are
+exactly ``point.contract().run(codes, thresholds)``.
 """
 
 from __future__ import annotations
@@ -104,13 +105,29 @@ def simulate_fixed(
     block_steps: int = DEFAULT_BLOCK_STEPS,
     keep_codes: bool = False,
     histograms: bool = False,
+    engine: str = "fused",
+    ranges: bool = True,
 ) -> FixedRun:
     """Run the fixed twin of ``point`` over ``scene``; see the module docstring.
 
     A scene whose ``(H, W)`` differs from the point's runs on the same point resized to
     it (:func:`fit_point`); ``meta`` records the size used. ``keep_codes`` keeps the ADC
-    codes (for stimulus files); ``histograms`` fills the profiling histograms.
+    codes (for stimulus files); ``histograms`` fills the profiling histograms (both run
+    the numpy engine). ``engine`` is ``"fused"`` (numba, default) or ``"numpy"``;
+    ``ranges=False`` lets the fused engine skip the min/max statistics (None then).
     """
+    if engine == "fused" and not keep_codes and not histograms:
+        from ..sampling_stream import ArraySink
+        from .fused import stream_fixed
+
+        sink = ArraySink()
+        run = stream_fixed(scene, point, sink, progress=progress, ranges=ranges)
+        run.spikes = sink.spikes
+        return run
+    if engine not in ("fused", "numpy"):
+        from ..errors import RvsmError
+
+        raise RvsmError(f"engine must be fused or numpy, got {engine!r}")
     point = fit_point(scene, point)
     contract = point.contract()
     noise = point.noise_source()

@@ -1,0 +1,418 @@
+"""Fused numba kernel of the fixed twin: ADC, integer sums, shift, saturate, fire, reset.
+
+:class:`FusedFixedTwin` runs a design point chunk by chunk; :func:`_fixed_chunk` processes
+tiles of rows in parallel and, inside a tile, loops over the chunk's steps: interpolate the
+brightness of the tile's rows plus a halo of ``L`` rows (SPEC section 1's expression), add
+the dark current (counter-based streams, :mod:`rvsm.model.noise_streams`), ADC (the
+rounding and clipping of :mod:`.adc`), exact receptive sums with the integer weights
+(orbit sums, :mod:`rvsm.model.orbit_kernels`), arithmetic right shift (floor division by
+``2**shift``), W-bit saturating accumulators, compare with the integer thresholds, reset.
+
+Exact integers: when every per-step sum and accumulator value fits in 52 bits (true for
+any practical design point; checked from the contract), the integer arithmetic runs in
+float64, where integers below ``2**53`` are exact and the loops vectorise; otherwise the
+same kernel is compiled for int64. Either way the spikes and the datapath statistics are
+the integers of :func:`rvsm.model.fixed.core.run_integer_array`, for any tile size,
+chunk length and thread count.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange, types
+from numba.extending import overload
+
+from ..errors import RvsmError
+from ..fused import _row_pairs, _scale_sum
+from ..noise_streams import ZIG_RATIO, ZIG_X, check_coordinates, pixel_normal
+from ..orbits import kernel_orbits
+from ..scene import Scene
+from .core import accumulator_range
+
+EXACT_FLOAT_BITS = 52
+
+
+def shift_down(v, shift, scale):
+    """``floor(v / 2**shift)``: ``v >> shift`` for integers, ``floor(v * scale)`` (``scale =
+    2**-shift``, exact) for integer-valued floats."""
+    if isinstance(v, (float, np.floating)):
+        return np.floor(v * scale)
+    return v >> shift
+
+
+@overload(shift_down, jit_options={"cache": True})
+def _shift_down_impl(v, shift, scale):
+    if isinstance(v, types.Float):
+        return lambda v, shift, scale: np.floor(v * scale)
+    return lambda v, shift, scale: v >> shift
+
+
+# Only min/max and sums of integer-valued floats (exact in any order) run under these
+# flags; no flag may touch the analogue interpolation, dark current or ADC.
+_INTEGER_FASTMATH = {"nnan", "ninf", "nsz", "reassoc"}
+
+
+@njit(fastmath=_INTEGER_FASTMATH, cache=True)
+def _range_row(analog, width, out):
+    """``out = (min(out[0], analog), max(out[1], analog))`` over one row."""
+    lo = out[0]
+    hi = out[1]
+    for x in range(width):
+        v = analog[x]
+        lo = min(lo, v)
+        hi = max(hi, v)
+    out[0] = lo
+    out[1] = hi
+
+
+@njit(fastmath=_INTEGER_FASTMATH, cache=True)
+def _integrate_fixed_row(sums, acc, thr, spikes, st, width, shift, scale, lo, hi, signed,
+                         zero_reset):
+    """Shift, saturate, compare, fire and reset one row of one scale; ``st`` holds the
+    running sum / shifted / accumulator min-max and the saturation count."""
+    zero = lo - lo
+    smin = st[0]
+    smax = st[1]
+    hmin = st[2]
+    hmax = st[3]
+    vmin = st[4]
+    vmax = st[5]
+    sat = 0
+    for x in range(width):
+        sm = sums[x]
+        smin = min(smin, sm)
+        smax = max(smax, sm)
+        sh = shift_down(sm, shift, scale)
+        hmin = min(hmin, sh)
+        hmax = max(hmax, sh)
+        v = acc[x] + sh
+        vmin = min(vmin, v)
+        vmax = max(vmax, v)
+        sat += (v > hi) | (v < lo)
+        v = min(max(v, lo), hi)
+        th = thr[x]
+        pos = v >= th
+        neg = signed & (v <= -th) & (not pos)
+        sp = np.int8(pos) - np.int8(neg)
+        spikes[x] = sp
+        if zero_reset:
+            acc[x] = zero if (pos | neg) else v
+        else:
+            acc[x] = v - th * sp
+    st[0] = smin
+    st[1] = smax
+    st[2] = hmin
+    st[3] = hmax
+    st[4] = vmin
+    st[5] = vmax
+    st[6] += sat
+
+
+@njit(fastmath=_INTEGER_FASTMATH, cache=True)
+def _integrate_fixed_row_fast(sums, acc, thr, spikes, st, width, shift, scale, lo, hi,
+                              signed, zero_reset):
+    """:func:`_integrate_fixed_row` without the min/max tracking (it keeps the saturation
+    count): branch-free, so the loop vectorises."""
+    zero = lo - lo
+    one = zero + 1
+    sgn = one if signed else zero
+    keep = zero if zero_reset else one
+    sat = 0
+    for x in range(width):
+        v = acc[x] + shift_down(sums[x], shift, scale)
+        sat += (v > hi) | (v < lo)
+        v = min(max(v, lo), hi)
+        th = thr[x]
+        p = one if v >= th else zero
+        n = sgn * (one if v <= -th else zero) * (one - p)
+        sp = p - n
+        spikes[x] = np.int8(sp)
+        fired = p + n
+        acc[x] = (one - fired) * v + fired * keep * (v - th * sp)
+    st[6] += sat
+
+
+@njit(inline="always", cache=True)
+def _add_dark(key, t, y, width, mean, sd, zx, zr, analog):
+    for x in range(width):
+        analog[x] = analog[x] + (mean + sd * pixel_normal(key, t, y, x, zx, zr))
+
+
+@njit(parallel=True, cache=True)
+def _fixed_chunk(frames, fidx, aw, thr, acc, weights, halves, lmax, gain, half, top,
+                 shift, scale, lo, hi, signed, zero_reset, noisy, key, t0, mean, sd, zx, zr,
+                 tile_rows, out, stats, analog_range, check_range, ranges):
+    num_scales, height, width = acc.shape
+    num_steps = fidx.shape[0]
+    num_tiles = (height + tile_rows - 1) // tile_rows
+    for ti in prange(num_tiles):
+        y0 = ti * tile_rows
+        y1 = min(height, y0 + tile_rows)
+        rows = y1 - y0
+        nrows = rows + 2 * lmax
+        pad = np.zeros((nrows, width + 2 * lmax), dtype=weights.dtype)
+        pairs = np.empty((lmax + 1, nrows, width), dtype=weights.dtype)
+        analog = np.empty(width)
+        sums = np.empty(width, dtype=weights.dtype)
+        st = stats[ti]
+        arange = np.zeros(2)
+        for b in range(num_steps):
+            f = fidx[b]
+            a = aw[b]
+            oma = 1.0 - a
+            for r in range(nrows):
+                y = y0 - lmax + r
+                if y < 0 or y >= height:
+                    continue
+                f0 = frames[f, y]
+                if a == 0.0:
+                    for x in range(width):
+                        analog[x] = f0[x]
+                else:
+                    f1 = frames[f + 1, y]
+                    for x in range(width):
+                        analog[x] = oma * f0[x] + a * f1[x]
+                if noisy:
+                    _add_dark(key, t0 + b, y, width, mean, sd, zx, zr, analog)
+                prow = pad[r]
+                if check_range:
+                    _range_row(analog, width, arange)
+                for x in range(width):
+                    v = analog[x]
+                    c = np.floor(v * gain + half)
+                    c = 0.0 if c < 0.0 else (top if c > top else c)
+                    prow[x + lmax] = c
+            _row_pairs(pad, nrows, lmax, width, pairs)
+            for r in range(rows):
+                y = y0 + r
+                for s in range(num_scales):
+                    _scale_sum(pairs, lmax + r, weights[s], halves[s], width, sums)
+                    if ranges:
+                        _integrate_fixed_row(sums, acc[s, y], thr[s, y], out[b, s, y], st[s],
+                                             width, shift, scale, lo, hi, signed, zero_reset)
+                    else:
+                        _integrate_fixed_row_fast(sums, acc[s, y], thr[s, y], out[b, s, y],
+                                                  st[s], width, shift, scale, lo, hi, signed,
+                                                  zero_reset)
+        amin = arange[0]
+        amax = arange[1]
+        analog_range[ti, 0] = min(analog_range[ti, 0], amin)
+        analog_range[ti, 1] = max(analog_range[ti, 1], amax)
+
+
+def exact_in_float(point) -> bool:
+    """True when every sum and accumulator value of ``point`` is an integer below 2**52."""
+    contract = point.contract()
+    bound = max(max(-lo, hi) for lo, hi in
+                (contract.sum_range(s) for s in range(contract.num_scales)))
+    return bound < (1 << EXACT_FLOAT_BITS) and point.accumulator_bits <= EXACT_FLOAT_BITS
+
+
+class FusedFixedTwin:
+    """State and fused chunk kernel of the fixed twin of ``point`` on ``scene``.
+
+    ``thresholds`` is ``(S, H, W) int64``; :meth:`run` advances over steps ``t0 .. t1 - 1``
+    (consecutive) and returns spikes ``(t1 - t0, S, H, W) int8``; :meth:`stats` gives the
+    datapath counters so far (per scale: sum, shifted and accumulator min/max, saturated).
+    """
+
+    def __init__(self, scene: Scene, point, thresholds: np.ndarray, tile_rows: int = 16,
+                 ranges: bool = True):
+        self.scene = scene
+        self.ranges = bool(ranges)
+        self.point = point
+        contract = point.contract()
+        _, weights, halves, self.lmax = kernel_orbits(contract.weight_arrays)
+        dtype = np.float64 if exact_in_float(point) else np.int64
+        self.dtype = dtype
+        self.weights = np.ascontiguousarray(weights, dtype=dtype)
+        self.halves = halves
+        self.thr = np.ascontiguousarray(thresholds, dtype=dtype)
+        self.acc = np.zeros_like(self.thr)
+        lo, hi = accumulator_range(point.accumulator_bits)
+        self.lo, self.hi = dtype(lo), dtype(hi)
+        self.shift = np.int64(point.shift)
+        self.scale = 2.0 ** -point.shift
+        self.gain = float(point.adc_gain)
+        if point.adc_rounding == "truncate":
+            self.half = 0.0
+        elif point.adc_rounding == "round-half-up":
+            self.half = 0.5
+        else:  # pragma: no cover - the design point validates it
+            raise RvsmError(f"unknown ADC rounding {point.adc_rounding!r}")
+        self.top = float((1 << point.adc_bits) - 1)
+        self.signed = bool(point.signed)
+        self.zero_reset = point.reset == "zero"
+        self.tile_rows = max(1, int(tile_rows))
+        num_tiles = -(-scene.shape[0] // self.tile_rows)
+        s = point.num_scales
+        big = np.finfo(np.float64).max if dtype is np.float64 else np.iinfo(np.int64).max
+        self._stats = np.zeros((num_tiles, s, 7), dtype=dtype)
+        self._stats[:, :, 0::2] = big
+        self._stats[:, :, 1::2] = -big
+        self._stats[:, :, 6] = 0
+        noise = point.noise_source()
+        if noise is not None:
+            check_coordinates(scene.num_steps, scene.shape)
+            self.key = noise.dark_key
+            self.mean, self.sd = noise.dark_mean_sd
+            self.noisy = True
+        else:
+            self.key, self.mean, self.sd, self.noisy = np.uint64(0), 0.0, 0.0, False
+        self.next_step = 0
+
+    def run(self, t0: int, t1: int, out: np.ndarray | None = None) -> np.ndarray:
+        """Spikes ``(t1 - t0, S, H, W) int8`` of steps ``t0 .. t1 - 1``."""
+        if t0 != self.next_step:
+            raise ValueError(f"chunks must be consecutive: expected step {self.next_step}")
+        scene = self.scene
+        f, a = scene.frame_weights(t0, t1)
+        first = int(f[0])
+        last = min(int(f[-1]) + 1, scene.num_frames - 1)
+        frames = scene.frames[first:last + 1]
+        s, h, w = self.acc.shape
+        if out is None:
+            out = np.empty((t1 - t0, s, h, w), dtype=np.int8)
+        analog_range = np.zeros((self._stats.shape[0], 2))
+        _fixed_chunk(
+            frames, (f - first).astype(np.int64), np.ascontiguousarray(a, dtype=np.float64),
+            self.thr, self.acc, self.weights, self.halves, self.lmax, self.gain, self.half,
+            self.top, self.shift, self.scale, self.lo, self.hi, self.signed, self.zero_reset,
+            self.noisy, self.key, int(t0), self.mean, self.sd, ZIG_X, ZIG_RATIO, self.tile_rows,
+            out, self._stats, analog_range, self.point.adc_clip == "error", self.ranges,
+        )
+        if self.point.adc_clip == "error":
+            lo, hi = float(analog_range[:, 0].min()), float(analog_range[:, 1].max())
+            fs = self.point.adc_full_scale
+            if lo < 0 or hi > fs:
+                raise RvsmError(
+                    f"adc.clip = 'error': analogue input {lo:g}..{hi:g} leaves the ADC range "
+                    f"0..{fs:g}; raise adc.full_scale or use adc.clip = 'saturate'"
+                )
+        self.next_step = t1
+        return out
+
+    def stats(self) -> dict[str, np.ndarray | None]:
+        """Per-scale ``(S,) int64`` counters: ``sum_min``, ``sum_max``, ``shifted_min``,
+        ``shifted_max``, ``acc_min``, ``acc_max`` (None unless ``ranges``), ``saturated``."""
+        st = self._stats
+        names = ("sum_min", "sum_max", "shifted_min", "shifted_max", "acc_min", "acc_max")
+        out = {}
+        for i, name in enumerate(names):
+            if not self.ranges:
+                out[name] = None
+                continue
+            col = st[:, :, i].min(axis=0) if i % 2 == 0 else st[:, :, i].max(axis=0)
+            if self.dtype is np.float64:
+                limit = np.iinfo(np.int64)
+                col = np.where(np.isfinite(col) & (np.abs(col) < 2.0**62), col,
+                               limit.max if i % 2 == 0 else limit.min)
+            out[name] = col.astype(np.int64)
+        out["saturated"] = st[:, :, 6].sum(axis=0).astype(np.int64)
+        return out
+
+
+def stream_fixed(
+    scene: Scene,
+    point,
+    sink,
+    chunk_steps: int = 256,
+    engine: str = "fused",
+    tile_rows: int = 16,
+    progress: bool = False,
+    ranges: bool = True,
+):
+    """Run the fixed twin of ``point`` over ``scene`` chunk by chunk into ``sink``.
+
+    Returns a :class:`~.twin.FixedRun` whose ``spikes`` is ``None`` (they went to the
+    sink). ``engine`` ``"numpy"`` runs the vectorised reference
+    (:func:`~.twin.simulate_fixed` ``engine="numpy"``) step by step. ``ranges=False``
+    skips the min/max datapath statistics of the fused engine (they stay None; the
+    saturation counts are always kept): about 1.5x faster.
+    """
+    from ..samplers import ENGINES, progress_bar
+    from ..sampling_stream import check_chunking, run_chunks
+    from .adc import adc_codes
+    from .core import FixedIntegrator, arithmetic_shift, integer_receptive_sums
+    from .twin import FixedRun, FixedStats, fit_point, fixed_meta
+
+    if engine not in ENGINES:
+        raise RvsmError(f"engine must be one of {ENGINES}, got {engine!r}")
+    check_chunking(chunk_steps, tile_rows)
+    point = fit_point(scene, point)
+    contract = point.contract()
+    noise = point.noise_source()
+    thresholds = point.integer_thresholds(noise)
+    s_count, (h, w), t_total = point.num_scales, point.shape, scene.num_steps
+    shape = (t_total, s_count, h, w)
+    buf = np.empty((min(chunk_steps, max(t_total, 1)), s_count, h, w), dtype=np.int8)
+    if engine == "fused":
+        twin = FusedFixedTwin(scene, point, thresholds, tile_rows, ranges)
+
+        def produce(t0: int, t1: int) -> np.ndarray:
+            return twin.run(t0, t1, buf[:t1 - t0])
+
+        def final_stats() -> dict:
+            return twin.stats()
+    else:
+        integrator = FixedIntegrator(thresholds, point.accumulator_bits, point.signed,
+                                     point.reset, track=True)
+        weights = contract.weight_arrays
+        big, small = np.iinfo(np.int64).max, np.iinfo(np.int64).min
+        acc_stats = {"sum_min": np.full(s_count, big), "sum_max": np.full(s_count, small),
+                     "shifted_min": np.full(s_count, big),
+                     "shifted_max": np.full(s_count, small)}
+
+        def produce(t0: int, t1: int) -> np.ndarray:
+            analog = scene.brightness(t0, t1)
+            if noise is not None:
+                analog += noise.dark_current_at(t0, t1 - t0)
+            codes = adc_codes(analog, point.adc_bits, point.adc_full_scale,
+                              point.adc_rounding, point.adc_clip)
+            sums = integer_receptive_sums(codes, weights)
+            np.minimum(acc_stats["sum_min"], sums.min(axis=(0, 2, 3)), out=acc_stats["sum_min"])
+            np.maximum(acc_stats["sum_max"], sums.max(axis=(0, 2, 3)), out=acc_stats["sum_max"])
+            shifted = arithmetic_shift(sums, point.shift) if point.shift else sums
+            np.minimum(acc_stats["shifted_min"], shifted.min(axis=(0, 2, 3)),
+                       out=acc_stats["shifted_min"])
+            np.maximum(acc_stats["shifted_max"], shifted.max(axis=(0, 2, 3)),
+                       out=acc_stats["shifted_max"])
+            for b in range(t1 - t0):
+                buf[b] = integrator.step(shifted[b])
+            return buf[:t1 - t0]
+
+        def final_stats() -> dict:
+            return {**acc_stats, "acc_min": integrator.acc_min.copy(),
+                    "acc_max": integrator.acc_max.copy(),
+                    "saturated": integrator.saturated.copy()}
+
+    placeholder = FixedStats(steps=t_total, accumulators=h * w,
+                             saturated=np.zeros(s_count, dtype=np.int64),
+                             sum_min=np.zeros(s_count, dtype=np.int64),
+                             sum_max=np.zeros(s_count, dtype=np.int64),
+                             shifted_min=np.zeros(s_count, dtype=np.int64),
+                             shifted_max=np.zeros(s_count, dtype=np.int64),
+                             acc_min=np.zeros(s_count, dtype=np.int64),
+                             acc_max=np.zeros(s_count, dtype=np.int64))
+    meta = fixed_meta(scene, point, thresholds, placeholder)
+    bar = progress_bar(t_total, f"fixed {point.model} {scene.name}", progress)
+    stats_box: dict = {}
+
+    class _StatsSink:
+        def begin(self, shape, meta):
+            sink.begin(shape, meta)
+
+        def write(self, t0, spikes):
+            sink.write(t0, spikes)
+
+        def finish(self, meta):
+            st = final_stats()
+            stats_box["stats"] = FixedStats(steps=t_total, accumulators=h * w, **st)
+            meta.update(fixed_meta(scene, point, thresholds, stats_box["stats"]))
+            sink.finish(meta)
+
+        def abort(self):
+            sink.abort()
+
+    run_chunks(_StatsSink(), shape, meta, t_total, int(chunk_steps), produce, bar)
+    return FixedRun(None, thresholds, point, contract, stats_box["stats"], meta)
