@@ -1,0 +1,312 @@
+"""HDF5 spike files, written chunk by chunk, and a common reader for every spike format.
+
+Layout (``.h5``): dataset ``spikes`` ``(T, S, H, W) int8`` in {-1, 0, 1}, chunked along
+time (about 1 MiB per chunk, one scale per chunk) and compressed (LZF by default, gzip as
+an option); root attributes ``meta`` (the same JSON text as in ``.npz`` files),
+``format = "rvsm-spikes"``, ``format_version = 1`` and ``complete`` (True only once every
+step was written). Any HDF5 tool reads it: ``h5py.File(p)["spikes"][t0:t1]``.
+
+Atomicity: :class:`H5SpikeWriter` writes to a temporary ``.NAME.*.partial.h5`` beside the
+target, sets ``complete`` and renames it onto the target only after the last chunk, so a
+killed run never leaves a file under the target's name, and a partial file (if one were
+renamed by hand) is refused by :func:`open_spikes`.
+
+:func:`open_spikes` opens ``.h5`` lazily and ``.npz`` in memory behind one interface
+(:class:`SpikeSource`: ``shape``, ``meta``, ``read(t0, t1)``), so readers stream any file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from .atomic import _UMASK
+from .errors import RvsmError
+from .spike_files import _check_spikes, load_spikes
+
+FORMAT = "rvsm-spikes"
+FORMAT_VERSION = 1
+H5_SUFFIXES = (".h5", ".hdf5")
+CHUNK_BYTES = 1 << 20
+COMPRESSIONS = ("lzf", "gzip", "none")
+
+
+def is_h5_path(path: str | os.PathLike) -> bool:
+    """True when ``path`` names an HDF5 spike file (``.h5`` / ``.hdf5``)."""
+    return Path(path).suffix.lower() in H5_SUFFIXES
+
+
+def _h5py():
+    try:
+        import h5py
+    except ImportError as exc:  # pragma: no cover - a declared dependency
+        raise RvsmError(f"HDF5 spike files need h5py ({exc}); pip install h5py") from None
+    return h5py
+
+
+class H5SpikeWriter:
+    """A spike sink (see :mod:`.sampling_stream`) writing an HDF5 spike file atomically."""
+
+    def __init__(self, path: str | os.PathLike, compression: str = "lzf"):
+        if compression not in COMPRESSIONS:
+            raise RvsmError(f"compression must be one of {COMPRESSIONS}, got {compression!r}")
+        self.path = Path(path)
+        self.compression = None if compression == "none" else compression
+        self._file = None
+        self._tmp: Path | None = None
+        self._dset = None
+        self.steps_written = 0
+
+    def begin(self, shape, meta) -> None:
+        h5py = _h5py()
+        t, s, h, w = (int(v) for v in shape)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.stem}.", suffix=".partial.h5",
+                                   dir=self.path.parent)
+        os.close(fd)
+        self._tmp = Path(tmp)
+        self._file = h5py.File(self._tmp, "w")
+        chunk_t = max(1, min(max(t, 1), CHUNK_BYTES // max(h * w, 1)))
+        opts = {"compression": self.compression} if self.compression else {}
+        if self.compression == "gzip":
+            opts["compression_opts"] = 1
+        self._dset = self._file.create_dataset(
+            "spikes", shape=(t, s, h, w), dtype=np.int8,
+            chunks=(chunk_t, 1, h, w) if t else None, shuffle=False, **opts,
+        )
+        self._file.attrs["format"] = FORMAT
+        self._file.attrs["format_version"] = FORMAT_VERSION
+        self._file.attrs["complete"] = False
+        self._file.attrs["meta"] = json.dumps(meta, sort_keys=True)
+
+    def write(self, t0, spikes) -> None:
+        b = spikes.shape[0]
+        self._dset[t0:t0 + b] = spikes
+        self.steps_written = t0 + b
+
+    def finish(self, meta) -> None:
+        if self.steps_written != self._dset.shape[0]:
+            self.abort()
+            raise RvsmError(
+                f"{self.path}: only {self.steps_written} of {self._dset.shape[0]} steps written"
+            )
+        self._file.attrs["meta"] = json.dumps(meta, sort_keys=True)
+        self._file.attrs["complete"] = True
+        self._file.close()
+        self._file = None
+        os.chmod(self._tmp, 0o666 & ~_UMASK)
+        os.replace(self._tmp, self.path)
+        self._tmp = None
+
+    def abort(self) -> None:
+        if self._file is not None:
+            with contextlib.suppress(Exception):
+                self._file.close()
+            self._file = None
+        if self._tmp is not None and self._tmp.exists():
+            self._tmp.unlink()
+        self._tmp = None
+
+
+class SpikeSource:
+    """Read access to a spike file: ``shape (T, S, H, W)``, ``meta``, ``read(t0, t1)``.
+
+    Use as a context manager (closes an HDF5 file).
+    """
+
+    def __init__(self, shape, meta: dict, reader, closer=None, path: str = ""):
+        self.shape = tuple(int(v) for v in shape)
+        self.meta = meta
+        self._reader = reader
+        self._closer = closer
+        self.path = path
+
+    @property
+    def num_steps(self) -> int:
+        """T."""
+        return self.shape[0]
+
+    def read(self, t0: int, t1: int) -> np.ndarray:
+        """Spikes of steps ``t0 .. t1 - 1``: ``(t1 - t0, S, H, W) int8``."""
+        return np.asarray(self._reader(int(t0), int(t1)), dtype=np.int8)
+
+    def chunks(self, chunk_steps: int):
+        """Yield ``(t0, spikes)`` over the whole file in chunks of ``chunk_steps``."""
+        for t0 in range(0, self.num_steps, chunk_steps):
+            t1 = min(t0 + chunk_steps, self.num_steps)
+            yield t0, self.read(t0, t1)
+
+    def close(self) -> None:
+        if self._closer is not None:
+            self._closer()
+            self._closer = None
+
+    def __enter__(self) -> SpikeSource:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def array_source(spikes: np.ndarray, meta: dict | None = None) -> SpikeSource:
+    """An in-memory ``(T, S, H, W)`` array as a :class:`SpikeSource`."""
+    arr = np.asarray(spikes)
+    if arr.ndim == 3:
+        arr = arr[:, None]
+    return SpikeSource(arr.shape, meta or {}, lambda t0, t1: arr[t0:t1])
+
+
+def open_spikes(path: str | os.PathLike) -> SpikeSource:
+    """Open an ``.h5`` (lazily) or ``.npz`` (in memory) spike file for reading."""
+    path = Path(path)
+    if not is_h5_path(path):
+        spikes, meta = load_spikes(path)
+        src = array_source(spikes, meta)
+        src.path = str(path)
+        return src
+    if not path.is_file():
+        raise RvsmError(f"spike file {path} does not exist")
+    h5py = _h5py()
+    try:
+        handle = h5py.File(path, "r")
+    except OSError as exc:
+        raise RvsmError(f"{path} is not a readable HDF5 spike file: {exc}") from None
+    try:
+        if handle.attrs.get("format") != FORMAT or "spikes" not in handle:
+            raise RvsmError(f"{path} is not an rvsm spike file (no 'spikes' / format)")
+        if not bool(handle.attrs.get("complete", False)):
+            raise RvsmError(f"{path} is incomplete (the run that wrote it did not finish)")
+        try:
+            meta = json.loads(str(handle.attrs["meta"]))
+        except (KeyError, json.JSONDecodeError) as exc:
+            raise RvsmError(f"{path}: 'meta' missing or not valid JSON ({exc})") from None
+        dset = handle["spikes"]
+        if dset.ndim != 4 or dset.dtype != np.int8:
+            raise RvsmError(f"{path}: spikes must be (T, S, H, W) int8, got {dset.shape} "
+                            f"{dset.dtype}")
+    except BaseException:
+        handle.close()
+        raise
+    return SpikeSource(dset.shape, meta, lambda t0, t1: dset[t0:t1], handle.close, str(path))
+
+
+def load_any_spikes(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
+    """Whole spike array and meta of an ``.h5`` or ``.npz`` file (small files only)."""
+    with open_spikes(path) as src:
+        return _check_spikes(src.read(0, src.num_steps), str(path)), src.meta
+
+
+def write_spikes(path: str | os.PathLike, spikes: np.ndarray, meta: dict,
+                 chunk_steps: int = 256) -> None:
+    """Write a whole spike array to ``.h5`` (chunked) or ``.npz``, by suffix."""
+    if not is_h5_path(path):
+        from .spike_files import save_spikes
+
+        save_spikes(path, spikes, meta)
+        return
+    arr = _check_spikes(np.asarray(spikes), str(path))
+    sink = H5SpikeWriter(path)
+    sink.begin(arr.shape, meta)
+    try:
+        for t0 in range(0, arr.shape[0], chunk_steps):
+            sink.write(t0, arr[t0:t0 + chunk_steps])
+        sink.finish(meta)
+    except BaseException:
+        sink.abort()
+        raise
+
+
+class DatWriter:
+    """A spike sink writing FSM spikes in the camera's ``.dat`` layout, chunk by chunk,
+    atomically (see :func:`rvsm.model.spike_files.export_dat` for the layout)."""
+
+    def __init__(self, path: str | os.PathLike, flip: bool = False):
+        self.path = Path(path)
+        self.flip = flip
+        self._handle = None
+        self._tmp: Path | None = None
+
+    def begin(self, shape, meta) -> None:
+        t, s, h, w = shape
+        if s != 1:
+            raise RvsmError(f".dat (one bit per pixel) needs single-scale (FSM) spikes; these "
+                            f"have {s} scales")
+        if (h * w) % 8:
+            raise RvsmError(f".dat needs H*W divisible by 8 (8 pixels per byte), got {h}x{w}")
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.stem}.", suffix=".partial.dat",
+                                   dir=self.path.parent)
+        self._handle = os.fdopen(fd, "wb")
+        self._tmp = Path(tmp)
+
+    def write(self, t0, spikes) -> None:
+        arr = spikes[:, 0]
+        if arr.size and (arr.min() < 0 or arr.max() > 1):
+            raise RvsmError(".dat holds only 0/1 spikes; RVSM's -1 spikes cannot be exported")
+        if self.flip:
+            arr = arr[:, ::-1]
+        t, h, w = arr.shape
+        np.packbits(arr.reshape(t, h * w).astype(bool), axis=1,
+                    bitorder="little").tofile(self._handle)
+
+    def finish(self, meta) -> None:
+        self._handle.close()
+        self._handle = None
+        os.chmod(self._tmp, 0o666 & ~_UMASK)
+        os.replace(self._tmp, self.path)
+        self._tmp = None
+
+    def abort(self) -> None:
+        if self._handle is not None:
+            self._handle.close()
+            self._handle = None
+        if self._tmp is not None and self._tmp.exists():
+            self._tmp.unlink()
+        self._tmp = None
+
+
+def dat_source(path: str | os.PathLike, height: int, width: int,
+               flip: bool = False) -> SpikeSource:
+    """A camera ``.dat`` file as a :class:`SpikeSource` of ``(T, 1, H, W)`` spikes, read
+    step range by step range (memory-mapped)."""
+    path = Path(path)
+    if not path.is_file():
+        raise RvsmError(f".dat file {path} does not exist")
+    if height < 1 or width < 1 or (height * width) % 8:
+        raise RvsmError(
+            f".dat size {height}x{width} invalid: H*W must be positive and divisible by 8"
+        )
+    step_bytes = height * width // 8
+    size = path.stat().st_size
+    if size == 0 or size % step_bytes:
+        raise RvsmError(
+            f"{path} is truncated or not {height}x{width}: {size} bytes is not a whole "
+            f"number of steps of {step_bytes} bytes; check --size"
+        )
+    raw = np.memmap(path, dtype=np.uint8, mode="r").reshape(-1, step_bytes)
+
+    def read(t0: int, t1: int) -> np.ndarray:
+        bits = np.unpackbits(np.asarray(raw[t0:t1]), axis=1, bitorder="little")
+        frames = bits.reshape(-1, height, width)
+        if flip:
+            frames = frames[:, ::-1]
+        return np.ascontiguousarray(frames[:, None]).astype(np.int8)
+
+    return SpikeSource((raw.shape[0], 1, height, width), {}, read, None, str(path))
+
+
+def copy_source(source: SpikeSource, sink, meta: dict, chunk_steps: int = 256) -> None:
+    """Stream every step of ``source`` into ``sink``."""
+    sink.begin(source.shape, meta)
+    try:
+        for t0, chunk in source.chunks(chunk_steps):
+            sink.write(t0, chunk)
+        sink.finish(meta)
+    except BaseException:
+        sink.abort()
+        raise
