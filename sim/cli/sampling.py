@@ -8,9 +8,19 @@ import json
 import numpy as np
 
 from rvsm.model.errors import RvsmError
+from rvsm.model.fused import DEFAULT_CHUNK_STEPS
 from rvsm.model.reconstruction import MATCH_MODES, METHODS
-from rvsm.model.samplers import DEFAULT_PHI, RESET_MODES, SamplerConfig, sample
-from rvsm.model.spike_files import export_dat, import_dat, load_spikes, save_spikes
+from rvsm.model.samplers import DEFAULT_PHI, ENGINES, RESET_MODES, SamplerConfig
+from rvsm.model.sampling_stream import ArraySink, CountSink, TeeSink, stream_float
+from rvsm.model.spike_files import save_spikes
+from rvsm.model.spike_h5 import (
+    DatWriter,
+    H5SpikeWriter,
+    copy_source,
+    dat_source,
+    is_h5_path,
+    open_spikes,
+)
 from rvsm.model.thresholds import THRESHOLD_RULES, rule_thresholds
 
 from .args import (
@@ -25,9 +35,11 @@ from .args import (
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``simulate``, ``evaluate`` and ``dat``."""
-    p = sub.add_parser("simulate", help="sample a scene into a spike file (.npz)",
+    p = sub.add_parser("simulate", help="sample a scene into a spike file (.h5 or .npz)",
                        description="Sample a scene with a float model or a fixed-point "
-                       "design point and write spikes (T,S,H,W) int8 plus meta to .npz.")
+                       "design point and write spikes (T,S,H,W) int8 plus meta to .h5 "
+                       "(streamed chunk by chunk: any length in bounded memory) or .npz "
+                       "(in memory, small runs).")
     add_scene_arguments(p)
     p.add_argument("--model", default=None,
                    help="fsm, dog1..dog4 or gauss1..gauss4 (default dog4)")
@@ -41,16 +53,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_noise_arguments(p)
     p.add_argument("--fixed", metavar="POINT.toml",
                    help="run the bit-accurate fixed-point twin of this design point instead")
-    p.add_argument("-o", "--output", required=True, help="output .npz spike file")
+    p.add_argument("-o", "--output", required=True, help="output spike file (.h5 or .npz)")
     p.add_argument("--dat", metavar="FILE.dat", help="also export FSM spikes as camera .dat")
     p.add_argument("--flip", action="store_true", help="flip vertically in the .dat file")
+    add_engine_arguments(p)
     p.set_defaults(func=run_simulate)
 
     p = sub.add_parser("evaluate", help="reconstruct a spike file and score it",
                        description="Reconstruct spikes (TFI for FSM, the paper's RVSM "
                        "adjoint otherwise; --method inverse for the least-squares inverse), "
                        "match brightness and print MSE, PSNR and SSIM.")
-    p.add_argument("spikes", help=".npz spike file")
+    p.add_argument("spikes", help="spike file (.h5 streams chunk by chunk, or .npz)")
     p.add_argument("scene", nargs="?", default=None,
                    help="scene to score against (default: the one in the file's meta)")
     p.add_argument("--method", default="auto", choices=METHODS)
@@ -61,17 +74,40 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser("dat", help="convert FSM spikes to/from the camera's .dat layout")
     dat_sub = p.add_subparsers(dest="dat_command", metavar="ACTION", required=True)
-    q = dat_sub.add_parser("export", help=".npz (FSM) -> .dat")
-    q.add_argument("spikes", help=".npz spike file")
+    q = dat_sub.add_parser("export", help=".h5 / .npz (FSM) -> .dat (streamed)")
+    q.add_argument("spikes", help=".h5 or .npz spike file")
     q.add_argument("-o", "--output", required=True, help="output .dat")
     q.add_argument("--flip", action="store_true", help="flip vertically (camera row order)")
     q.set_defaults(func=run_dat_export)
-    q = dat_sub.add_parser("import", help=".dat -> .npz")
+    q = dat_sub.add_parser("import", help=".dat -> .h5 (streamed) or .npz")
     q.add_argument("dat", help="camera .dat file")
     q.add_argument("--size", required=True, metavar="HxW", help="sensor size, e.g. 250x400")
     q.add_argument("--flip", action="store_true", help="flip vertically (camera row order)")
-    q.add_argument("-o", "--output", required=True, help="output .npz")
+    q.add_argument("-o", "--output", required=True, help="output .h5 or .npz")
     q.set_defaults(func=run_dat_import)
+
+
+def add_engine_arguments(p: argparse.ArgumentParser) -> None:
+    """``--engine``, ``--chunk-steps`` and ``--threads``."""
+    p.add_argument("--engine", choices=ENGINES, default="fused",
+                   help="fused (numba, default) or numpy (the reference); same spikes")
+    p.add_argument("--chunk-steps", type=int, default=DEFAULT_CHUNK_STEPS, metavar="N",
+                   help=f"steps per chunk (default {DEFAULT_CHUNK_STEPS}); memory is one "
+                   "chunk of spikes")
+    p.add_argument("--threads", type=int, default=None, metavar="N",
+                   help="numba threads (default: all cores); spikes do not depend on it")
+
+
+def apply_threads(args: argparse.Namespace) -> None:
+    """Set numba's thread count from ``--threads``."""
+    if getattr(args, "threads", None) is None:
+        return
+    import numba
+
+    if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
+        raise RvsmError(f"--threads must be 1..{numba.config.NUMBA_NUM_THREADS}, "
+                        f"got {args.threads}")
+    numba.set_num_threads(args.threads)
 
 
 def _float_config(args: argparse.Namespace, scene=None) -> SamplerConfig:
@@ -100,9 +136,18 @@ def _float_config(args: argparse.Namespace, scene=None) -> SamplerConfig:
 
 
 def run_simulate(args: argparse.Namespace) -> int:
-    """``rvsm simulate``."""
+    """``rvsm simulate``: stream chunks into an ``.h5`` file (or collect them for
+    ``.npz``), and into a ``.dat`` file with ``--dat``."""
     if args.dat and not args.dat.endswith(".dat"):
         raise RvsmError(f"--dat expects a .dat path, got {args.dat!r}")
+    if not (is_h5_path(args.output) or args.output.endswith(".npz")):
+        raise RvsmError(f"-o expects a .h5 or .npz path, got {args.output!r}")
+    apply_threads(args)
+    h5 = is_h5_path(args.output)
+    counts = CountSink()
+    collect = None if h5 else ArraySink()
+    main_sink = H5SpikeWriter(args.output) if h5 else collect
+    dat_sink = DatWriter(args.dat, flip=args.flip) if args.dat else None
     if args.fixed:
         given = [f"--{n.replace('_', '-')}" for n in
                  ("model", "phi", "scale_phi", "reset", "thresholds", "noise", "k",
@@ -111,42 +156,54 @@ def run_simulate(args: argparse.Namespace) -> int:
         if given:
             raise RvsmError(f"{', '.join(given)} come(s) from the design point with --fixed; "
                             "edit the TOML instead")
+        from rvsm.model.fixed.fused import stream_fixed
         from rvsm.model.fixed.point_toml import load_design_point
-        from rvsm.model.fixed.twin import simulate_fixed
 
         point = load_design_point(args.fixed)
         size = parse_size_arg(args.size)
         if size is not None:
             point = point.with_size(*size)
         scene = load_scene_from_args(args, size=(point.height, point.width))
-        run = simulate_fixed(scene, point, progress=True)
-        spikes, meta = run.spikes, dict(run.meta)
+        run_fn = lambda sink: stream_fixed(  # noqa: E731
+            scene, point, sink, chunk_steps=args.chunk_steps, engine=args.engine,
+            progress=True, ranges=False)
     else:
         scene = load_scene_from_args(args)
         config = _float_config(args, scene)
-        train = sample(scene, config, progress=True)
-        spikes, meta = train.spikes, dict(train.meta)
-    if args.dat:
-        export_dat(args.dat, spikes, flip=args.flip)
-    save_spikes(args.output, spikes, meta)
-    t, s, h, w = spikes.shape
+        run_fn = lambda sink: stream_float(  # noqa: E731
+            scene, config, sink, chunk_steps=args.chunk_steps, engine=args.engine,
+            progress=True)
+    run_fn(TeeSink(counts, main_sink, dat_sink))
+    if collect is not None:
+        save_spikes(args.output, collect.spikes, collect.meta)
+    t = counts.steps
+    s = len(counts.per_scale)
+    h, w = scene.shape
     print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}, "
-          f"{int(np.count_nonzero(spikes))} spikes ({int((spikes < 0).sum())} negative)")
+          f"{counts.spikes} spikes ({counts.negative} negative)")
     return 0
 
 
 def run_evaluate(args: argparse.Namespace) -> int:
     """``rvsm evaluate``."""
     from rvsm.model.evaluation import evaluate_spikes
+    from rvsm.model.stream_eval import evaluate_source
 
-    spikes, meta = load_spikes(args.spikes)
-    scene = scene_from_meta(meta, override=args.scene)
-    model = meta.get("model")
-    phis = meta.get("phis")
-    if model is None or phis is None:
-        raise RvsmError("the spike file's meta lacks 'model' or 'phis'; re-run rvsm simulate")
-    result = evaluate_spikes(spikes, scene, model, np.asarray(phis, dtype=np.float64),
-                             method=args.method, match=args.match)
+    with open_spikes(args.spikes) as source:
+        meta = source.meta
+        scene = scene_from_meta(meta, override=args.scene)
+        model = meta.get("model")
+        phis = meta.get("phis")
+        if model is None or phis is None:
+            raise RvsmError("the spike file's meta lacks 'model' or 'phis'; re-run rvsm "
+                            "simulate")
+        phis = np.asarray(phis, dtype=np.float64)
+        if is_h5_path(args.spikes):
+            result = evaluate_source(source, scene, model, phis, method=args.method,
+                                     match=args.match)
+        else:
+            result = evaluate_spikes(source.read(0, source.num_steps), scene, model, phis,
+                                     method=args.method, match=args.match)
     if args.json:
         print(json.dumps({**result, "model": model, "scene": scene.name}, default=float))
     else:
@@ -157,19 +214,23 @@ def run_evaluate(args: argparse.Namespace) -> int:
 
 
 def run_dat_export(args: argparse.Namespace) -> int:
-    """``rvsm dat export``."""
-    spikes, _ = load_spikes(args.spikes)
-    export_dat(args.output, spikes, flip=args.flip)
-    print(f"wrote {args.output}: {spikes.shape[0]} steps of {spikes.shape[2]}x{spikes.shape[3]}")
+    """``rvsm dat export``: streams the spike file into the ``.dat`` file."""
+    with open_spikes(args.spikes) as source:
+        copy_source(source, DatWriter(args.output, flip=args.flip), dict(source.meta))
+        t, _, h, w = source.shape
+    print(f"wrote {args.output}: {t} steps of {h}x{w}")
     return 0
 
 
 def run_dat_import(args: argparse.Namespace) -> int:
-    """``rvsm dat import``."""
+    """``rvsm dat import``: streams the ``.dat`` file into ``.h5`` (or ``.npz``)."""
     h, w = parse_size_arg(args.size)
-    spikes = import_dat(args.dat, h, w, flip=args.flip)
+    source = dat_source(args.dat, h, w, flip=args.flip)
     meta = {"kind": "camera", "model": "fsm", "phis": [DEFAULT_PHI], "source": str(args.dat),
-            "height": h, "width": w, "num_steps": int(spikes.shape[0])}
-    save_spikes(args.output, spikes, meta)
-    print(f"wrote {args.output}: {spikes.shape[0]} steps of {h}x{w}")
+            "height": h, "width": w, "num_steps": int(source.num_steps)}
+    if is_h5_path(args.output):
+        copy_source(source, H5SpikeWriter(args.output), meta)
+    else:
+        save_spikes(args.output, source.read(0, source.num_steps), meta)
+    print(f"wrote {args.output}: {source.num_steps} steps of {h}x{w}")
     return 0
