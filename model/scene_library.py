@@ -108,14 +108,14 @@ class _Grid:
     frame index as float.
     """
 
-    def __init__(self, size: tuple[int, int], num_frames: int) -> None:
+    def __init__(self, size: tuple[int, int], num_frames: int, first: int = 0) -> None:
         h, w = size
         self.h, self.w = h, w
         self.s = max(DEFAULT_SIZE[0] / h, DEFAULT_SIZE[1] / w)
         self.Y = ((np.arange(h) + 0.5 - h / 2) * self.s)[None, :, None]
         self.X = ((np.arange(w) + 0.5 - w / 2) * self.s)[None, None, :]
         self.half_h, self.half_w = h * self.s / 2, w * self.s / 2
-        self.k = np.arange(num_frames, dtype=np.float64)[:, None, None]
+        self.k = np.arange(first, first + num_frames, dtype=np.float64)[:, None, None]
         self.F = num_frames
 
 
@@ -362,11 +362,18 @@ def _check_size(size: tuple[int, int], num_frames: int) -> tuple[tuple[int, int]
     return (h, w), int(num_frames)
 
 
+#: Frames rendered per batch: every renderer works frame by frame, so batches bound the
+#: rendering's temporary memory (about a dozen batch-sized arrays) without changing a value.
+RENDER_BATCH = 16
+
+
 @functools.lru_cache(maxsize=32)
 def _render_cached(name: str, size: tuple[int, int], num_frames: int) -> np.ndarray:
-    g = _Grid(size, num_frames)
-    v = np.broadcast_to(_RENDERERS[name](g), (num_frames, *size))
-    out = np.ascontiguousarray(_to_brightness(v), dtype=np.float64)
+    out = np.empty((num_frames, *size), dtype=np.float64)
+    for f0 in range(0, num_frames, RENDER_BATCH):
+        n = min(RENDER_BATCH, num_frames - f0)
+        g = _Grid(size, n, first=f0)
+        out[f0:f0 + n] = _to_brightness(np.broadcast_to(_RENDERERS[name](g), (n, *size)))
     out.setflags(write=False)
     return out
 

@@ -1,23 +1,70 @@
 #!/usr/bin/env python3
-"""Throughput of the float samplers at 250x400 on a built-in scene (`make bench`).
+"""Twin throughput and long-run memory at 250x400 (`make bench`, issue 10), in one run.
 
-Prints pixel-steps/s for FSM and accumulator-steps/s for dog4 (and the other ladders),
-with and without noise, beside the naive per-step transcription of the SPEC
-(``rvsm.model.reference``) on a short run. Targets (issue 2): FSM >= 3e8 pixel-steps/s,
-dog4 >= 1e8 accumulator-steps/s, noiseless. Figures are best-of-``--repeat`` wall time.
+Rates: accumulator-steps per second (pixels x scales x steps / wall seconds; pixel-steps
+for FSM) of the fused numba engine (all numba threads) and, beside each, of the numpy
+reference engine, on the built-in scene ``flyball`` (best of ``--repeat``; the numpy
+path on fewer steps, ``--numpy-steps``). The fixed twin runs the default design point as
+``rvsm simulate --fixed`` does (min/max statistics off). Memory: peak RSS of
+``rvsm simulate flyball --size 250x400 --model dog4 --noise`` for ``--long-steps`` steps
+(``--frames 401 --steps-per-frame 100`` for 40,000) to an ``.h5`` file, measured as the
+child's ``ru_maxrss``. Every figure is printed with the load average at its start; the
+targets are issue 10's, for a 2-core machine.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import resource
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 
+import numba
+
+from rvsm.model.fixed.config import DesignPoint
+from rvsm.model.fixed.fused import stream_fixed
 from rvsm.model.noise import NoiseParams
-from rvsm.model.reference import reference_sample
-from rvsm.model.samplers import SamplerConfig, sample
+from rvsm.model.samplers import SamplerConfig
+from rvsm.model.sampling_stream import stream_float
 from rvsm.model.scene_library import builtin_scene
 
-TARGETS = {"fsm": 3e8, "dog4": 1e8}
+#: (label, kind, model, noise) -> target acc-steps/s (None: no target)
+CASES = [
+    ("float fsm", "float", "fsm", False, 2e9),
+    ("float fsm", "float", "fsm", True, None),
+    ("float dog4", "float", "dog4", False, 1e9),
+    ("float dog4", "float", "dog4", True, 2e8),
+    ("float gauss4", "float", "gauss4", False, None),
+    ("float gauss4", "float", "gauss4", True, None),
+    ("fixed dog4", "fixed", "dog4", False, 5e8),
+    ("fixed dog4", "fixed", "dog4", True, 1.5e8),
+]
+RSS_TARGET_BYTES = 1.5e9
+
+
+class NullSink:
+    """Discards spikes (the rates measure the twins, not a file format)."""
+
+    def begin(self, shape, meta):
+        pass
+
+    def write(self, t0, spikes):
+        pass
+
+    def finish(self, meta):
+        pass
+
+    def abort(self):
+        pass
+
+
+def load() -> str:
+    """The 1-minute load average, as `uptime` prints it."""
+    return f"{os.getloadavg()[0]:.2f}"
 
 
 def best_time(fn, repeat: int) -> float:
@@ -30,35 +77,81 @@ def best_time(fn, repeat: int) -> float:
     return best
 
 
+def run_case(kind: str, model: str, noise: bool, scene, engine: str):
+    if kind == "float":
+        config = SamplerConfig(model=model, noise=NoiseParams() if noise else None)
+        return (lambda: stream_float(scene, config, NullSink(), engine=engine),
+                config.spec.num_scales)
+    point = DesignPoint(model=model, noise=noise)
+    return (lambda: stream_fixed(scene, point, NullSink(), engine=engine, ranges=False),
+            point.num_scales)
+
+
+def verdict(rate: float, target: float | None) -> str:
+    if target is None:
+        return "-"
+    return "met" if rate >= target else "MISSED"
+
+
+def peak_rss(steps: int, out_dir: Path) -> tuple[float, float, str]:
+    """``(peak RSS bytes, wall seconds, command)`` of the long dog4 run."""
+    spf = 100
+    frames = steps // spf + 1
+    out = out_dir / "long.h5"
+    cmd = [sys.executable, "-m", "rvsm.sim.cli", "simulate", "flyball", "--size", "250x400",
+           "--model", "dog4", "--noise", "--frames", str(frames), "--steps-per-frame",
+           str(spf), "-o", str(out)]
+    start = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    if proc.returncode != 0:
+        raise SystemExit(f"long run failed: {proc.stderr.strip()[-500:]}")
+    rss = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024.0
+    size = out.stat().st_size
+    shown = "rvsm simulate " + " ".join(cmd[4:-2]) + " -o long.h5"
+    return rss, wall, f"{shown}  ({size / 1e6:.0f} MB file)"
+
+
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--scene", default="flyball")
-    parser.add_argument("--frames", type=int, default=21, help="frames (x10 steps)")
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--steps", type=int, default=1000, help="steps per fused run")
+    parser.add_argument("--numpy-steps", type=int, default=60, help="steps per numpy run")
     parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--naive-steps", type=int, default=10)
+    parser.add_argument("--long-steps", type=int, default=40000,
+                        help="steps of the peak-RSS run (0 to skip)")
     args = parser.parse_args()
-    scene = builtin_scene(args.scene, num_frames=args.frames)
+    m = 10
+    scene = builtin_scene("flyball", num_frames=args.steps // m + 1, steps_per_frame=m)
+    short = builtin_scene("flyball", num_frames=args.numpy_steps // m + 1, steps_per_frame=m)
     h, w = scene.shape
-    print(f"scene {scene.name} {h}x{w}, {scene.num_steps} steps; best of {args.repeat}")
-    print(f"{'model':8s} {'noise':6s} {'seconds':>8s} {'acc-steps/s':>12s} {'target':>8s}")
-    for model in ("fsm", "dog4", "gauss4", "dog1"):
-        for noise in (None, NoiseParams()):
-            config = SamplerConfig(model=model, noise=noise)
-            seconds = best_time(lambda c=config: sample(scene, c), args.repeat)
-            rate = scene.num_steps * config.spec.num_scales * h * w / seconds
-            target = TARGETS.get(model) if noise is None else None
-            verdict = "" if target is None else ("ok" if rate >= target else "MISSED")
-            print(f"{model:8s} {'k=1' if noise else 'off':6s} {seconds:8.3f} {rate:12.3g} "
-                  f"{verdict:>8s}")
-    short = builtin_scene(args.scene, num_frames=2, steps_per_frame=args.naive_steps)
-    print(f"\nnaive per-step loop (rvsm.model.reference), {short.num_steps} steps:")
-    for model in ("fsm", "dog4"):
-        config = SamplerConfig(model=model)
-        naive = best_time(lambda c=config: reference_sample(short, c), 1)
-        fast = best_time(lambda c=config: sample(short, c), args.repeat)
-        rate = short.num_steps * config.spec.num_scales * h * w
-        print(f"{model:8s} naive {rate / naive:10.3g}/s   vectorised {rate / fast:10.3g}/s   "
-              f"speed-up {naive / fast:5.1f}x")
+    print(f"flyball {h}x{w}; fused: {scene.num_steps} steps, numba threads "
+          f"{numba.get_num_threads()}; numpy: {short.num_steps} steps; best of {args.repeat}; "
+          f"{os.cpu_count()} CPUs; load = 1-min load average at the start of each row")
+    head = (f"{'twin':13s} {'noise':5s} {'fused/s':>10s} {'numpy/s':>10s} {'speed-up':>8s} "
+            f"{'target':>8s} {'met':>6s} {'load':>5s}")
+    print(head)
+    print("-" * len(head))
+    for label, kind, model, noise, target in CASES:
+        ld = load()
+        fused, scales = run_case(kind, model, noise, scene, "fused")
+        fused()  # compile / warm the caches
+        t_fused = best_time(fused, args.repeat)
+        rate = scene.num_steps * scales * h * w / t_fused
+        ref, _ = run_case(kind, model, noise, short, "numpy")
+        t_ref = best_time(ref, 1 if args.repeat < 3 else 2)
+        ref_rate = short.num_steps * scales * h * w / t_ref
+        tgt = f"{target:.1e}" if target else "-"
+        print(f"{label:13s} {'on' if noise else 'off':5s} {rate:10.3g} {ref_rate:10.3g} "
+              f"{rate / ref_rate:7.1f}x {tgt:>8s} {verdict(rate, target):>6s} {ld:>5s}",
+              flush=True)
+    if args.long_steps:
+        ld = load()
+        with tempfile.TemporaryDirectory() as tmp:
+            rss, wall, cmd = peak_rss(args.long_steps, Path(tmp))
+        ok = "met" if rss <= RSS_TARGET_BYTES else "MISSED"
+        print(f"\npeak RSS {rss / 1e9:.2f} GB (target <= 1.5 GB: {ok}), {wall:.0f} s wall, "
+              f"load {ld}: {cmd}")
 
 
 if __name__ == "__main__":
