@@ -28,6 +28,7 @@ from .samplers import (
     sampling_meta,
 )
 from .scene import Scene
+from .spike_packing import count_spikes
 
 
 class SpikeSink(Protocol):
@@ -75,10 +76,10 @@ class CountSink:
         self.per_scale = np.zeros(shape[1], dtype=np.int64)
 
     def write(self, t0, spikes) -> None:
-        nz = np.count_nonzero(spikes, axis=(0, 2, 3))
+        nz, neg = count_spikes(spikes)
         self.per_scale += nz
         self.spikes += int(nz.sum())
-        self.negative += int(np.count_nonzero(spikes < 0))
+        self.negative += neg
         self.steps += spikes.shape[0]
 
     def finish(self, meta) -> None:
