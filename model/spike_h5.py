@@ -103,10 +103,11 @@ class H5SpikeWriter:
         self.steps_written = t0 + b
 
     def finish(self, meta) -> None:
-        if self.steps_written != self._dset.shape[0]:
+        expected = self._dset.shape[0]
+        if self.steps_written != expected:
             self.abort()
             raise RvsmError(
-                f"{self.path}: only {self.steps_written} of {self._dset.shape[0]} steps written"
+                f"{self.path}: only {self.steps_written} of {expected} steps written"
             )
         self._file.attrs["meta"] = json.dumps(meta, sort_keys=True)
         self._file.attrs["complete"] = True
