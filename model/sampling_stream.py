@@ -17,6 +17,7 @@ import numpy as np
 
 from .errors import RvsmError
 from .fused import DEFAULT_CHUNK_STEPS, DEFAULT_TILE_ROWS, FusedFloatSampler
+from .progress import progress_bar
 from .samplers import (
     ENGINES,
     Integrator,
@@ -24,7 +25,6 @@ from .samplers import (
     SpikeTrain,
     accumulator_thresholds,
     iter_step_drives,
-    progress_bar,
     sampling_meta,
 )
 from .scene import Scene

@@ -27,7 +27,7 @@ from ..fused import _row_pairs, _scale_sum
 from ..noise_streams import ZIG_RATIO, ZIG_X, check_coordinates, pixel_normal
 from ..orbits import kernel_orbits
 from ..scene import Scene
-from .core import accumulator_range
+from .widths import signed_range
 
 EXACT_FLOAT_BITS = 52
 
@@ -229,7 +229,7 @@ class FusedFixedTwin:
         self.halves = halves
         self.thr = np.ascontiguousarray(thresholds, dtype=dtype)
         self.acc = np.zeros_like(self.thr)
-        lo, hi = accumulator_range(point.accumulator_bits)
+        lo, hi = signed_range(point.accumulator_bits)
         self.lo, self.hi = dtype(lo), dtype(hi)
         self.shift = np.int64(point.shift)
         self.scale = 2.0 ** -point.shift
@@ -330,7 +330,8 @@ def stream_fixed(
     skips the min/max datapath statistics of the fused engine (they stay None; the
     saturation counts are always kept): about 1.5x faster.
     """
-    from ..samplers import ENGINES, progress_bar
+    from ..progress import progress_bar
+    from ..samplers import ENGINES
     from ..sampling_stream import check_chunking, run_chunks
     from .adc import adc_codes
     from .core import FixedIntegrator, arithmetic_shift, integer_receptive_sums

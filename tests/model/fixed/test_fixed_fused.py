@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from rvsm.model.errors import RvsmError
-from rvsm.model.fixed.config import DesignPoint
+from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.fused import exact_in_float, stream_fixed
 from rvsm.model.fixed.twin import simulate_fixed
 from rvsm.model.sampling_stream import ArraySink
