@@ -66,7 +66,7 @@ def quantisation_cost(
     point = fit_point(scene, point)
     config = point.sampler_config()
     flt = sample(scene, config, progress=progress)
-    fix = simulate_fixed(scene, point, progress=progress)
+    fix = simulate_fixed(scene, point, progress=progress, ranges=False)
     agree = spike_agreement(fix.spikes, flt.spikes)
     phis = point.phis
     ev_float = evaluate_spikes(flt.spikes, scene, point.model, phis, method=method, match=match)

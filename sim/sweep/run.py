@@ -51,13 +51,20 @@ class SweepSummary:
 
 
 def evaluate_task(task: SweepTask, frames: int, steps_per_frame: int, method: str = "auto",
-                  match: str = "gain") -> dict[str, Any]:
+                  match: str = "gain", threads: int | None = None) -> dict[str, Any]:
     """Fixed vs float on one scene: :func:`~rvsm.model.fixed.cost.quantisation_cost` plus
     ``mse_cost`` (fixed minus float, 8-bit units squared), ``saturation_rate`` (per scale,
     saturated accumulator-steps / (steps * H * W)), ``max_saturation_rate`` and
-    ``seconds`` (wall time)."""
+    ``seconds`` (wall time). ``threads`` caps the numba threads of the twins' fused kernels
+    in this process (a local cluster gives each of its ``n`` worker processes
+    ``cores // n``, so workers x threads never oversubscribe the cores)."""
     from rvsm.model.fixed.cost import quantisation_cost
     from rvsm.model.scene_io import load_scene
+
+    if threads is not None:
+        import numba
+
+        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
 
     t0 = time.perf_counter()
     scene = load_scene(task.scene, size=task.size, num_frames=frames,
@@ -245,6 +252,8 @@ def _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=processes,
                                dashboard_address=":0", silence_logs=logging.ERROR)
         client = Client(cluster)
+        # numba threads per worker: the cores shared out, never oversubscribed.
+        args = (*args, max(1, (os.cpu_count() or 1) // n))
     futures = []
     try:
         summary.workers = len(client.scheduler_info().get("workers", {}))
