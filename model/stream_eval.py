@@ -9,7 +9,8 @@ whole array, with memory bounded by one chunk plus ``O(T / chunk_steps)`` bounda
   last two spikes of the recording; the forward pass then fills ``last`` and ``next``
   within each chunk from those carries (look-ahead across chunk borders).
 - The RVSM coefficients are causal: their ``(S, H, W)`` state is carried from chunk to
-  chunk.
+  chunk. The least-squares inverse (``method="inverse"``) decodes the scored steps in
+  order with warm starts, so it gathers their coefficients ``(N, S, H, W)`` first.
 - TFP reads each scored step's window straight from the file.
 
 Scores are computed per scored step (brightness matching and metrics are per frame) and
@@ -100,8 +101,9 @@ def _tfi_chunks(source: SpikeSource, phi: float, steps: np.ndarray, chunk_steps:
 
 
 def _rvsm_chunks(source: SpikeSource, spec: ModelSpec, phis, steps: np.ndarray,
-                 chunk_steps: int):
-    """Yield ``(positions, images)`` of the RVSM inverse at the scored ``steps``."""
+                 chunk_steps: int, images: bool = True):
+    """Yield ``(positions, images)`` of the RVSM adjoint at the scored ``steps`` (or
+    ``(positions, coefficients)`` with ``images=False``)."""
     n, s_count = source.shape[:2]
     phi = np.broadcast_to(np.asarray(phis, dtype=np.float64).reshape(-1), (s_count,))
     phi = phi[:, None, None]
@@ -121,7 +123,20 @@ def _rvsm_chunks(source: SpikeSource, spec: ModelSpec, phis, steps: np.ndarray,
                 t_prev[fired] = t
             coeffs[steps[sel] == t] = k
         if sel.size:
-            yield sel, rvsm_image(coeffs, spec)
+            yield sel, (rvsm_image(coeffs, spec) if images else coeffs)
+
+
+def _inverse_all(source: SpikeSource, spec: ModelSpec, phis, steps: np.ndarray,
+                 chunk_steps: int):
+    """The least-squares inverse decodes the scored steps in order, each warm-started from
+    the previous one, so it runs once on all of them: their coefficients ``(N, S, H, W)``
+    are gathered (streaming) and decoded together."""
+    from .inverse import inverse_images
+
+    coeffs = np.empty((steps.size,) + source.shape[1:], dtype=np.float64)
+    for sel, part in _rvsm_chunks(source, spec, phis, steps, chunk_steps, images=False):
+        coeffs[sel] = part
+    yield np.arange(steps.size), inverse_images(coeffs, spec)
 
 
 def _tfp_chunks(source: SpikeSource, phi: float, steps: np.ndarray, window: int,
@@ -173,6 +188,8 @@ def evaluate_source(
         parts = _tfi_chunks(source, float(phi_arr[0]), chosen, int(chunk_steps))
     elif how == "tfp":
         parts = _tfp_chunks(source, float(phi_arr[0]), chosen, DEFAULT_TFP_WINDOW)
+    elif how == "inverse":
+        parts = _inverse_all(source, spec, phi_arr, chosen, int(chunk_steps))
     else:
         parts = _rvsm_chunks(source, spec, phi_arr, chosen, int(chunk_steps))
     mse = np.empty(chosen.size)

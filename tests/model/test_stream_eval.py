@@ -16,7 +16,8 @@ def scene():
     return builtin_scene("flyball", size=(32, 48), num_frames=9)
 
 
-@pytest.mark.parametrize("model,method", [("fsm", "tfi"), ("fsm", "tfp"), ("dog2", "rvsm")])
+@pytest.mark.parametrize("model,method", [("fsm", "tfi"), ("fsm", "tfp"), ("dog2", "rvsm"),
+                                          ("dog2", "inverse")])
 def test_chunked_equals_whole(scene, tmp_path, model, method):
     config = SamplerConfig(model=model, noise=NoiseParams(seed=1))
     spikes = sample(scene, config).spikes
