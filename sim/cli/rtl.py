@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shlex
 import sys
 
 from rvsm.model.errors import RvsmError
@@ -20,7 +21,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("point", help="design point TOML")
     p.add_argument("-o", "--out", default="build", help="output folder (default: build)")
     p.add_argument("--size", metavar="HxW", help="override the array size")
-    p.add_argument("--top", help="top module name (default: rvsm_array, or "
+    p.add_argument("--top", type=_top_arg,
+                   help="top module name, a Verilog identifier (default: rvsm_array, or "
                    "rvsm_stream_array with --arch stream)")
     p.add_argument("--arch", choices=("parallel", "stream"), default="parallel",
                    help="fully parallel array (small in-pixel designs) or the "
@@ -36,17 +38,26 @@ def register(sub: argparse._SubParsersAction) -> None:
         "verify", help="simulate the RTL and compare every spike with the fixed twin",
         description="Build the generated Verilog on Icarus or Verilator, drive a stimulus, "
         "compare every spike. Either SCENE --fixed POINT.toml (the fixed twin makes the "
-        "stimulus) or --stimulus FILE (replay a file written by `rvsm stimulus`).",
+        "stimulus), --stimulus FILE (replay a file written by `rvsm stimulus`) or "
+        "--random SEED --fixed POINT.toml (seeded random and corner stimulus). Exit "
+        "status: 0 pass, 1 mismatches, 2 bad input, 3 tool or environment failure, "
+        "130 interrupted (docs/cli.md).",
     )
     p.add_argument("scene", nargs="?", help="built-in scene name or scene path")
     p.add_argument("--fixed", metavar="POINT.toml", help="design point TOML (with SCENE)")
     p.add_argument("--stimulus", metavar="FILE.npz",
                    help="replay this stimulus file (from `rvsm stimulus`) instead")
+    p.add_argument("--random", metavar="SEED", type=int,
+                   help="drive a seeded random and corner stimulus (codes at 0 and full "
+                   "scale, exact threshold hits, both saturation rails, clears "
+                   "mid-stream) instead of a scene; needs --fixed, --size, --steps")
     p.add_argument("--sim", choices=SIMULATORS, default="icarus")
     p.add_argument("--steps", type=int, help="simulate only the first N steps")
     p.add_argument("--size", metavar="HxW", help="override the array size")
-    p.add_argument("--waves", action="store_true", help="keep a waveform (FST/VCD)")
-    p.add_argument("--work", default="build/verify", help="build/run folder")
+    p.add_argument("--waves", action="store_true", help="keep an FST waveform")
+    p.add_argument("--work", default="build/verify",
+                   help="work folder: shared build cache (builds/) and one new folder per "
+                   "run (runs/)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--arch", choices=("parallel", "stream"), default="parallel",
                    help="verify the fully parallel or the streaming array")
@@ -88,23 +99,45 @@ def _verilog(args: argparse.Namespace) -> int:
     return 0
 
 
+def _top_arg(text: str) -> str:
+    from rvsm.rtl.verilog import check_top
+
+    try:
+        return check_top(text)
+    except RvsmError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def _verify(args: argparse.Namespace) -> int:
-    from rvsm.sim.cosim.verify import replay, verify
+    from rvsm.sim.cosim.verify import random_verify, replay, verify
 
     if args.steps is not None and args.steps < 1:
         raise RvsmError(f"--steps must be >= 1, got {args.steps}")
     lanes = args.lanes if args.arch == "stream" else None
     if args.stimulus:
         given = [n for n, v in (("SCENE", args.scene), ("--fixed", args.fixed),
-                                ("--size", args.size)) if v is not None]
+                                ("--size", args.size), ("--random", args.random))
+                 if v is not None]
         if given:
             raise RvsmError(f"{', '.join(given)} cannot be combined with --stimulus: the "
                             "stimulus file holds the scene's codes and the contract")
         r = replay(args.stimulus, args.sim, steps=args.steps, waves=args.waves,
                    work_dir=args.work, lanes=lanes)
+    elif args.random is not None:
+        if args.scene is not None:
+            raise RvsmError("SCENE cannot be combined with --random (the stimulus is "
+                            "generated)")
+        missing = [n for n, v in (("--fixed", args.fixed), ("--size", args.size),
+                                  ("--steps", args.steps)) if v is None]
+        if missing:
+            raise RvsmError(f"rvsm verify --random SEED also needs {', '.join(missing)}, "
+                            "e.g. --random 1 --fixed point.toml --size 4x4 --steps 200")
+        r = random_verify(args.fixed, args.random, args.steps, args.sim, waves=args.waves,
+                          size=parse_size_arg(args.size), work_dir=args.work, lanes=lanes)
     else:
         if args.scene is None or args.fixed is None:
-            raise RvsmError("rvsm verify needs SCENE --fixed POINT.toml, or --stimulus FILE")
+            raise RvsmError("rvsm verify needs SCENE --fixed POINT.toml, --stimulus FILE, "
+                            "or --random SEED --fixed POINT.toml")
         r = verify(args.scene, args.fixed, args.sim, steps=args.steps, waves=args.waves,
                    size=parse_size_arg(args.size), work_dir=args.work, lanes=lanes)
     if args.json:
@@ -115,6 +148,11 @@ def _verify(args: argparse.Namespace) -> int:
         print(f"{args.sim}: compared {r['compared']} spikes ({r['steps']} steps x "
               f"{r['accumulators']} accumulators, {r['expected_spikes']} non-zero), "
               f"{r['mismatches']} mismatches")
+        if r.get("coverage"):
+            from rvsm.model.fixed.corner_stimulus import coverage_summary
+
+            for line in coverage_summary(r["coverage"]):
+                print(f"coverage {line}")
         if r["mismatches"]:
             f = r["first_mismatch"] or {}
             print("first mismatch: " + ", ".join(f"{k}={v}" for k, v in f.items()))
@@ -122,5 +160,9 @@ def _verify(args: argparse.Namespace) -> int:
             print(f"stream: {r['lanes']} lane(s), {r['cycles']} cycles at "
                   f"{r['cycles_per_second']:.0f} cycles/s (build {r['build_seconds']:.0f} s)")
         if r["waves"]:
-            print(f"waveform kept: {r['waves']}")
+            at = r.get("first_mismatch_time_ns")
+            jump = f"; first mismatch at {at} ns" if r["mismatches"] and at is not None else ""
+            print(f"waveform kept: {r['waves']}{jump}; open it with: gtkwave "
+                  f"{shlex.quote(r['waves'])} (or: surfer {shlex.quote(r['waves'])})")
+        print(f"run folder: {r['run_dir']}")
     return 1 if r["mismatches"] else 0

@@ -102,6 +102,7 @@ async def array_matches_fixed_twin(dut: object) -> None:
     schedule += [None] * 4  # drain (longer than any latency we build)
 
     compared = mismatches = 0
+    first_time: int | None = None  # simulation time (ns) of the first mismatch
     listed: list[dict] = []
     next_step = 0
     t0 = time.perf_counter()
@@ -114,6 +115,7 @@ async def array_matches_fixed_twin(dut: object) -> None:
         if str(dut.valid.value) != "1":
             continue
         if next_step >= steps:
+            first_time = int(get_sim_time("ns")) if first_time is None else first_time
             mismatches += 1
             listed.append({"step": next_step, "error": "valid without a pending step"})
             continue
@@ -122,6 +124,7 @@ async def array_matches_fixed_twin(dut: object) -> None:
         bad = (pos ^ exp_pos[next_step]) | (neg ^ exp_neg[next_step]) | xp | xn
         compared += n_acc
         if bad:
+            first_time = int(get_sim_time("ns")) if first_time is None else first_time
             idx = [i for i in range(n_acc) if (bad >> i) & 1]
             mismatches += len(idx)
             for i in idx[:max(0, MAX_LISTED - len(listed))]:
@@ -135,6 +138,7 @@ async def array_matches_fixed_twin(dut: object) -> None:
         next_step += 1
     stream_seconds = time.perf_counter() - t0
     if next_step < steps:
+        first_time = int(get_sim_time("ns")) if first_time is None else first_time
         mismatches += (steps - next_step) * n_acc
         listed.append({"step": next_step, "error": f"only {next_step} of {steps} steps "
                        "produced valid outputs"})
@@ -145,6 +149,7 @@ async def array_matches_fixed_twin(dut: object) -> None:
         "accumulators": n_acc,
         "expected_spikes": int(np.count_nonzero(expected)),
         "first_mismatch": listed[0] if listed else None,
+        "first_mismatch_time_ns": first_time,
         "mismatch_list": listed,
         "stream_seconds": stream_seconds,
         "sim_time_ns": int(get_sim_time("ns")),

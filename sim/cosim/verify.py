@@ -13,6 +13,7 @@ point TOML via the fixed twin; :func:`replay` from a stimulus file (``rvsm stimu
 from __future__ import annotations
 
 import os
+import shutil
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -23,9 +24,10 @@ from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.stimulus import Stimulus, load_stimulus, save_stimulus
 from rvsm.model.fixed.widths import unsigned_max
 
-from .runner import build, check_simulator, run_testbench
+from .runner import SimBuild, build, check_simulator, new_run_dir, run_testbench
 
-__all__ = ["MAX_PARALLEL_SIDE", "check_stimulus", "replay", "run_rtl", "verify"]
+__all__ = ["MAX_PARALLEL_SIDE", "check_stimulus", "random_verify", "replay", "run_rtl",
+           "verify"]
 
 #: Largest side of a fully parallel array ``verify`` will build (generation time grows
 #: with pixels x taps; a full-resolution sensor needs the streaming array).
@@ -76,9 +78,12 @@ def check_stimulus(
     ``lanes`` drives the streaming array (:mod:`rvsm.rtl.stream_array`) with that many
     lanes instead of the fully parallel one.
 
-    Writes ``work_dir/<sim>/<name>/stimulus.npz`` (the testbench's input). Returns the
-    testbench result: ``compared``, ``mismatches``, ``first_mismatch``, ``simulator``,
-    ``waves`` (path or None), ``build_seconds``, ``stream_seconds``...
+    Each call gets its own run folder ``work_dir/runs/<name>-<sim>-<time>-<pid>-<random>``
+    (:func:`~.runner.new_run_dir`) holding ``stimulus.npz`` (the testbench's input), the
+    result, the log and waves; builds are shared in ``build_root`` (default
+    ``work_dir/builds``). Returns the testbench result: ``compared``, ``mismatches``,
+    ``first_mismatch``, ``first_mismatch_time_ns``, ``simulator``, ``waves`` (path or
+    None), ``build_seconds``, ``stream_seconds``, ``run_dir``...
     """
     contract = stim.contract
     _check_inputs(contract, stim.codes, stim.thresholds)
@@ -88,7 +93,24 @@ def check_stimulus(
     work = Path(work_dir)
     root = work / "builds" if build_root is None else Path(build_root)
     sb = build(contract, sim, root, waves=waves, lanes=lanes)
-    run_dir = work / sim / name
+    run_dir = new_run_dir(work, f"{name}-{sim}")
+    try:
+        result = _run_and_keep_waves(stim, sb, run_dir, root, waves)
+    except KeyboardInterrupt:  # an interrupted run leaves no half-written run folder
+        shutil.rmtree(run_dir, ignore_errors=True)
+        raise
+    result.update(
+        build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
+        build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),
+        arch="parallel" if lanes is None else "stream", lanes=lanes,
+    )
+    return result
+
+
+def _run_and_keep_waves(stim: Stimulus, sb: SimBuild, run_dir: Path, root: Path,
+                        waves: bool) -> dict:
+    """Run ``stim`` in ``run_dir``; on a mismatch without ``waves``, re-run it up to the
+    first failing step with waves on (``run_dir/failure``) so a waveform is kept."""
     path = run_dir / "stimulus.npz"
     save_stimulus(path, stim)
     result = run_testbench(sb, path, run_dir, waves=waves)
@@ -98,13 +120,8 @@ def check_stimulus(
         again_dir = run_dir / "failure"
         again = again_dir / "stimulus.npz"
         save_stimulus(again, stim.first_steps(upto))
-        sbw = build(contract, sim, root, waves=True, lanes=lanes)
+        sbw = build(stim.contract, sb.sim, root, waves=True, lanes=sb.lanes)
         result["waves"] = run_testbench(sbw, again, again_dir, waves=True)["waves"]
-    result.update(
-        build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
-        build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),
-        arch="parallel" if lanes is None else "stream", lanes=lanes,
-    )
     return result
 
 
@@ -159,7 +176,8 @@ def replay(
         stim = stim.first_steps(steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
                             name=Path(stimulus).stem or "stimulus", lanes=lanes)
-    result.update(stimulus=str(stimulus), height=c.height, width=c.width)
+    result.update(stimulus=str(stimulus), height=c.height, width=c.width,
+                  coverage=_coverage(stim))
     return result
 
 
@@ -195,5 +213,46 @@ def verify(
     stim = make_stimulus(load_scene(scene, size=(h, w)), point, num_steps=steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
                             name=Path(str(scene)).stem or "scene", lanes=lanes)
-    result.update(scene=str(scene), point=str(fixed), height=h, width=w)
+    result.update(scene=str(scene), point=str(fixed), height=h, width=w,
+                  coverage=_coverage(stim))
     return result
+
+
+def random_verify(
+    fixed: str | os.PathLike,
+    seed: int,
+    steps: int,
+    sim: str = "icarus",
+    waves: bool = False,
+    size: tuple[int, int] | None = None,
+    work_dir: str | os.PathLike = DEFAULT_WORK,
+    lanes: int | None = None,
+) -> dict:
+    """Verify the RTL of design point ``fixed`` on a seeded random and corner stimulus
+    (:func:`~rvsm.model.fixed.corner_stimulus.corner_stimulus`, ``steps`` steps);
+    ``lanes`` verifies the streaming array.
+
+    Returns :func:`check_stimulus`'s result plus ``seed``, ``point``, ``height``,
+    ``width`` and ``coverage`` (per scale, accumulator-steps per bin).
+    """
+    from rvsm.model.fixed.corner_stimulus import corner_stimulus, coverage
+    from rvsm.model.fixed.point_toml import load_design_point
+
+    check_simulator(sim)
+    point = load_design_point(fixed)
+    if size is not None:
+        point = point.with_size(*size)
+    _check_size(point.contract(), lanes)
+    stim = corner_stimulus(point.contract(), seed, steps)
+    stim.point = point
+    result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=f"random{seed}",
+                            lanes=lanes)
+    result.update(seed=seed, point=str(fixed), height=point.height, width=point.width,
+                  coverage=coverage(stim))
+    return result
+
+
+def _coverage(stim: Stimulus) -> list[dict]:
+    from rvsm.model.fixed.corner_stimulus import coverage
+
+    return coverage(stim)

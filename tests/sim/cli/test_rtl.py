@@ -64,6 +64,31 @@ def test_stimulus_file_replays_on_icarus(tmp_path: Path, capsys: pytest.CaptureF
                  "--work", work]) == 1
     out = json.loads(capsys.readouterr().out)
     assert out["mismatches"] == 1 and out["first_mismatch"]["step"] == 12
+    assert out["waves"].endswith(".fst") and Path(out["waves"]).exists()
+    assert out["first_mismatch_time_ns"] > 0  # where to jump to in the waveform
+    assert main(["verify", "--stimulus", str(stim), "--steps", "20", "--work", work]) == 1
+    text = capsys.readouterr().out
+    assert f"first mismatch at {out['first_mismatch_time_ns']} ns" in text
+    assert "open it with: gtkwave" in text
+
+
+def test_verify_random_corner_stimulus_reports_coverage(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """``rvsm verify --random SEED``: seeded corner stimulus, coverage per scale."""
+    point = tmp_path / "p.toml"
+    save_design_point(point, replace(default_design_point().with_size(4, 4), model="dog1"))
+    args = ["verify", "--random", "5", "--fixed", str(point), "--size", "6x6", "--steps",
+            "200", "--work", str(tmp_path / "work")]
+    assert main([*args, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mismatches"] == 0 and out["seed"] == 5 and out["steps"] == 200
+    # 18-bit accumulators: 200 steps of this seed reach every bin, the bottom rail too
+    assert len(out["coverage"]) == 1 and all(n for n in out["coverage"][0].values())
+    assert main(args) == 0
+    assert "coverage scale 0: 9/9 bins hit" in capsys.readouterr().out
+    assert main(["verify", "--random", "5", "--fixed", str(point)]) == 2
+    assert "--size, --steps" in capsys.readouterr().err
 
 
 def test_verify_needs_scene_and_point_or_stimulus(tmp_path: Path,

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rvsm.model.errors import RvsmError
+from rvsm.model.errors import RvsmError, ToolError
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.kernels import MODEL_NAMES
 from rvsm.sim.cosim.runner import check_simulator
@@ -147,7 +147,7 @@ def test_checker_catches_wrong_expectation_verilator(
 
 def test_missing_simulator_is_one_clear_line(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("PATH", "/nonexistent")
-    with pytest.raises(RvsmError, match="apt-get install iverilog"):
+    with pytest.raises(ToolError, match="apt-get install iverilog"):  # exit status 3
         check_simulator("icarus")
 
 

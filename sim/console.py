@@ -1,0 +1,41 @@
+"""The ``rvsm`` console script: signal handlers first, then the (slow) command imports.
+
+Importing the command families (numpy, matplotlib, amaranth, ...) takes a second or more;
+SIGTERM and SIGHUP are turned into interrupts before that, so a signal during start-up
+also ends with status 130 and one line instead of a traceback or a bare kill. The
+commands themselves are :func:`rvsm.sim.cli.main.main`.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+
+__all__ = ["main"]
+
+
+def _startup_interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt(signal.Signals(signum).name)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``rvsm`` console script; returns the process exit status."""
+    previous = {sig: signal.getsignal(sig) for sig in (signal.SIGTERM, signal.SIGHUP)}
+    for sig, handler in previous.items():
+        if handler is not signal.SIG_IGN:  # `nohup rvsm ...` keeps ignoring SIGHUP
+            signal.signal(sig, _startup_interrupt)
+    try:
+        try:
+            from rvsm.sim.cli.main import main as run
+        except KeyboardInterrupt as exc:
+            why = f" by {exc.args[0]}" if exc.args else ""
+            print(f"rvsm: interrupted{why} while starting", file=sys.stderr)
+            return 130
+        return run(argv)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
