@@ -504,3 +504,19 @@ def test_nohup_keeps_ignoring_sighup(tmp_path: Path) -> None:
     proc.send_signal(signal.SIGHUP)
     _, err = proc.communicate(timeout=300)
     assert proc.returncode == 0, err
+
+
+def test_stream_verify_follows_the_same_contract(tmp_path: Path) -> None:
+    """``--arch stream``: a killed simulator is exit 3, a pass is 0, in its own run folder."""
+    point, work = _point(tmp_path / "p.toml"), tmp_path / "w"
+    args = [*_verify_args(point, work, "--json"), "--arch", "stream", "--lanes", "2"]
+    env = _fake_tools(tmp_path / "bin", vvp="kill -9 $$")
+    r = _rvsm(*args, env=env)
+    assert r.returncode == 3
+    assert "icarus simulation (vvp) was killed by SIGKILL" in _one_line(r.stderr)
+    r = _rvsm(*args)
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["mismatches"] == 0 and out["lanes"] == 2
+    assert Path(out["run_dir"]).parent == work.resolve() / "runs"
+    assert _leftovers(work) == []
