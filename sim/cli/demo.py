@@ -8,6 +8,7 @@ from pathlib import Path
 from rvsm.sim.cosim import SIMULATORS
 from rvsm.sim.studies.demo import (
     DEMO_MODELS,
+    DEMO_RTL_LANES,
     DEMO_RTL_SIZE,
     DEMO_RTL_STEPS,
     DEMO_SCENE,
@@ -55,8 +56,9 @@ def run_demo(args: argparse.Namespace) -> int:
     from rvsm.sim.studies.demo import run_rtl_demo
 
     h, w = DEMO_RTL_SIZE
-    print(f"RTL: default design point at {h}x{w}, Verilog + {DEMO_RTL_STEPS}-step "
-          f"spike-for-spike check on {args.sim} (the first build takes a few minutes)")
+    print(f"RTL: default design point, streaming array at {h}x{w} with {DEMO_RTL_LANES} "
+          f"lanes: Verilog + {DEMO_RTL_STEPS}-step spike-for-spike check on {args.sim} "
+          "(the first build takes a few minutes)")
     result = run_rtl_demo(args.scene, out / "rtl", sim=args.sim)
     print(f"RTL: wrote {result['verilog']} (generated in {result['generate_seconds']:.1f} s); "
           f"{result['simulator']}: {result['compared']} spikes compared, "

@@ -25,8 +25,11 @@ from rvsm.model.spike_files import save_spikes
 DEMO_SCENE = "flyball"
 DEMO_MODELS = ("fsm", "dog4", "gauss4")
 # The flat RTL array is verified on a small window: Verilator builds grow with the array.
-DEMO_RTL_SIZE = (4, 6)
-DEMO_RTL_STEPS = 200
+#: The RTL check of the demo: the streaming array (rvsm.rtl.stream_array) at this size,
+#: lanes and steps, spike for spike against the fixed twin.
+DEMO_RTL_SIZE = (64, 96)
+DEMO_RTL_LANES = 8
+DEMO_RTL_STEPS = 40
 
 
 @dataclass(frozen=True)
@@ -121,23 +124,26 @@ def run_rtl_demo(
     size: tuple[int, int] = DEMO_RTL_SIZE,
     steps: int = DEMO_RTL_STEPS,
     sim: str = "verilator",
+    lanes: int = DEMO_RTL_LANES,
 ) -> dict:
-    """Generate the default design point's Verilog and verify it against the fixed twin.
+    """Generate the default design point's streaming-array Verilog and verify it.
 
-    Writes ``out_dir/point.toml``, the Verilog and its port map, then runs ``steps``
-    steps of ``scene_arg`` (rendered at ``size``) on ``sim`` through cocotb. Returns the
+    Writes ``out_dir/point.toml``, the Verilog of ``RvsmStreamArray(contract, lanes)`` and
+    its port map, then runs ``steps`` steps of ``scene_arg`` (rendered at ``size``) on
+    ``sim`` through cocotb, spike for spike against the fixed twin. Returns the
     verification result (``compared``, ``mismatches``, ``first_mismatch``, ``waves``,
     timings) plus ``verilog`` and ``generate_seconds``.
     """
     from rvsm.model.fixed.design_point import default_design_point
     from rvsm.model.fixed.point_toml import save_design_point
-    from rvsm.rtl.verilog import write_outputs
+    from rvsm.rtl.stream_verilog import write_stream_outputs
     from rvsm.sim.cosim.verify import verify
 
     point = default_design_point().with_size(*size)
     point_path = out_dir / "point.toml"
     save_design_point(point_path, point)
-    paths, generated = write_outputs(point.contract(), out_dir)
-    result = verify(scene_arg, point_path, sim=sim, steps=steps, work_dir=out_dir / "verify")
+    paths, generated = write_stream_outputs(point.contract(), lanes, out_dir)
+    result = verify(scene_arg, point_path, sim=sim, steps=steps, work_dir=out_dir / "verify",
+                    lanes=lanes)
     result.update(verilog=str(paths["verilog"]), generate_seconds=generated.seconds)
     return result
