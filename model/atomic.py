@@ -18,18 +18,28 @@ def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
 
     On any exception the temporary file is removed and ``target`` is left untouched. The
     temporary name keeps ``target``'s suffix, so writers that infer a format still work.
+    An ``OSError`` becomes a one-line error (:func:`rvsm.model.outputs.os_error`): a full
+    disk a :class:`~.errors.ToolError` (exit 3), a read-only or forbidden location an
+    :class:`~.errors.RvsmError` (exit 2).
     """
+    from .outputs import os_error
+
     target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(
-        prefix=f".{target.stem}.", suffix=f".partial{target.suffix}", dir=target.parent
-    )
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{target.stem}.", suffix=f".partial{target.suffix}", dir=target.parent
+        )
+    except OSError as exc:
+        raise os_error(exc, target) from None
     os.close(fd)
     tmp_path = Path(tmp)
     try:
         yield tmp_path
         os.chmod(tmp_path, 0o666 & ~_UMASK)  # mkstemp makes 0600; give a normal file mode
         os.replace(tmp_path, target)
+    except OSError as exc:
+        raise os_error(exc, target) from None
     finally:
         if tmp_path.exists():
             tmp_path.unlink()

@@ -31,6 +31,10 @@ from .noise_streams import (
 )
 
 MAX_SCALES = 4
+#: Largest noise intensity k: at k = 1000 the dark current's standard deviation is 750
+#: brightness units, three times an 8-bit scene's range; beyond it the integer twin's
+#: casts would no longer be meaningful.
+MAX_K = 1000.0
 
 
 @dataclass(frozen=True)
@@ -54,6 +58,8 @@ class NoiseParams:
         for name in ("k", "b1", "b2", "b3"):
             if getattr(self, name) < 0:
                 raise RvsmError(f"noise parameter {name} must be >= 0, got {getattr(self, name)}")
+        if self.k > MAX_K:
+            raise RvsmError(f"noise intensity k must be <= {MAX_K:g}, got {self.k!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
                 or self.seed < 0:
             raise RvsmError(f"noise seed must be an integer >= 0, got {self.seed!r}")

@@ -21,6 +21,7 @@ import numpy as np
 
 from .errors import RvsmError
 from .kernels import ModelSpec, model_spec
+from .memory import require_spike_memory
 from .noise import NoiseParams, NoiseSource
 from .orbits import orbit_receptive_sums
 from .progress import progress_bar
@@ -221,6 +222,7 @@ def sample(
     spec = config.spec
     thresholds = accumulator_thresholds(config, scene.shape)
     integrator = Integrator(thresholds, spec.signed, config.reset)
+    require_spike_memory(scene, spec.num_scales)
     spikes = np.zeros((scene.num_steps, spec.num_scales) + scene.shape, dtype=np.int8)
     bar = progress_bar(scene.num_steps, f"{spec.name} {scene.name}", progress)
     for t, drive in iter_step_drives(scene, config, block_steps):

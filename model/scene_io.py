@@ -76,6 +76,9 @@ def _float_to_8bit(img: np.ndarray) -> np.ndarray:
 
 
 def _load_npy(path: Path) -> np.ndarray:
+    from .npy_guard import check_npy_file
+
+    check_npy_file(path)
     try:
         arr = np.load(path, allow_pickle=False)
     except Exception as exc:  # truncated, corrupt, pickled object arrays ...
@@ -206,8 +209,13 @@ def load_scene(
         raise RvsmError(f"number of frames must be an integer >= 1, got {num_frames!r}")
     text = os.fspath(arg)
     if text in SCENE_NAMES:
+        from .memory import require_memory
         from .scene_library import DEFAULT_FRAMES, DEFAULT_SIZE
 
+        h, w = DEFAULT_SIZE if size is None else size
+        frames = DEFAULT_FRAMES if num_frames is None else int(num_frames)
+        require_memory(2 * 8 * frames * h * w, f"scene {text!r} with {frames} frames of {h}x{w}",
+                       "ask for fewer --frames or a smaller --size")
         return builtin_scene(
             text,
             DEFAULT_SIZE if size is None else size,
@@ -237,6 +245,9 @@ def load_scene(
         )
     frames = validate_frames(frames, str(path))
     if num_frames is not None:
+        if num_frames > frames.shape[0]:
+            raise RvsmError(f"{path}: has {frames.shape[0]} frames, fewer than the "
+                            f"{int(num_frames)} asked for; ask for at most {frames.shape[0]}")
         frames = frames[: int(num_frames)]
     frames = _fit_size(frames, size, str(path))
     name = path.stem if path.suffix else path.name

@@ -20,12 +20,15 @@ import numpy as np
 
 from .atomic import atomic_path
 from .errors import RvsmError
+from .npy_guard import check_npz_members
+from .versions import with_versions
 
 
 def save_spikes(path: str | os.PathLike, spikes: np.ndarray, meta: dict) -> None:
-    """Write ``spikes (T, S, H, W) int8`` and ``meta`` to an ``.npz`` file, atomically."""
+    """Write ``spikes (T, S, H, W) int8`` and ``meta`` to an ``.npz`` file, atomically;
+    ``meta`` gains ``versions`` (rvsm, numpy, Python: :func:`~.versions.with_versions`)."""
     spikes = _check_spikes(np.asarray(spikes), str(path))
-    text = json.dumps(meta, sort_keys=True)
+    text = json.dumps(with_versions(meta), sort_keys=True)
     with atomic_path(path) as tmp, open(tmp, "wb") as handle:
         np.savez_compressed(handle, spikes=spikes, meta=np.array(text))
 
@@ -35,6 +38,7 @@ def load_spikes(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
     path = Path(path)
     if not path.is_file():
         raise RvsmError(f"spike file {path} does not exist")
+    check_npz_members(path, {"spikes": 4, "meta": 0})
     try:
         with np.load(path, allow_pickle=False) as data:
             missing = {"spikes", "meta"} - set(data.files)

@@ -28,6 +28,9 @@ ADC_CLIPS = ("saturate", "error")
 def quantise(values: np.ndarray, rounding: str) -> np.ndarray:
     """Round float ``values`` to integers (``int64``) with a declared rounding rule."""
     x = np.asarray(values, dtype=np.float64)
+    if not np.isfinite(x).all():
+        raise RvsmError("analogue values to quantise are NaN or infinite; check the noise "
+                        "intensity and the scene")
     if rounding == "truncate":
         out = np.floor(x)
     elif rounding == "round-half-up":

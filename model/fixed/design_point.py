@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import RvsmError
 from ..kernels import MODEL_NAMES, ModelSpec, model_spec
-from ..noise import NoiseParams, NoiseSource
+from ..noise import MAX_K, NoiseParams, NoiseSource
 from ..noise_presets import NOISE_PRESETS, preset_noise
 from ..samplers import RESET_MODES, SamplerConfig
 from ..scene_library import SCENE_NAMES
@@ -106,7 +106,8 @@ class DesignPoint:
         f"scene of the response rule (default {DEFAULT_CALIBRATION_SCENE})", sweep=False)
     noise: bool = declare("noise", "enabled", Flag(), False,
                           "SPEC section 3 noise on or off", sweep=False)
-    noise_k: float = declare("noise", "k", Number(allow_zero=True), 1.0, "noise intensity k")
+    noise_k: float = declare("noise", "k", Number(allow_zero=True, hi=MAX_K), 1.0,
+                              "noise intensity k")
     seed: int = declare("noise", "seed", Integer(0, (1 << 63) - 1), 0,
                         "numpy seed, shared with the float model", sweep=False)
     noise_preset: str | None = declare(

@@ -62,9 +62,11 @@ class Integer:
 
 @dataclass(frozen=True)
 class Number:
-    """A finite number ``> 0`` (or ``>= 0`` with ``allow_zero``), stored as float."""
+    """A finite number ``> 0`` (or ``>= 0`` with ``allow_zero``) and ``<= hi``, stored as
+    float."""
 
     allow_zero: bool = False
+    hi: float = math.inf
 
     def check(self, path: str, value: Any) -> float:
         ok = not isinstance(value, bool) and isinstance(value, (int, float, np.number)) \
@@ -72,10 +74,13 @@ class Number:
         if not ok or value < 0 or (value == 0 and not self.allow_zero):
             rel = ">= 0" if self.allow_zero else "> 0"
             raise RvsmError(f"{path} must be a finite number {rel}, got {value!r}")
+        if value > self.hi:
+            raise RvsmError(f"{path} must be <= {self.hi:g}, got {value!r}")
         return float(value)
 
     def describe(self) -> str:
-        return "number >= 0" if self.allow_zero else "number > 0"
+        text = "number >= 0" if self.allow_zero else "number > 0"
+        return text if self.hi == math.inf else f"{text}, <= {self.hi:g}"
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,7 @@ else:  # pragma: no cover
 from ..atomic import write_text_atomic
 from ..errors import RvsmError
 from ..thresholds import DEFAULT_CALIBRATION_SCENE
+from ..text_files import read_utf8_text
 from .design_point import FIELDS, DesignPoint
 
 __all__ = [
@@ -120,11 +121,7 @@ def design_point_toml(point: DesignPoint) -> str:
 def load_design_point(path: str | os.PathLike) -> DesignPoint:
     """Read and validate a design-point TOML file (errors name the file and the field)."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise RvsmError(f"cannot read design point {p}: {exc.strerror or exc}") from None
-    return parse_design_point(text, str(p))
+    return parse_design_point(read_utf8_text(p, "design point"), str(p))
 
 
 def parse_design_point(text: str, source: str = "design point") -> DesignPoint:

@@ -33,7 +33,9 @@ import numpy as np
 
 from ..atomic import atomic_path
 from ..errors import RvsmError
+from ..npy_guard import check_npz_members
 from ..scene import Scene
+from ..versions import with_versions
 from .core import ArrayContract
 from .design_point import DesignPoint
 from .point_toml import design_point_toml, parse_design_point
@@ -90,6 +92,10 @@ def make_stimulus(
     if num_steps is not None:
         if isinstance(num_steps, bool) or int(num_steps) < 1:
             raise RvsmError(f"number of steps must be an integer >= 1, got {num_steps!r}")
+        if num_steps > scene.num_steps:
+            raise RvsmError(f"--steps {num_steps} is more than the {scene.num_steps} steps of "
+                            f"scene {scene.name!r}; ask for at most {scene.num_steps} (or "
+                            "give more --frames)")
         if num_steps < scene.num_steps:
             scene = _first_steps(scene, int(num_steps))
     run = simulate_fixed(scene, point, progress=progress, keep_codes=True)
@@ -131,7 +137,7 @@ def save_stimulus(path: str | os.PathLike, stim: Stimulus) -> None:
         "half_widths": np.array([len(k) // 2 for k in c.weights], dtype=np.int64),
         "contract": np.array(json.dumps(asdict(c))),
         "point": np.array(design_point_toml(stim.point) if stim.point else ""),
-        "meta": np.array(json.dumps(stim.meta, sort_keys=True)),
+        "meta": np.array(json.dumps(with_versions(stim.meta), sort_keys=True)),
     }
     with atomic_path(path) as tmp, open(tmp, "wb") as handle:
         np.savez_compressed(handle, **arrays)
@@ -142,6 +148,7 @@ def load_stimulus(path: str | os.PathLike) -> Stimulus:
     p = Path(path)
     if not p.is_file():
         raise RvsmError(f"stimulus file {p} does not exist")
+    check_npz_members(p, {"codes": 3, "thresholds": 3, "spikes": 4})
     try:
         with np.load(p, allow_pickle=False) as data:
             missing = set(STIMULUS_KEYS) - set(data.files)

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..memory import require_spike_memory
 from ..noise import NoiseSource
 from ..progress import progress_bar
 from ..samplers import DEFAULT_BLOCK_STEPS, sampling_meta
@@ -138,6 +139,7 @@ def simulate_fixed(
     )
     weights = contract.weight_arrays
     s_count, (h, w), t_total = point.num_scales, point.shape, scene.num_steps
+    require_spike_memory(scene, s_count, 3 if keep_codes else 1)
     spikes = np.zeros((t_total, s_count, h, w), dtype=np.int8)
     codes_out = np.zeros((t_total, h, w), dtype=np.uint16) if keep_codes else None
     big, small = np.iinfo(np.int64).max, np.iinfo(np.int64).min

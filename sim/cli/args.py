@@ -41,6 +41,13 @@ def add_noise_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=None, help="noise seed (default 0)")
 
 
+def add_force_argument(parser: argparse.ArgumentParser) -> None:
+    """``--force``: replace an existing output of another kind (:mod:`rvsm.model.outputs`)."""
+    parser.add_argument("--force", action="store_true",
+                        help="replace an existing output file even if it holds another kind "
+                        "of file (never an input)")
+
+
 def noise_from_args(args: argparse.Namespace) -> NoiseParams | None:
     """The noise asked for on the command line, or ``None`` for a noiseless sensor."""
     preset = getattr(args, "noise_preset", None)
@@ -80,9 +87,20 @@ def load_scene_from_args(
         scene_arg if scene_arg is not None else args.scene,
         size=size if size is not None else parse_size_arg(args.size),
         num_frames=args.frames,
-        steps_per_frame=args.steps_per_frame or DEFAULT_STEPS_PER_FRAME,
+        steps_per_frame=positive_or_default(args.steps_per_frame, "--steps-per-frame",
+                                            DEFAULT_STEPS_PER_FRAME),
         hold=bool(args.hold),
     )
+
+
+def positive_or_default(value: int | None, option: str, default: int) -> int:
+    """``value`` when given (refused unless >= 1, never silently replaced), else
+    ``default``."""
+    if value is None:
+        return default
+    if value < 1:
+        raise RvsmError(f"{option} must be an integer >= 1, got {value}")
+    return value
 
 
 def scene_from_meta(meta: dict, override: str | None = None) -> Scene:

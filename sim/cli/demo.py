@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from rvsm.model.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.cosim import SIMULATORS
 from rvsm.sim.studies.demo import (
     DEMO_MODELS,
@@ -15,7 +16,7 @@ from rvsm.sim.studies.demo import (
     run_float_demo,
 )
 
-from .args import load_scene_from_args
+from .args import add_force_argument, load_scene_from_args
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -35,11 +36,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--sim", choices=(*SIMULATORS, "none"), default="verilator",
                    help="simulator for the RTL check of the default design point "
                    "(default verilator; none skips it)")
+    add_force_argument(p)
     p.set_defaults(func=run_demo, hold=False)
 
 
 def run_demo(args: argparse.Namespace) -> int:
     """``rvsm demo``."""
+    files = tuple((f"{m}{ext}", kind) for m in DEMO_MODELS
+                  for ext, kind in ((".npz", "spike file"), (".png", None)))
+    files += (("metrics.md", PLAIN), ("metrics.csv", PLAIN), ("rtl", FOLDER))
+    check_outputs([Output(args.output, "-o", FOLDER, files)], [args.scene], args.force)
     scene = load_scene_from_args(args)
     out = Path(args.output)
     h, w = scene.shape

@@ -8,10 +8,11 @@ import sys
 from pathlib import Path
 
 from rvsm.model.errors import RvsmError
+from rvsm.model.outputs import PLAIN, Output, check_outputs
 from rvsm.model.reconstruction import MATCH_MODES, METHODS
 from rvsm.model.thresholds import THRESHOLD_RULES
 
-from .args import add_scene_arguments, load_scene_from_args, parse_size_arg
+from .args import add_force_argument, add_scene_arguments, load_scene_from_args, parse_size_arg
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -22,6 +23,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     q = cfg.add_parser("new", help="print the documented default design point as TOML")
     q.add_argument("-o", "--output", help="write to this file instead of stdout")
     q.add_argument("--size", metavar="HxW", help="array size (default 250x400)")
+    add_force_argument(q)
     q.set_defaults(func=run_config_new)
     q = cfg.add_parser("check", help="validate a design point and print its integers")
     q.add_argument("point", help="design point .toml")
@@ -34,6 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     _common(p)
     p.add_argument("--steps", type=int, default=None, help="keep only the first N steps")
     p.add_argument("-o", "--output", required=True, help="output stimulus .npz")
+    add_force_argument(p)
     p.set_defaults(func=cmd_stimulus)
 
     p = sub.add_parser("profile", help="quantisation profile (saturation, ranges, weights)",
@@ -44,6 +47,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--plot", default="fixed-profile.png",
                    help="plot file (default fixed-profile.png; '' for none)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_force_argument(p)
     p.set_defaults(func=run_profile)
 
     p = sub.add_parser("cost", help="what quantisation costs: fixed vs float spikes and PSNR",
@@ -85,6 +89,7 @@ def run_config_new(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.design_point import default_design_point
     from rvsm.model.fixed.point_toml import design_point_toml, save_design_point
 
+    check_outputs([args.output and Output(args.output, "-o", PLAIN)], force=args.force)
     point = default_design_point()
     size = parse_size_arg(args.size)
     if size is not None:
@@ -119,6 +124,8 @@ def cmd_stimulus(args: argparse.Namespace) -> int:
     """``rvsm stimulus``."""
     from rvsm.model.fixed.stimulus import make_stimulus, save_stimulus
 
+    check_outputs([Output(args.output, "-o", "stimulus file")], [args.scene, args.fixed],
+                  args.force)
     point, scene = _point_and_scene(args)
     stim = make_stimulus(scene, point, progress=True, num_steps=args.steps)
     save_stimulus(args.output, stim)
@@ -134,6 +141,8 @@ def run_profile(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.profile import format_profile, profile_figure, profile_report
     from rvsm.model.fixed.twin import simulate_fixed
 
+    check_outputs([args.plot and Output(args.plot, "--plot")], [args.scene, args.fixed],
+                  args.force)
     point, scene = _point_and_scene(args)
     run = simulate_fixed(scene, point, progress=True, histograms=True)
     report = profile_report(run)

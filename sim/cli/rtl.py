@@ -5,12 +5,12 @@ from __future__ import annotations
 import argparse
 import json
 import shlex
-import sys
 
 from rvsm.model.errors import RvsmError
+from rvsm.model.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.cosim import SIMULATORS
 
-from .args import parse_size_arg
+from .args import add_force_argument, parse_size_arg
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,6 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--lint", action="store_true", help="run verilator --lint-only")
     p.add_argument("--stats", action="store_true",
                    help="synthesise with yosys (synth; stat) and print cells/flip-flops")
+    add_force_argument(p)
     p.set_defaults(func=_verilog)
 
     p = sub.add_parser(
@@ -68,6 +69,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _verilog(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.verilog import verilator_lint, write_outputs, yosys_stats
+    from rvsm.sim.cosim.verify import MAX_PARALLEL_SIDE
 
     size = parse_size_arg(args.size)
     point = load_design_point(args.point)
@@ -78,12 +80,19 @@ def _verilog(args: argparse.Namespace) -> int:
         from rvsm.rtl.stream_verilog import STREAM_TOP, write_stream_outputs
 
         args.top = args.top or STREAM_TOP
-        paths, gen = write_stream_outputs(contract, args.lanes, args.out, args.top)
     else:
         args.top = args.top or "rvsm_array"
-        if max(contract.height, contract.width) > 64:
-            print(f"rvsm: note: a {contract.height}x{contract.width} fully parallel array "
-                  "takes long to generate; consider --size or --arch stream", file=sys.stderr)
+        if max(contract.height, contract.width) > MAX_PARALLEL_SIDE:  # as verify refuses
+            raise RvsmError(
+                f"the fully parallel RTL array is limited to {MAX_PARALLEL_SIDE}x"
+                f"{MAX_PARALLEL_SIDE} pixels (larger ones take hours to generate), the "
+                f"design point is {contract.height}x{contract.width}; pass --size, e.g. "
+                "--size 16x16, or --arch stream")
+    files = tuple((f"{args.top}{ext}", PLAIN) for ext in (".v", ".ports.json", ".ports.md"))
+    check_outputs([Output(args.out, "-o", FOLDER, files)], [args.point], args.force)
+    if args.arch == "stream":
+        paths, gen = write_stream_outputs(contract, args.lanes, args.out, args.top)
+    else:
         paths, gen = write_outputs(contract, args.out, args.top)
     print(f"wrote {paths['verilog']} ({gen.seconds:.1f} s), {paths['ports_json']}, "
           f"{paths['ports_md']}; latency {gen.latency} cycle(s)")
@@ -111,6 +120,8 @@ def _top_arg(text: str) -> str:
 def _verify(args: argparse.Namespace) -> int:
     from rvsm.sim.cosim.verify import random_verify, replay, verify
 
+    check_outputs([Output(args.work, "--work", FOLDER)],
+                  [args.scene, args.fixed, args.stimulus])
     if args.steps is not None and args.steps < 1:
         raise RvsmError(f"--steps must be >= 1, got {args.steps}")
     lanes = args.lanes if args.arch == "stream" else None

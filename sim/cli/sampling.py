@@ -9,6 +9,7 @@ import numpy as np
 
 from rvsm.model.errors import RvsmError
 from rvsm.model.fused import DEFAULT_CHUNK_STEPS
+from rvsm.model.outputs import PLAIN, Output, check_outputs
 from rvsm.model.reconstruction import MATCH_MODES, METHODS
 from rvsm.model.samplers import DEFAULT_PHI, ENGINES, RESET_MODES, SamplerConfig
 from rvsm.model.sampling_stream import ArraySink, CountSink, TeeSink, stream_float
@@ -24,6 +25,7 @@ from rvsm.model.spike_h5 import (
 from rvsm.model.thresholds import THRESHOLD_RULES, rule_thresholds
 
 from .args import (
+    add_force_argument,
     add_noise_arguments,
     add_scene_arguments,
     load_scene_from_args,
@@ -57,6 +59,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--dat", metavar="FILE.dat", help="also export FSM spikes as camera .dat")
     p.add_argument("--flip", action="store_true", help="flip vertically in the .dat file")
     add_engine_arguments(p)
+    add_force_argument(p)
     p.set_defaults(func=run_simulate)
 
     p = sub.add_parser("evaluate", help="reconstruct a spike file and score it",
@@ -78,12 +81,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument("spikes", help=".h5 or .npz spike file")
     q.add_argument("-o", "--output", required=True, help="output .dat")
     q.add_argument("--flip", action="store_true", help="flip vertically (camera row order)")
+    add_force_argument(q)
     q.set_defaults(func=run_dat_export)
     q = dat_sub.add_parser("import", help=".dat -> .h5 (streamed) or .npz")
     q.add_argument("dat", help="camera .dat file")
     q.add_argument("--size", required=True, metavar="HxW", help="sensor size, e.g. 250x400")
     q.add_argument("--flip", action="store_true", help="flip vertically (camera row order)")
     q.add_argument("-o", "--output", required=True, help="output .h5 or .npz")
+    add_force_argument(q)
     q.set_defaults(func=run_dat_import)
 
 
@@ -142,6 +147,9 @@ def run_simulate(args: argparse.Namespace) -> int:
         raise RvsmError(f"--dat expects a .dat path, got {args.dat!r}")
     if not (is_h5_path(args.output) or args.output.endswith(".npz")):
         raise RvsmError(f"-o expects a .h5 or .npz path, got {args.output!r}")
+    check_outputs([Output(args.output, "-o", "spike file"),
+                   args.dat and Output(args.dat, "--dat", PLAIN)],
+                  [args.scene, args.fixed], args.force)
     apply_threads(args)
     h5 = is_h5_path(args.output)
     counts = CountSink()
@@ -215,6 +223,7 @@ def run_evaluate(args: argparse.Namespace) -> int:
 
 def run_dat_export(args: argparse.Namespace) -> int:
     """``rvsm dat export``: streams the spike file into the ``.dat`` file."""
+    check_outputs([Output(args.output, "-o", PLAIN)], [args.spikes], args.force)
     with open_spikes(args.spikes) as source:
         copy_source(source, DatWriter(args.output, flip=args.flip), dict(source.meta))
         t, _, h, w = source.shape
@@ -224,6 +233,7 @@ def run_dat_export(args: argparse.Namespace) -> int:
 
 def run_dat_import(args: argparse.Namespace) -> int:
     """``rvsm dat import``: streams the ``.dat`` file into ``.h5`` (or ``.npz``)."""
+    check_outputs([Output(args.output, "-o", "spike file")], [args.dat], args.force)
     h, w = parse_size_arg(args.size)
     source = dat_source(args.dat, h, w, flip=args.flip)
     meta = {"kind": "camera", "model": "fsm", "phis": [DEFAULT_PHI], "source": str(args.dat),

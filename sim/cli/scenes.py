@@ -8,6 +8,7 @@ import numpy as np
 
 from rvsm.model.atomic import atomic_path
 from rvsm.model.errors import RvsmError
+from rvsm.model.outputs import Output, check_outputs
 from rvsm.model.scene_library import (
     DEFAULT_FRAMES,
     DEFAULT_SIZE,
@@ -16,7 +17,7 @@ from rvsm.model.scene_library import (
     scene_descriptions,
 )
 
-from .args import parse_size_arg
+from .args import add_force_argument, parse_size_arg
 
 SHEET_FRAMES = 4
 
@@ -35,6 +36,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help=f"frame size, default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]}")
     p.add_argument("--frames", type=int, default=DEFAULT_FRAMES, metavar="F",
                    help=f"number of frames, default {DEFAULT_FRAMES}")
+    add_force_argument(p)
     p.set_defaults(func=run)
 
 
@@ -63,6 +65,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if not args.output:
         raise RvsmError("--render needs -o FILE.png, the contact sheet to write")
+    check_outputs([Output(args.output, "-o")], force=args.force)
     size = parse_size_arg(args.size) or DEFAULT_SIZE
     frames = render_frames(args.render, size, args.frames)
     sheet = contact_sheet(frames)

@@ -9,12 +9,13 @@ from pathlib import Path
 from rvsm.model.atomic import atomic_path, write_text_atomic
 from rvsm.model.errors import RvsmError
 from rvsm.model.noise_presets import NOISE_PRESETS
+from rvsm.model.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.model.samplers import DEFAULT_PHI
 from rvsm.model.thresholds import DEFAULT_CALIBRATION_SCENE, THRESHOLD_RULES
 from rvsm.sim.studies import claims, robustness, table
 from rvsm.sim.studies.settings_table import run_settings_table, settings_csv
 
-from .args import parse_size_arg
+from .args import add_force_argument, parse_size_arg
 
 # Defaults of ``rvsm table``: the built-in scenes' full 250 x 400 canvas and 41 frames
 # (400 steps): 108 runs in ~6.5 min on a 2-core machine; see docs/reproduction.md.
@@ -56,6 +57,9 @@ def save_figure(fig, path: Path) -> None:
 
 def cmd_table(args: argparse.Namespace) -> int:
     """Run the quality table and write table.md, table.csv and fig6.png."""
+    check_outputs([Output(args.output, "-o", FOLDER, (
+        ("table.md", PLAIN), ("table.csv", PLAIN), ("fig6.png", None),
+        ("settings.csv", PLAIN), ("verdicts.md", PLAIN)))], force=args.force)
     names = [n.strip() for item in (args.scenes or []) for n in item.split(",") if n.strip()]
     scenes = table.load_scenes(
         names or None,
@@ -111,6 +115,9 @@ def _choices(flag: str, text: str, valid: tuple[str, ...]) -> list[str]:
 
 def cmd_robustness(args: argparse.Namespace) -> int:
     """Run the robustness sweep and write robustness.csv, robustness.json, fig8.png."""
+    check_outputs([Output(args.output, "-o", FOLDER, (
+        ("robustness.csv", PLAIN), ("robustness.json", PLAIN), ("fig8.png", None)))],
+        force=args.force)
     size = scored_size(args.size)
     result = robustness.run_robustness(
         parse_floats(args.ks), size, _positive("--steps", args.steps), seed=args.seed,
@@ -155,6 +162,7 @@ def register(subparsers) -> None:
     p.add_argument("-o", "--output", default="out/table",
                    help="output folder (default %(default)s)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    add_force_argument(p)
     p.set_defaults(func=cmd_table)
 
     p = subparsers.add_parser(
@@ -176,4 +184,5 @@ def register(subparsers) -> None:
     p.add_argument("-o", "--output", default="out/robustness",
                    help="output folder (default %(default)s)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    add_force_argument(p)
     p.set_defaults(func=cmd_robustness)

@@ -10,6 +10,7 @@ import argparse
 from pathlib import Path
 
 from rvsm.model.errors import RvsmError
+from rvsm.model.outputs import FOLDER, Output, check_outputs
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,7 +33,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="local Dask worker processes (default: one per core; 0 = in this "
                    "process, no Dask)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="run on an existing Dask cluster, e.g. tcp://host:8786")
+                   help="run on an existing Dask cluster, e.g. tcp://host:8786 (its "
+                   "scheduler runs pickled tasks without authentication: use tls:// on any "
+                   "network you do not control; see docs/design-space.md)")
+    p.add_argument("--force", action="store_true",
+                   help="replace an existing output of another kind (never an input)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--tolerance", type=float, default=0.1,
                    help="report: PSNR cost bound in dB for the recommendation (default 0.1)")
@@ -66,6 +71,7 @@ def _run(args: argparse.Namespace, sweep_file: str) -> int:
         raise RvsmError(f"--workers must be >= 0, got {args.workers}")
     spec = load_sweep(sweep_file)
     db = Path(args.output) if args.output else Path(sweep_file).with_suffix(".sqlite")
+    check_outputs([Output(db, "-o", "SQLite database")], [sweep_file], args.force)
     print(f"sweep {sweep_file}: {len(spec.designs)} design point(s) x "
           f"{len(spec.run.scenes)} scene(s) x {len(spec.run.noise)} noise x "
           f"{len(spec.run.seeds)} seed(s) at {spec.run.size[0]}x{spec.run.size[1]}, "
@@ -87,6 +93,8 @@ def _report(args: argparse.Namespace) -> int:
 
     db = Path(args.path)
     out = Path(args.output) if args.output else db.with_name(db.stem + "-report")
+    check_outputs([Output(out, "-o", FOLDER, (("report.md", None), ("width-cost.png", None),
+                                              ("pareto.png", None)))], [db], args.force)
     files, rec = write_report(db, out, tolerance=args.tolerance)
     for f in files:
         print(f"wrote {f}")

@@ -5,9 +5,13 @@ the hardware cost (logic per lane of the streaming array) of each distinct RTL n
 ``lane_cost`` once, and runs the rest on a Dask cluster: a
 :class:`~dask.distributed.LocalCluster` of ``workers`` processes (default: one per core),
 ``scheduler=ADDRESS`` for an existing cluster, or ``workers=0`` in this process without
-Dask. Only this (coordinating) process writes the database, one committed row per finished
-future, so Ctrl-C keeps everything finished. The task functions :func:`evaluate_task` and
-:func:`synthesise_task` are top-level so distributed workers can import them.
+Dask. A local cluster listens on 127.0.0.1 only (:func:`local_cluster`);
+``scheduler`` trusts that cluster completely: Dask runs unauthenticated pickled tasks, so
+a remote scheduler must be on a trusted network or use ``tls://`` with certificates
+(``dask.distributed.Security``). Only this (coordinating) process writes the database,
+one committed row per finished future, so Ctrl-C keeps everything finished. The task
+functions :func:`evaluate_task` and :func:`synthesise_task` are top-level so distributed
+workers can import them.
 """
 
 from __future__ import annotations
@@ -234,9 +238,26 @@ def _call(finished, kind, item, fn, *args) -> None:
     finished(kind, item, value, None)
 
 
+#: Where a local cluster listens: the loopback interface only (its scheduler accepts
+#: pickled tasks without authentication, so it must never be reachable from the network).
+LOCAL_HOST = "127.0.0.1"
+
+
+def local_cluster(workers: int, processes: bool = True):
+    """A :class:`~dask.distributed.LocalCluster` of ``workers`` single-threaded workers
+    whose scheduler, workers, nannies and the scheduler's HTTP pages (workers, logs, call
+    stacks: Dask always serves them) listen on :data:`LOCAL_HOST` only, on random ports;
+    the workers' dashboards are off."""
+    from dask.distributed import LocalCluster
+
+    return LocalCluster(n_workers=workers, threads_per_worker=1, processes=processes,
+                        host=LOCAL_HOST, dashboard_address=f"{LOCAL_HOST}:0",
+                        worker_dashboard_address=None, silence_logs=logging.ERROR)
+
+
 def _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
           processes) -> None:
-    from dask.distributed import Client, LocalCluster, as_completed
+    from dask.distributed import Client, as_completed
 
     cluster = None
     if scheduler is not None:
@@ -249,8 +270,7 @@ def _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
         n = workers if workers is not None else (os.cpu_count() or 1)
         if n < 1:
             raise RvsmError(f"--workers must be >= 0, got {n}")
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=processes,
-                               dashboard_address=":0", silence_logs=logging.ERROR)
+        cluster = local_cluster(n, processes)
         client = Client(cluster)
         # numba threads per worker: the cores shared out, never oversubscribed.
         args = (*args, max(1, (os.cpu_count() or 1) // n))

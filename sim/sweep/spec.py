@@ -174,12 +174,10 @@ def task_id(
 
 def load_sweep(path: str | os.PathLike) -> SweepSpec:
     """Read and validate a sweep file; errors name the file and the field."""
+    from rvsm.model.text_files import read_utf8_text
+
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise RvsmError(f"cannot read sweep file {p}: {exc.strerror or exc}") from None
-    return parse_sweep(text, str(p), base_dir=p.parent)
+    return parse_sweep(read_utf8_text(p, "sweep file"), str(p), base_dir=p.parent)
 
 
 def parse_sweep(
