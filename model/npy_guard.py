@@ -29,7 +29,7 @@ def _header(handle: BinaryIO, source: str) -> tuple[tuple[int, ...], np.dtype, i
         else:
             shape, _, dtype = npformat.read_array_header_2_0(handle)
     except (ValueError, OSError, EOFError, SyntaxError) as exc:
-        raise RvsmError(f"{source}: not a readable .npy array header ({exc})") from None
+        raise RvsmError(f"{source}: cannot load .npy data, bad array header ({exc})") from None
     return tuple(int(v) for v in shape), np.dtype(dtype), handle.tell()
 
 

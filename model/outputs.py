@@ -3,10 +3,11 @@
 Every ``rvsm`` command that writes calls :func:`check_outputs` right after parsing, so a
 bad ``-o`` is refused in one line before minutes or hours of computation:
 
-- a file output needs an existing, writable parent folder (checked with ``os.access``
-  and a probe file, so a read-only file system is caught too) and must not be a folder;
-- a folder output is either an existing writable folder or one that can be created
-  (its nearest existing ancestor is a writable folder);
+- a file output must not be a folder, and its parent folder must be writable (checked
+  with ``os.access`` and a probe file, so a read-only file system is caught too) or, when
+  missing, creatable: its nearest existing ancestor is a writable folder (the writers
+  create missing folders, as :mod:`.atomic` does);
+- a folder output is likewise an existing writable folder or one that can be created;
 - no output may be one of the inputs (same resolved path or same inode), lie inside an
   input folder (an image-folder scene), or hold an input when it is a folder;
 - an existing file of a different kind (e.g. a ``.npy`` scene where a spike file would
@@ -149,7 +150,8 @@ def _probe(folder: Path, option: str, target: Path) -> None:
     if not folder.is_dir():
         raise RvsmError(f"{option} {target}: {folder} is not a folder")
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise os_error(OSError(errno.EACCES, os.strerror(errno.EACCES)), folder,
+        code = errno.EROFS if _read_only(folder) else errno.EACCES
+        raise os_error(OSError(code, os.strerror(code)), folder,
                        f"write into {option} {target}: folder")
     try:
         fd, tmp = tempfile.mkstemp(prefix=".rvsm-probe-", dir=folder)
@@ -157,6 +159,13 @@ def _probe(folder: Path, option: str, target: Path) -> None:
         raise os_error(exc, folder, f"write into {option} {target}: folder") from None
     os.close(fd)
     os.unlink(tmp)
+
+
+def _read_only(folder: Path) -> bool:
+    try:
+        return bool(os.statvfs(folder).f_flag & os.ST_RDONLY)
+    except (OSError, AttributeError):  # pragma: no cover - no statvfs
+        return False
 
 
 def _nearest_existing(path: Path) -> Path:
@@ -212,10 +221,14 @@ def _check_file(out: Output, inputs: Sequence[Path], force: bool) -> None:
     _check_not_input(target, out.option, inputs)
     _check_replace(target, out.option, kind, force)
     parent = target.parent if str(target.parent) else Path(".")
-    if not parent.exists():
-        raise RvsmError(f"{out.option} {target}: folder {parent} does not exist; create it "
-                        "first or choose another location")
-    _probe(parent, out.option, target)
+    if parent.exists():
+        _probe(parent, out.option, target)
+        return
+    base = _nearest_existing(parent)  # missing folders are created when writing
+    if not base.is_dir():
+        raise RvsmError(f"{out.option} {target}: cannot create folder {parent}, {base} is "
+                        "not a folder")
+    _probe(base, out.option, target)
 
 
 def _check_folder(out: Output, inputs: Sequence[Path], force: bool) -> None:

@@ -69,9 +69,9 @@ def _run(args: argparse.Namespace, sweep_file: str) -> int:
 
     if args.workers is not None and args.workers < 0:
         raise RvsmError(f"--workers must be >= 0, got {args.workers}")
-    spec = load_sweep(sweep_file)
     db = Path(args.output) if args.output else Path(sweep_file).with_suffix(".sqlite")
     check_outputs([Output(db, "-o", "SQLite database")], [sweep_file], args.force)
+    spec = load_sweep(sweep_file)
     print(f"sweep {sweep_file}: {len(spec.designs)} design point(s) x "
           f"{len(spec.run.scenes)} scene(s) x {len(spec.run.noise)} noise x "
           f"{len(spec.run.seeds)} seed(s) at {spec.run.size[0]}x{spec.run.size[1]}, "

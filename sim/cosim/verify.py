@@ -172,6 +172,9 @@ def replay(
     stim = load_stimulus(stimulus)
     c = stim.contract
     _check_size(c, lanes)
+    if steps is not None and steps > stim.num_steps:
+        raise RvsmError(f"--steps {steps}: {stimulus} holds {stim.num_steps} steps; ask for "
+                        f"at most {stim.num_steps}")
     if steps is not None and steps < stim.num_steps:
         stim = stim.first_steps(steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,

@@ -77,7 +77,7 @@ def test_npy_truncated(tmp_path) -> None:
     np.save(p, _stack(4, 16, 16))
     raw = p.read_bytes()
     p.write_bytes(raw[: len(raw) // 2])
-    with pytest.raises(RvsmError, match="cannot load .npy"):
+    with pytest.raises(RvsmError, match="truncated or corrupt"):
         load_scene(str(p))
     p.write_bytes(b"not an npy file at all")
     with pytest.raises(RvsmError, match="cannot load .npy"):
