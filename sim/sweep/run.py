@@ -245,14 +245,15 @@ LOCAL_HOST = "127.0.0.1"
 
 def local_cluster(workers: int, processes: bool = True):
     """A :class:`~dask.distributed.LocalCluster` of ``workers`` single-threaded workers
-    whose scheduler, workers, nannies and the scheduler's HTTP pages (workers, logs, call
-    stacks: Dask always serves them) listen on :data:`LOCAL_HOST` only, on random ports;
-    the workers' dashboards are off."""
+    whose scheduler, workers, nannies and HTTP pages (workers, logs, call stacks: Dask
+    always serves them, even without a dashboard) listen on :data:`LOCAL_HOST` only, on
+    random ports (threaded workers talk in-process)."""
     from dask.distributed import LocalCluster
 
+    where = {"host": LOCAL_HOST} if processes else {}  # threads talk in-process (inproc://)
     return LocalCluster(n_workers=workers, threads_per_worker=1, processes=processes,
-                        host=LOCAL_HOST, dashboard_address=f"{LOCAL_HOST}:0",
-                        worker_dashboard_address=None, silence_logs=logging.ERROR)
+                        **where, dashboard_address=f"{LOCAL_HOST}:0",
+                        worker_dashboard_address=f"{LOCAL_HOST}:0", silence_logs=logging.ERROR)
 
 
 def _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
