@@ -77,8 +77,8 @@ class RunSettings:
 
     @property
     def steps(self) -> int:
-        """Simulated steps: ``(frames - 1) * steps_per_frame`` (at least one)."""
-        return max(1, (self.frames - 1) * self.steps_per_frame)
+        """Simulated steps: ``(frames - 1) * steps_per_frame`` (``frames >= 2``)."""
+        return (self.frames - 1) * self.steps_per_frame
 
 
 @dataclass(frozen=True)
@@ -326,6 +326,9 @@ def _parse_run(raw: Any, source: str) -> RunSettings:
     except RvsmError as exc:
         raise RvsmError(f"{source}: run.size: {exc}") from None
     frames = _pos_int(raw.get("frames", 11), f"{source}: run.frames")
+    if frames < 2:
+        raise RvsmError(f"{source}: run.frames must be >= 2 (steps interpolate between "
+                        f"frames), got {frames}")
     spf = _pos_int(raw.get("steps_per_frame", 10), f"{source}: run.steps_per_frame")
     seeds = raw.get("seeds", [0])
     seeds = seeds if isinstance(seeds, list) else [seeds]
