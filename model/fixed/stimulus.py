@@ -94,8 +94,7 @@ def make_stimulus(
             raise RvsmError(f"number of steps must be an integer >= 1, got {num_steps!r}")
         if num_steps > scene.num_steps:
             raise RvsmError(f"--steps {num_steps} is more than the {scene.num_steps} steps of "
-                            f"scene {scene.name!r}; ask for at most {scene.num_steps} (or "
-                            "give more --frames)")
+                            f"scene {scene.name!r}; ask for at most {scene.num_steps}")
         if num_steps < scene.num_steps:
             scene = _first_steps(scene, int(num_steps))
     run = simulate_fixed(scene, point, progress=progress, keep_codes=True)

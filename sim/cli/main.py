@@ -122,16 +122,6 @@ def _fail(args: argparse.Namespace, exc: BaseException, message: str, status: in
         traceback.print_exception(exc)
     print(f"rvsm: error: {message}", file=sys.stderr)
     return status
-    except OSError as exc:  # a write the output check could not foresee (disk full...)
-        from rvsm.model.outputs import os_error
-
-        err = os_error(exc, exc.filename or "a file", "access")
-        print(f"rvsm: error: {err}", file=sys.stderr)
-        return 3 if isinstance(err, ToolError) else 2
-    except MemoryError:
-        print("rvsm: error: out of memory; use a smaller --size, fewer --frames or steps",
-              file=sys.stderr)
-        return 3
 
 
 if __name__ == "__main__":
