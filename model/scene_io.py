@@ -209,13 +209,8 @@ def load_scene(
         raise RvsmError(f"number of frames must be an integer >= 1, got {num_frames!r}")
     text = os.fspath(arg)
     if text in SCENE_NAMES:
-        from .memory import require_memory
         from .scene_library import DEFAULT_FRAMES, DEFAULT_SIZE
 
-        h, w = DEFAULT_SIZE if size is None else size
-        frames = DEFAULT_FRAMES if num_frames is None else int(num_frames)
-        require_memory(2 * 8 * frames * h * w, f"scene {text!r} with {frames} frames of {h}x{w}",
-                       "ask for fewer --frames or a smaller --size")
         return builtin_scene(
             text,
             DEFAULT_SIZE if size is None else size,

@@ -383,8 +383,13 @@ def render_frames(
 ) -> np.ndarray:
     """Render built-in scene ``name``: ``(num_frames, H, W) float64`` brightness in 8-bit
     units within [16, 240]. Deterministic and cached; the returned array is read-only."""
+    from .memory import require_memory
+
     _check_name(name)
     size, num_frames = _check_size(size, num_frames)
+    require_memory(2 * 8 * num_frames * size[0] * size[1],  # frames and a working copy
+                   f"scene {name!r} with {num_frames} frames of {size[0]}x{size[1]}",
+                   "ask for fewer --frames or a smaller --size")
     return _render_cached(name, size, num_frames)
 
 

@@ -340,3 +340,45 @@ def tmpfs(tmp_path):
     yield mount
     for point in mounted:
         subprocess.run(["umount", "-l", str(point)], check=False)
+
+
+def test_more_rendered_frames_than_memory_are_refused(capsys, tmp_path):
+    code, _, err = _run(capsys, "scenes", "--render", "coin", "--frames", "1000000000",
+                        "-o", tmp_path / "c.png")
+    assert code == 2 and "of memory" in _one_line(err)
+
+
+def test_npy_scene_header_is_checked_before_loading(tmp_path, capsys, monkeypatch):
+    from rvsm.model import memory
+
+    scene = tmp_path / "scene.npy"
+    np.save(scene, np.full((4, 16, 24), 100.0))
+    monkeypatch.setattr(memory, "available_bytes", lambda: 4096)
+    code, _, err = _run(capsys, "simulate", scene, "-o", tmp_path / "s.npz")
+    assert code == 2 and "shape (4, 16, 24)" in _one_line(err) and "of memory" in err
+
+
+def test_non_finite_analogue_values_are_never_cast(capsys):
+    from rvsm.model.errors import RvsmError
+    from rvsm.model.fixed.adc import adc_codes
+
+    with pytest.raises(RvsmError, match="NaN or infinite"):
+        adc_codes(np.array([[[1.0, np.nan]]]), 7, 255.0)
+    with pytest.raises(RvsmError, match="NaN or infinite"):
+        adc_codes(np.array([[[np.inf]]]), 7, 255.0)
+
+
+def test_a_sweep_of_one_frame_is_refused(tmp_path, capsys):
+    sweep = tmp_path / "s.toml"
+    sweep.write_text('[axes]\n"adc.bits" = [6]\n[run]\nscenes = ["coin"]\nframes = 1\n')
+    code, _, err = _run(capsys, "sweep", sweep, "--workers", "0")
+    assert code == 2 and "run.frames must be >= 2" in _one_line(err)
+
+
+@pytest.mark.parametrize("extra", [[], ["--fixed"]])
+def test_a_spike_array_beyond_memory_is_refused_before_sampling(extra, inputs, capsys,
+                                                                 tmp_path):
+    fixed = [*extra, inputs["point"]] if extra else []
+    code, _, err = _run(capsys, "simulate", "coin", "--size", "16x24", "--frames", "3",
+                        "--steps-per-frame", "1000000000000", *fixed, "-o", tmp_path / "s.npz")
+    assert code == 2 and "spikes needs" in _one_line(err) and "--steps-per-frame" in err
