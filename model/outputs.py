@@ -243,9 +243,13 @@ def _check_folder(out: Output, inputs: Sequence[Path], force: bool) -> None:
             raise RvsmError(f"{out.option} {folder} exists and is not a folder")
         _probe(folder, out.option, folder)
         for name, kind in out.files:
-            sub = Output(folder / name, out.option, kind)
-            _check_not_input(Path(sub.path), out.option, inputs)
-            _check_replace(Path(sub.path), out.option, kind or kind_for_suffix(name), force)
+            sub = folder / name
+            _check_not_input(sub, out.option, inputs)
+            if kind == FOLDER:
+                if sub.exists() and not sub.is_dir():
+                    raise RvsmError(f"{out.option} {folder}: {sub} exists and is not a folder")
+            else:
+                _check_replace(sub, out.option, kind or kind_for_suffix(name), force)
         return
     base = _nearest_existing(folder)
     if not base.is_dir():

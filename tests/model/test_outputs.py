@@ -131,3 +131,13 @@ def test_atomic_writer_maps_a_failed_rename(tmp_path, monkeypatch):
     with pytest.raises(ToolError, match="No space left"):
         write_text_atomic(tmp_path / "a.txt", "x")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_folder_outputs_may_hold_their_sub_folders(tmp_path):
+    out = tmp_path / "out"
+    (out / "rtl").mkdir(parents=True)
+    check_outputs([Output(out, "-o", FOLDER, (("rtl", FOLDER), ("m.md", PLAIN)))])
+    (out / "rtl").rmdir()
+    (out / "rtl").write_text("x")
+    with pytest.raises(RvsmError, match="rtl exists and is not a folder"):
+        check_outputs([Output(out, "-o", FOLDER, (("rtl", FOLDER),))])

@@ -382,3 +382,12 @@ def test_a_spike_array_beyond_memory_is_refused_before_sampling(extra, inputs, c
     code, _, err = _run(capsys, "simulate", "coin", "--size", "16x24", "--frames", "3",
                         "--steps-per-frame", "1000000000000", *fixed, "-o", tmp_path / "s.npz")
     assert code == 2 and "spikes needs" in _one_line(err) and "--steps-per-frame" in err
+
+
+def test_rerunning_into_the_same_outputs_needs_no_force(tmp_path, capsys):
+    out = tmp_path / "demo"
+    argv = ["demo", "--size", "16x24", "--frames", "3", "--sim", "none", "-o", out]
+    assert _run(capsys, *argv)[0] == 0
+    (out / "rtl").mkdir()  # what --sim icarus|verilator leaves
+    assert _run(capsys, *argv)[0] == 0
+    _no_partials(out)
