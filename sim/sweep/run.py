@@ -19,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import logging
 import os
+import sqlite3
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -29,7 +30,7 @@ from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.design_point import DesignPoint
 
 from .spec import HardwareSettings, SweepSpec, SweepTask
-from .store import SweepStore
+from .store import SweepStore, database_error
 
 
 @dataclass
@@ -133,6 +134,14 @@ def run_sweep(
     ``on_result(summary)`` is called after each stored row or synthesis (tests use it to
     interrupt). ``processes=False`` runs a local cluster's workers as threads.
     """
+    try:
+        return _run_sweep(spec, db_path, workers, scheduler, progress, on_result, processes)
+    except sqlite3.Error as exc:  # a full disk or a lost database while writing rows
+        raise database_error(exc, db_path) from None
+
+
+def _run_sweep(spec, db_path, workers, scheduler, progress, on_result, processes
+               ) -> SweepSummary:
     t0 = time.perf_counter()
     summary = SweepSummary()
     tasks = spec.tasks()

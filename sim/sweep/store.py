@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from rvsm.model.errors import RvsmError
+from rvsm.model.errors import RvsmError, ToolError
 
 from .spec import SweepSpec, SweepTask
 
@@ -70,6 +70,21 @@ def _now() -> str:
     return time.strftime("%Y-%m-%dT%H:%M:%S")
 
 
+def database_error(exc: sqlite3.Error, path: str | os.PathLike) -> RvsmError:
+    """The one-line error for an SQLite failure on ``path``: a full disk or an I/O error
+    is a :class:`ToolError` (exit 3); a read-only, unopenable or foreign file an
+    :class:`RvsmError` (exit 2)."""
+    code = getattr(exc, "sqlite_errorcode", 0) & 0xFF  # primary result code
+    if code in (sqlite3.SQLITE_FULL, sqlite3.SQLITE_IOERR):
+        why = "disk full" if code == sqlite3.SQLITE_FULL else f"{exc}; disk full?"
+        return ToolError(f"{path}: the sweep database cannot be written ({why}); free "
+                         "space or choose another -o; finished rows are kept")
+    if code in (sqlite3.SQLITE_READONLY, sqlite3.SQLITE_CANTOPEN, sqlite3.SQLITE_PERM):
+        return RvsmError(f"{path}: cannot write the sweep database ({exc}); choose a "
+                         "writable -o")
+    return RvsmError(f"{path}: not a usable sweep database: {exc}")
+
+
 class SweepStore:
     """An open results database (``path``; created with its schema if missing)."""
 
@@ -85,7 +100,7 @@ class SweepStore:
                             (str(SCHEMA_VERSION),))
             self.db.commit()
         except sqlite3.DatabaseError as exc:
-            raise RvsmError(f"{self.path}: not a usable sweep database: {exc}") from None
+            raise database_error(exc, self.path) from None
 
     def close(self) -> None:
         """Close the connection."""

@@ -200,6 +200,34 @@ def test_an_unforeseen_os_error_is_one_line(tmp_path, capsys, monkeypatch):
     assert code == 3 and "Input/output error" in _one_line(err)
 
 
+def test_sweep_database_on_a_full_disk_exits_3(tmpfs, tmp_path, capsys):
+    mount = tmpfs(size="40k")
+    sweep = tmp_path / "s.toml"
+    sweep.write_text('[axes]\n"adc.bits" = [5, 6, 7, 8]\n"weights.frac_bits" = [6, 7, 8, 9]\n'
+                     '[run]\nscenes = ["coin"]\nsize = "8x8"\nframes = 2\n'
+                     'steps_per_frame = 2\n[hardware]\nenabled = false\n')
+    code, _, err = _run(capsys, "sweep", sweep, "-o", mount / "r.sqlite", "--workers", "0",
+                        "--no-progress")
+    assert code == 3 and "the sweep database cannot be written" in _one_line(err)
+
+
+def test_sqlite_errors_map_to_statuses(tmp_path):
+    import sqlite3
+
+    from rvsm.model.errors import ToolError
+    from rvsm.sim.sweep.store import database_error
+
+    def err(code):
+        exc = sqlite3.OperationalError("x")
+        exc.sqlite_errorcode = code
+        return database_error(exc, tmp_path / "r.sqlite")
+
+    assert type(err(sqlite3.SQLITE_FULL)) is ToolError
+    assert type(err(sqlite3.SQLITE_IOERR_WRITE)) is ToolError
+    assert type(err(sqlite3.SQLITE_READONLY)) is not ToolError
+    assert "not a usable sweep database" in str(err(sqlite3.SQLITE_NOTADB))
+
+
 # -- no silent adjustment -------------------------------------------------------------------
 
 def test_steps_per_frame_zero_is_refused(capsys):
