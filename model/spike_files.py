@@ -20,6 +20,7 @@ import numpy as np
 
 from .atomic import atomic_path
 from .errors import RvsmError
+from .memory import require_memory
 from .npy_guard import check_npz_members
 from .versions import with_versions
 
@@ -118,6 +119,8 @@ def import_dat(
             f".dat size {height}x{width} invalid: H*W must be positive and divisible by 8"
         )
     step_bytes = height * width // 8
+    require_memory(9 * path.stat().st_size, f"{path} (one int8 per pixel)",
+                   "split the .dat file into shorter recordings")
     raw = np.fromfile(path, dtype=np.uint8)
     if raw.size == 0 or raw.size % step_bytes:
         raise RvsmError(
