@@ -22,8 +22,8 @@ else:  # pragma: no cover
 
 from ..atomic import write_text_atomic
 from ..errors import RvsmError
-from ..thresholds import DEFAULT_CALIBRATION_SCENE
 from ..text_files import read_utf8_text
+from ..thresholds import DEFAULT_CALIBRATION_SCENE
 from .design_point import FIELDS, DesignPoint
 
 __all__ = [

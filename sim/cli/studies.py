@@ -116,7 +116,8 @@ def _choices(flag: str, text: str, valid: tuple[str, ...]) -> list[str]:
 def cmd_robustness(args: argparse.Namespace) -> int:
     """Run the robustness sweep and write robustness.csv, robustness.json, fig8.png."""
     check_outputs([Output(args.output, "-o", FOLDER, (
-        ("robustness.csv", PLAIN), ("robustness.json", PLAIN), ("fig8.png", None)))],
+        ("robustness.csv", PLAIN), ("robustness.json", PLAIN), ("fig8.png", None),
+        ("verdict.md", PLAIN)))],
         force=args.force)
     size = scored_size(args.size)
     result = robustness.run_robustness(
