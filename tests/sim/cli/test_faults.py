@@ -419,3 +419,17 @@ def test_rerunning_into_the_same_outputs_needs_no_force(tmp_path, capsys):
     (out / "rtl").mkdir()  # what --sim icarus|verilator leaves
     assert _run(capsys, *argv)[0] == 0
     _no_partials(out)
+
+
+def test_a_full_resolution_stream_array_reaches_the_output_check(tmp_path, capsys,
+                                                                 monkeypatch):
+    point = tmp_path / "p.toml"
+    assert _run(capsys, "config", "new", "-o", point)[0] == 0  # 250x400: fine when streamed
+    monkeypatch.setattr(outputs.os, "access", lambda *a, **k: False)
+    monkeypatch.setattr("rvsm.rtl.stream_verilog.write_stream_outputs", WORK_REFUSED)
+    code, _, err = _run(capsys, "verilog", point, "--arch", "stream", "-o", tmp_path / "rtl")
+    assert code == 2 and "choose a writable location" in _one_line(err)
+
+
+def WORK_REFUSED(*a, **k):  # noqa: N802 - a sentinel
+    raise AssertionError("the work started before the output was checked")
