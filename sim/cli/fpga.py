@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from rvsm.model.errors import RvsmError
+from rvsm.model.outputs import FOLDER, Output, check_outputs
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -63,6 +64,7 @@ def _fpga(args: argparse.Namespace) -> int:
         raise RvsmError(f"--lanes must be >= 1, got {args.lanes}")
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be > 0 seconds, got {args.timeout}")
+    check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
     point = load_design_point(args.point)
     h, w = args.size or (point.height, point.width)
     if args.arch == "parallel" and h * w > 64:

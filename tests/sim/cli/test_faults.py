@@ -86,6 +86,7 @@ def _writers(i: dict, out: Path) -> dict[str, list]:
         "sweep": ["sweep", i["sweep"], "-o", out / "r.sqlite"],
         "sweep report": ["sweep", "report", i["db"], "-o", out / "rep"],
         "demo": ["demo", "-o", out / "demo"],
+        "fpga": ["fpga", i["point"], "-o", out / "fpga"],
     }
 
 
@@ -101,6 +102,7 @@ WORK = [
     "rvsm.sim.studies.table.run_table", "rvsm.sim.studies.robustness.run_robustness",
     "rvsm.sim.sweep.run.run_sweep", "rvsm.sim.sweep.report.write_report",
     "rvsm.sim.cli.demo.run_float_demo", "rvsm.model.fixed.point_toml.save_design_point",
+    "rvsm.rtl.fpga.flow.run_fpga",
 ]
 
 
