@@ -181,6 +181,10 @@ def run_simulate(args: argparse.Namespace) -> int:
         run_fn = lambda sink: stream_float(  # noqa: E731
             scene, config, sink, chunk_steps=args.chunk_steps, engine=args.engine,
             progress=True)
+    if collect is not None:  # .npz collects every spike in memory: refuse what cannot fit
+        from rvsm.model.memory import require_spike_memory
+
+        require_spike_memory(scene, point.num_scales if args.fixed else config.spec.num_scales)
     run_fn(TeeSink(counts, main_sink, dat_sink))
     if collect is not None:
         save_spikes(args.output, collect.spikes, collect.meta)

@@ -95,8 +95,9 @@ WRITERS = list(_writers({k: Path("x") for k in ("point", "spikes", "dat", "sweep
 
 #: The functions doing each command's work: none may run when the output is refused.
 WORK = [
-    "rvsm.sim.cli.sampling.sample", "rvsm.model.fixed.twin.simulate_fixed",
-    "rvsm.sim.cli.sampling.export_dat", "rvsm.sim.cli.sampling.import_dat",
+    "rvsm.sim.cli.sampling.stream_float", "rvsm.model.fixed.fused.stream_fixed",
+    "rvsm.model.fixed.twin.simulate_fixed", "rvsm.sim.cli.sampling.open_spikes",
+    "rvsm.sim.cli.sampling.dat_source",
     "rvsm.sim.cli.scenes.render_frames", "rvsm.model.fixed.stimulus.make_stimulus",
     "rvsm.rtl.verilog.write_outputs", "rvsm.sim.cosim.verify.verify",
     "rvsm.sim.studies.table.run_table", "rvsm.sim.studies.robustness.run_robustness",
@@ -147,6 +148,9 @@ def test_simulate_never_overwrites_its_scene(tmp_path, inputs, capsys, no_work):
     scene = inputs["scene"]
     before = scene.read_bytes()
     code, _, err = _run(capsys, "simulate", scene, "--frames", "3", "-o", scene, "--force")
+    assert code == 2 and _one_line(err)  # refused (as an input, or for its suffix)
+    code, _, err = _run(capsys, "stimulus", scene, "--fixed", inputs["point"], "-o", scene,
+                        "--force")
     assert code == 2 and "also an input" in _one_line(err)
     code, _, err = _run(capsys, "stimulus", scene, "--fixed", inputs["point"], "-o",
                         inputs["point"])
@@ -197,7 +201,7 @@ def test_an_unforeseen_os_error_is_one_line(tmp_path, capsys, monkeypatch):
     def broken(*a, **k):
         raise OSError(errno.EIO, os.strerror(errno.EIO), "somefile")
 
-    monkeypatch.setattr("rvsm.sim.cli.sampling.load_spikes", broken)
+    monkeypatch.setattr("rvsm.sim.cli.sampling.open_spikes", broken)
     code, _, err = _run(capsys, "evaluate", tmp_path / "x.npz")
     assert code == 3 and "Input/output error" in _one_line(err)
 
