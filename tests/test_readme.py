@@ -46,7 +46,8 @@ def table_commands() -> list[str]:
         cmd = re.sub(r"(\S+)\|\S+", r"\1", cmd)  # a|b -> a
         cmd = cmd.replace("[", "").replace("]", "").split(">")[0]
         cmd = (cmd.replace("SCENE", "coin").replace("RESULTS.sqlite", "r.sqlite")
-               .replace(" M ", " 10 ").replace("--render NAME", "--render coin"))
+               .replace(" M ", " 10 ").replace(" SEED ", " 1 ")
+               .replace("--render NAME", "--render coin"))
         out.append(cmd.strip())
     return out
 
