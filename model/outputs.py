@@ -131,15 +131,16 @@ def _compatible(existing: str, writing: str) -> bool:
 
 def os_error(exc: OSError, target: str | os.PathLike, what: str = "write") -> RvsmError:
     """The user-facing error for an ``OSError`` met writing ``target``: a full disk or an
-    I/O error is a :class:`ToolError` (exit 3); a read-only, forbidden or missing
-    location an :class:`RvsmError` (exit 2) saying what to fix."""
+    I/O error, a read-only or forbidden location is a :class:`ToolError` (exit 3: the
+    environment cannot take the output); a missing or malformed path an
+    :class:`RvsmError` (exit 2) saying what to fix."""
     code = exc.errno
     reason = os.strerror(code) if code else str(exc)
     if code in (errno.ENOSPC, errno.EDQUOT):
         return ToolError(f"cannot {what} {target}: {reason} (disk full); free space or "
                          "choose another location; no partial file was left")
     if code in (errno.EROFS, errno.EACCES, errno.EPERM):
-        return RvsmError(f"cannot {what} {target}: {reason}; choose a writable location")
+        return ToolError(f"cannot {what} {target}: {reason}; choose a writable location")
     if code in (errno.ENOENT, errno.ENOTDIR, errno.EISDIR, errno.ENAMETOOLONG):
         return RvsmError(f"cannot {what} {target}: {reason}; check the path")
     return ToolError(f"cannot {what} {target}: {reason}")
