@@ -248,11 +248,13 @@ def test_testbench_crash_is_a_tool_error(tmp_path: Path, small_contract,
         run_testbench(sb, stim, tmp_path / "run", test_module="crashing_tb")
 
 
-def test_unwritable_work_folder_is_exit_3(tmp_path: Path) -> None:
+def test_work_folder_under_a_file_is_refused_before_the_build(tmp_path: Path) -> None:
+    """An impossible path is bad usage (2), found before any build (docs/cli.md); an
+    unwritable folder is exit 3 (tests/sim/cli/test_faults.py)."""
     (tmp_path / "file").write_text("")  # a file where a folder should be (even for root)
     r = _rvsm(*_verify_args(_point(tmp_path / "p.toml"), tmp_path / "file" / "w"))
-    assert r.returncode == 3
-    assert "Not a directory" in _one_line(r.stderr)
+    assert r.returncode == 2
+    assert "is not a folder" in _one_line(r.stderr)
 
 
 def test_disk_full_is_exit_3(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
