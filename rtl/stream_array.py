@@ -360,13 +360,19 @@ class RvsmStreamArray(wiring.Component):
 
     def _banked(self, m: Module, name: str, width: int, advance: Value,
                 read_addr: Value, read_bank: Value,
-                writes: Sequence[tuple[Value, Value, Value]]) -> Value:
+                writes: Sequence[tuple[Value, Value, Value]],
+                forward: tuple[Value, Value] | None = None) -> Value:
         """A banked memory of ``width``-bit words; returns the registered read data.
 
         The read address is sampled at an ``advance`` edge; the data is registered per
         bank at the next ``advance`` edge and multiplexed by ``read_bank`` (which must be
         the bank of that address, delayed alike). ``writes`` is one ``(en, addr, data)``
-        port description per write port.
+        port description per write port. A bank's read is disabled at an edge where a
+        write port writes its address: the read data is then undefined (yosys needs no
+        read-first bypass multiplexer after the block RAM), so either such collisions
+        never meet a valid read, or ``forward = (hit, data)`` (sampled with the read
+        address) replaces the read data by ``data`` where ``hit`` was set, after the
+        bank registers.
         """
         sizes = self.geometry.bank_sizes
         banked = len(sizes) > 1
@@ -381,8 +387,11 @@ class RvsmStreamArray(wiring.Component):
                 m.d.comb += [wp.addr.eq(addr[:offset_bits] if banked else addr),
                              wp.data.eq(wdata), wp.en.eq(en & hit)]
             rp = mem.read_port()
-            m.d.comb += [rp.addr.eq(read_addr[:offset_bits] if banked else read_addr),
-                         rp.en.eq(advance)]
+            m.d.comb += rp.addr.eq(read_addr[:offset_bits] if banked else read_addr)
+            collide = Const(0)
+            for wp in mem.write_ports:
+                collide = collide | (wp.en & (wp.addr == rp.addr))
+            m.d.comb += rp.en.eq(advance & ~collide)
             reg = Signal(unsigned(width), name=f"{name}_b{b}_q", reset_less=True)
             with m.If(advance):
                 m.d.sync += reg.eq(rp.data)
@@ -390,6 +399,15 @@ class RvsmStreamArray(wiring.Component):
         out = outs[-1]
         for b in range(len(outs) - 2, -1, -1):
             out = Mux(read_bank == b, outs[b], out)
+        if forward is not None:
+            hit, data = forward
+            hit1 = Signal(name=f"{name}_fwd1", reset_less=True)
+            hit2 = Signal(name=f"{name}_fwd2", reset_less=True)
+            data1 = Signal(unsigned(width), name=f"{name}_fwd1_data", reset_less=True)
+            data2 = Signal(unsigned(width), name=f"{name}_fwd2_data", reset_less=True)
+            with m.If(advance):
+                m.d.sync += [hit1.eq(hit), data1.eq(data), hit2.eq(hit1), data2.eq(data1)]
+            out = Mux(hit2, data2, out)
         return out
 
     def elaborate(self, platform: object) -> Module:
@@ -529,17 +547,25 @@ class RvsmStreamArray(wiring.Component):
         # -- state memories and the tail: add, compare/saturate, fire/reset ---------------
         lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
         tw = c.threshold_bits
+        # Threshold writes land one edge after the bus accepts them (a registered bus),
+        # so a read at the bus' edge does not see them; a read meeting the registered
+        # write at the next edge gets its data forwarded after the bank registers.
         bus = self.thr
         word_bits = threshold_word_bits(words)
-        bus_word = bus.addr[:word_bits]
-        bus_scale = bus.addr[word_bits:]
+        bus_we = Signal(name="thr_we_r", reset_less=True)
+        bus_addr = Signal.like(bus.addr, name="thr_addr_r", reset_less=True)
+        bus_data = Signal.like(bus.data, name="thr_data_r", reset_less=True)
+        m.d.sync += [bus_we.eq(bus.we), bus_addr.eq(bus.addr), bus_data.eq(bus.data)]
+        bus_word = bus_addr[:word_bits]
+        bus_scale = bus_addr[word_bits:]
         tail_stmts = []
         pos_bits, neg_bits = [], []
         for s in range(c.num_scales):
             after_lanes = []
             thr_q = self._banked(
                 m, f"thr_s{s}", p * tw, advance, rd_addr, bank_q,
-                [(bus.we & (bus_scale == s), bus_word, bus.data)])
+                [(bus_we & (bus_scale == s), bus_word, bus_data)],
+                forward=(bus_we & (bus_scale == s) & (bus_word == rd_addr), bus_data))
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
             acc_q = self._banked(m, f"acc_s{s}", p * wa, advance, rd_addr, bank_q,
                                  [(wr_en, wr_addr, after_flat)])
