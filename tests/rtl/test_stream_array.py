@@ -17,8 +17,13 @@ from rvsm.model.fixed.core import (
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.weights import quantise_model
 from rvsm.model.kernels import MODEL_NAMES
-from rvsm.rtl.stream_array import StreamGeometry, simulate
-from rvsm.rtl.stream_schedule import check_beats
+from rvsm.rtl.stream_array import (
+    RvsmStreamArray,
+    StreamGeometry,
+    simulate,
+    threshold_word_bits,
+)
+from rvsm.rtl.stream_schedule import OutputBeats, check_beats, pack_lanes
 
 
 def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int = 12,
@@ -117,6 +122,107 @@ def test_threshold_write_at_frame_boundary() -> None:
     want = np.stack(want)
     assert not np.array_equal(want, c.run(codes, thr))  # the change is visible
     assert_exact(c, 3, codes, thr, want, threshold_updates={2: thr2})
+
+
+def stream_with_threshold_writes(c: ArrayContract, lanes: int, codes: np.ndarray,
+                                 thr: np.ndarray, writes: dict[int, tuple[int, int, int]],
+                                 bank_words: int) -> OutputBeats:
+    """Load ``thr``, stream ``codes`` back to back (then ``lag`` flush beats) and, at the
+    edge accepting beat ``k``, write ``writes[k] = (s, addr, word)`` on ``thr``."""
+    from amaranth.sim import Simulator
+
+    dut = RvsmStreamArray(c, lanes, bank_words)
+    sched = dut.schedule
+    word_bits = threshold_word_bits(sched.beats_per_frame)
+    layout = dut.geometry.spike_layout
+    fields = ("row", "group", "last", "pos", "neg")
+    got: dict[str, list[int]] = {k: [] for k in (*fields, "accepted")}
+    words = pack_lanes(sched.threshold_words(thr).reshape(-1, lanes), c.threshold_bits)
+    beats = pack_lanes(sched.input_beats(codes), c.adc_bits)  # with the flush beats
+
+    async def bench(ctx) -> None:  # noqa: ANN001
+        for i, word in enumerate(words):
+            ctx.set(dut.thr.we, 1)
+            ctx.set(dut.thr.addr, (i // sched.beats_per_frame << word_bits)
+                    | i % sched.beats_per_frame)
+            ctx.set(dut.thr.data, word)
+            await ctx.tick()
+        previous = -1
+        for k, beat in enumerate([*beats, None, None]):
+            ctx.set(dut.codes.valid, beat is not None)
+            ctx.set(dut.codes.payload.as_value(), beat or 0)
+            s, a, w = writes.get(k, (0, 0, 0))
+            ctx.set(dut.thr.we, k in writes)
+            ctx.set(dut.thr.addr, (s << word_bits) | a)
+            ctx.set(dut.thr.data, w)
+            await ctx.tick()
+            if ctx.get(dut.spikes.valid):
+                word = ctx.get(dut.spikes.payload.as_value())
+                for name in fields:
+                    off, width = layout[name].offset, layout[name].width
+                    got[name].append((word >> off) & ((1 << width) - 1))
+                got["accepted"].append(previous)
+            previous = k if beat is not None else -1
+
+    sim = Simulator(dut)
+    sim.add_clock(1e-6)
+    sim.add_testbench(bench)
+    sim.run()
+    return OutputBeats.from_words(*(got[k] for k in fields), c.num_scales, lanes,
+                                  got["accepted"])
+
+
+@pytest.mark.parametrize(("lanes", "bank_words"), [(1, 8), (2, 1024), (3, 4)])
+def test_threshold_writes_colliding_with_reads(lanes: int, bank_words: int) -> None:
+    """Threshold writes while the stream runs, many at the very edge that reads the same
+    word (not seen by that read) or one edge earlier (seen): the RTL gates such a
+    block-RAM read and forwards the registered write after the bank registers."""
+    c = model_contract("dog2", 5, 6, reset="subtract")
+    steps = 4
+    codes, thr = random_run(c, steps, seed=43, thr_hi=400)
+    sched = StreamGeometry(c, lanes, bank_words).schedule
+    hg, lag = sched.beats_per_frame, sched.threshold_lag
+    rng = np.random.default_rng(47)
+    state = sched.threshold_words(thr).copy()  # (S, H*G, P), as the reads see it
+    seen_late = state.copy()  # the same if a write were seen at its own edge
+    frames, frames_late = [], []
+    writes: dict[int, tuple[int, int, int]] = {}
+    collisions = 0
+    # back to back, position p reads at the edge accepting beat p + threshold_lag + 1
+    for p in range(steps * hg):
+        k = p + lag + 1
+        s, lanes_thr = int(rng.integers(c.num_scales)), rng.integers(1, 400, lanes)
+        kind = rng.integers(4)  # 0: p's own word, 1: p+1's word, 2: any word, 3: none
+        a = [p % hg, (p + 1) % hg, int(rng.integers(hg)), None][kind]
+        if a is not None:
+            writes[k] = (s, a, pack_lanes(lanes_thr[None], c.threshold_bits)[0])
+            collisions += kind == 0
+        if p % hg == 0:
+            frames.append(np.empty_like(state))
+            frames_late.append(np.empty_like(state))
+        frames[-1][:, p % hg] = state[:, p % hg]
+        if a is not None:
+            seen_late[s, a] = lanes_thr
+        frames_late[-1][:, p % hg] = seen_late[:, p % hg]
+        if a is not None:
+            state[s, a] = lanes_thr
+    assert collisions > 10
+
+    def run(per_frame: list[np.ndarray]) -> np.ndarray:
+        integ = FixedIntegrator(thr, c.accumulator_bits, c.signed, c.reset)
+        sums = arithmetic_shift(integer_receptive_sums(codes, c.weight_arrays), c.shift)
+        out = []
+        for t in range(steps):
+            integ.thr = per_frame[t].reshape(thr.shape)
+            out.append(integ.step(sums[t]))
+        return np.stack(out)
+
+    want = run(frames)
+    assert not np.array_equal(want, run(frames_late))  # the same-edge rule is visible
+    got = stream_with_threshold_writes(c, lanes, codes, thr, writes, bank_words)
+    result = check_beats(sched, want, got)
+    assert result["mismatches"] == 0, result["first_mismatch"]
+    assert result["compared"] == want.size
 
 
 def test_banked_state_memories() -> None:
