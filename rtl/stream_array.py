@@ -370,9 +370,10 @@ class RvsmStreamArray(wiring.Component):
         port description per write port. A bank's read is disabled at an edge where a
         write port writes its address: the read data is then undefined (yosys needs no
         read-first bypass multiplexer after the block RAM), so either such collisions
-        never meet a valid read, or ``forward = (hit, data)`` (sampled with the read
-        address) replaces the read data by ``data`` where ``hit`` was set, after the
-        bank registers.
+        never meet a valid read, or ``forward = (hit, data)`` replaces the read data by
+        ``data`` after the bank registers where ``hit`` was set (``hit`` is sampled with
+        the read address; ``data`` must be the forwarded word delayed alike, two
+        ``advance`` edges).
         """
         sizes = self.geometry.bank_sizes
         banked = len(sizes) > 1
@@ -403,11 +404,9 @@ class RvsmStreamArray(wiring.Component):
             hit, data = forward
             hit1 = Signal(name=f"{name}_fwd1", reset_less=True)
             hit2 = Signal(name=f"{name}_fwd2", reset_less=True)
-            data1 = Signal(unsigned(width), name=f"{name}_fwd1_data", reset_less=True)
-            data2 = Signal(unsigned(width), name=f"{name}_fwd2_data", reset_less=True)
             with m.If(advance):
-                m.d.sync += [hit1.eq(hit), data1.eq(data), hit2.eq(hit1), data2.eq(data1)]
-            out = Mux(hit2, data2, out)
+                m.d.sync += [hit1.eq(hit), hit2.eq(hit1)]
+            out = Mux(hit2, data, out)
         return out
 
     def elaborate(self, platform: object) -> Module:
@@ -558,6 +557,10 @@ class RvsmStreamArray(wiring.Component):
         m.d.sync += [bus_we.eq(bus.we), bus_addr.eq(bus.addr), bus_data.eq(bus.data)]
         bus_word = bus_addr[:word_bits]
         bus_scale = bus_addr[word_bits:]
+        fwd_data = [Signal.like(bus.data, name=f"thr_fwd{k}_data", reset_less=True)
+                    for k in (1, 2)]  # shared by the scales
+        with m.If(advance):
+            m.d.sync += [fwd_data[0].eq(bus_data), fwd_data[1].eq(fwd_data[0])]
         tail_stmts = []
         pos_bits, neg_bits = [], []
         for s in range(c.num_scales):
@@ -565,7 +568,7 @@ class RvsmStreamArray(wiring.Component):
             thr_q = self._banked(
                 m, f"thr_s{s}", p * tw, advance, rd_addr, bank_q,
                 [(bus_we & (bus_scale == s), bus_word, bus_data)],
-                forward=(bus_we & (bus_scale == s) & (bus_word == rd_addr), bus_data))
+                forward=(bus_we & (bus_scale == s) & (bus_word == rd_addr), fwd_data[1]))
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
             acc_q = self._banked(m, f"acc_s{s}", p * wa, advance, rd_addr, bank_q,
                                  [(wr_en, wr_addr, after_flat)])
