@@ -27,7 +27,10 @@ split into banks of at most :attr:`StreamGeometry.bank_words` words (a power of 
 1024 by default) whose read data is registered before the bank multiplexer (ECP5
 block-RAM timing). Each address is read and written once per frame,
 :attr:`StreamGeometry.rmw_depth` beats apart, so the
-read-modify-write needs no forwarding as long as ``H*G > rmw_depth`` (checked).
+read-modify-write needs no forwarding as long as ``H*G > rmw_depth`` (checked). A bank's
+read is disabled when its write port writes the same address at that edge (no read-first
+bypass multiplexer after the block RAM); threshold writes are registered and forwarded
+after the bank registers to a read meeting them, so the rule below holds.
 
 **Streams.** ``codes`` (:func:`code_beat_signature`): ``payload`` lane ``i`` = pixel
 ``(y, g*P + i)``; a beat is accepted at a rising edge with ``valid & ready``; ``ready``
