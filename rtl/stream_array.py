@@ -475,7 +475,11 @@ class RvsmStreamArray(wiring.Component):
         ac = Signal(range(words), name="centre_addr")
         fresh0 = Signal(init=1, name="fresh_s0")
         last0 = ac == words - 1
-        step = advance & primed & valid0
+        # valid0 is set only at an advance edge where primed holds, and primed stays set
+        # until a clear (which drops valid0 too): valid0 implies primed. So the position
+        # steps on valid0 alone, which keeps the prime counter out of the next-position
+        # logic (a critical path at 64x64, P = 8).
+        step = advance & valid0
         g_end = gc == g_count - 1
         ny, ng, na = Signal.like(yc), Signal.like(gc), Signal.like(ac)
         with m.If(clear):
