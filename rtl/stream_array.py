@@ -215,6 +215,20 @@ class StreamGeometry:
         return self.TAIL_STAGES + 1
 
     @property
+    def rmw_guard_bits(self) -> int:
+        """Low address bits that tell an accumulator read from the write at its edge.
+
+        The read of position ``p`` meets the write-back of ``p - rmw_depth``, so the
+        addresses differ by ``rmw_depth`` or ``rmw_depth - beats_per_frame``: the
+        smallest ``k`` for which ``2**k`` divides neither (all address bits at most).
+        """
+        def twos(v: int) -> int:
+            return (v & -v).bit_length() - 1
+
+        d, n = self.rmw_depth, self.beats_per_frame
+        return min(1 + max(twos(d), twos(n - d)), max(1, (n - 1).bit_length()))
+
+    @property
     def threshold_lag(self) -> int:
         """Position ``p`` reads its thresholds at the edge after the one accepting input
         beat ``p + threshold_lag``."""
@@ -364,7 +378,8 @@ class RvsmStreamArray(wiring.Component):
     def _banked(self, m: Module, name: str, width: int, advance: Value,
                 read_addr: Value, read_bank: Value,
                 writes: Sequence[tuple[Value, Value, Value]],
-                forward: tuple[Value, Value] | None = None) -> Value:
+                forward: tuple[Value, Value] | None = None,
+                guard: tuple[Value, int] | None = None) -> Value:
         """A banked memory of ``width``-bit words; returns the registered read data.
 
         The read address is sampled at an ``advance`` edge; the data is registered per
@@ -376,7 +391,10 @@ class RvsmStreamArray(wiring.Component):
         never meet a valid read, or ``forward = (hit, data)`` replaces the read data by
         ``data`` after the bank registers where ``hit`` was set (``hit`` is sampled with
         the read address; ``data`` must be the forwarded word delayed alike, two
-        ``advance`` edges).
+        ``advance`` edges). ``guard = (may_write, k)`` (one write port whose enable is
+        ``advance & may_write``) gates the read where ``may_write`` holds and the low
+        ``k`` address bits match: a cheaper superset of the collisions, for a memory
+        whose valid reads and writes never match in those bits.
         """
         sizes = self.geometry.bank_sizes
         banked = len(sizes) > 1
@@ -393,8 +411,13 @@ class RvsmStreamArray(wiring.Component):
             rp = mem.read_port()
             m.d.comb += rp.addr.eq(read_addr[:offset_bits] if banked else read_addr)
             collide = Const(0)
-            for wp in mem.write_ports:
-                collide = collide | (wp.en & (wp.addr == rp.addr))
+            for (_, addr, _), wp in zip(writes, mem.write_ports, strict=True):
+                if guard is None:
+                    collide = collide | (wp.en & (wp.addr == rp.addr))
+                else:
+                    hit = (addr >> offset_bits) == b if banked else Const(1)
+                    k = min(guard[1], len(rp.addr))
+                    collide = collide | (guard[0] & hit & (wp.addr[:k] == rp.addr[:k]))
             m.d.comb += rp.en.eq(advance & ~collide)
             reg = Signal(unsigned(width), name=f"{name}_b{b}_q", reset_less=True)
             with m.If(advance):
@@ -578,7 +601,8 @@ class RvsmStreamArray(wiring.Component):
                 forward=(bus_we & (bus_scale == s) & (bus_word == rd_addr), fwd_data[1]))
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
             acc_q = self._banked(m, f"acc_s{s}", p * wa, advance, rd_addr, bank_q,
-                                 [(wr_en, wr_addr, after_flat)])
+                                 [(wr_en, wr_addr, after_flat)],
+                                 guard=(valid[tail], geo.rmw_guard_bits))
             for i in range(p):
                 acc = Mux(fresh_q, 0, acc_q[i * wa:(i + 1) * wa].as_signed())
                 shifted = sums[i][s].value.as_signed() >> c.shift
