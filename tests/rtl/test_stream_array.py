@@ -291,6 +291,20 @@ def test_default_point_state_and_timing() -> None:
     assert bits["thresholds"] == 4 * 250 * 400 * 17
 
 
+@pytest.mark.parametrize(("h", "w", "lanes"), [(5, 6, 1), (6, 8, 2), (64, 64, 8), (7, 12, 3),
+                                                (250, 400, 40)])
+def test_rmw_guard_bits_separate_read_and_write_back(h: int, w: int, lanes: int) -> None:
+    """The accumulator read's collision guard (low address bits) never meets the
+    write-back at the same edge (brute force over a frame); one bit fewer would."""
+    geo = StreamGeometry(model_contract("dog4", h, w), lanes)
+    n, k = geo.beats_per_frame, geo.rmw_guard_bits
+    rd = np.arange(n)
+    wr = (rd - geo.rmw_depth) % n
+    assert np.all((rd ^ wr) & ((1 << k) - 1))
+    if k > 1:
+        assert not np.all((rd ^ wr) & ((1 << (k - 1)) - 1))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("model", MODEL_NAMES)
 @pytest.mark.parametrize("lanes", [1, 3, 5, 15])
