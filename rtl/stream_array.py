@@ -614,14 +614,11 @@ class RvsmStreamArray(wiring.Component):
                 thr2 = Signal(unsigned(tw), name=f"thr2_s{s}_l{i}", **data)
                 pos = Signal(name=f"pos_s{s}_l{i}", **data)
                 neg = Signal(name=f"neg_s{s}_l{i}", **data)
-                # -thr registered beside thr: the negative compare is one carry chain
-                nthr1 = Signal(signed(tw + 1), name=f"nthr1_s{s}_l{i}", **data)
                 fire_pos = total >= thr1
-                fire_neg = (~fire_pos & (total <= nthr1)) if c.signed else Const(0)
+                fire_neg = (~fire_pos & (total <= -thr1)) if c.signed else Const(0)
                 tail_stmts += [
                     total.eq(acc + shifted),
                     thr1.eq(thr_q[i * tw:(i + 1) * tw]),
-                    *([nthr1.eq(-thr_q[i * tw:(i + 1) * tw])] if c.signed else []),
                     sat.eq(Mux(total > hi, hi, Mux(total < lo, lo, total))),
                     pos.eq(fire_pos), neg.eq(fire_neg), thr2.eq(thr1),
                 ]
