@@ -33,6 +33,7 @@ from .atomic import _UMASK
 from .errors import RvsmError
 from .spike_files import _check_spikes, load_spikes
 from .spike_packing import pack_spikes, packed_width, unpack_spikes
+from .versions import with_versions
 
 FORMAT = "rvsm-spikes"
 FORMAT_VERSION = 1
@@ -95,7 +96,7 @@ class H5SpikeWriter:
         self._file.attrs["format"] = FORMAT
         self._file.attrs["format_version"] = FORMAT_VERSION
         self._file.attrs["complete"] = False
-        self._file.attrs["meta"] = json.dumps(meta, sort_keys=True)
+        self._file.attrs["meta"] = json.dumps(with_versions(meta), sort_keys=True)
 
     def write(self, t0, spikes) -> None:
         b = spikes.shape[0]
@@ -109,7 +110,7 @@ class H5SpikeWriter:
             raise RvsmError(
                 f"{self.path}: only {self.steps_written} of {expected} steps written"
             )
-        self._file.attrs["meta"] = json.dumps(meta, sort_keys=True)
+        self._file.attrs["meta"] = json.dumps(with_versions(meta), sort_keys=True)
         self._file.attrs["complete"] = True
         self._file.close()
         self._file = None

@@ -14,6 +14,7 @@ from rvsm.model.spike_h5 import (
     write_spikes,
 )
 from rvsm.model.spike_packing import count_spikes, pack_spikes, unpack_spikes
+from rvsm.model.versions import with_versions
 
 
 def _spikes(shape=(37, 2, 5, 11), seed=0):
@@ -46,7 +47,7 @@ def test_h5_round_trip_chunked(tmp_path, encoding, compression):
     sink.finish(meta)
     assert list(tmp_path.iterdir()) == [path]
     with open_spikes(path) as src:
-        assert src.shape == a.shape and src.meta == meta
+        assert src.shape == a.shape and src.meta == with_versions(meta)
         np.testing.assert_array_equal(src.read(5, 23), a[5:23])
     with h5py.File(path) as f:
         assert f.attrs["complete"] and f.attrs["encoding"] == encoding
@@ -62,7 +63,7 @@ def test_failed_run_leaves_nothing_and_keeps_old_file(tmp_path):
     sink.write(0, _spikes((10, 1, 4, 4)))
     sink.abort()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.h5"]
-    assert open_spikes(path).meta == {"old": True}
+    assert open_spikes(path).meta == with_versions({"old": True})
     short = H5SpikeWriter(tmp_path / "short.h5")
     short.begin((20, 1, 4, 4), {})
     short.write(0, _spikes((10, 1, 4, 4)))

@@ -25,7 +25,8 @@ def test_h5_and_npz_hold_the_same_spikes_and_scores(tmp_path, capsys):
     a, meta_a = load_any_spikes(h5)
     b, meta_b = load_spikes(npz)
     np.testing.assert_array_equal(a, b)
-    assert meta_b.pop("versions")["rvsm"]  # .npz files record the versions (docs/cli.md)
+    assert meta_b.pop("versions")["rvsm"]  # both kinds record the versions (docs/cli.md)
+    assert meta_a.pop("versions")["numpy"]
     assert meta_a == meta_b
     scores = [json.loads(_run(capsys, "evaluate", p, "--json")[1]) for p in (h5, npz)]
     assert scores[0] == scores[1]
