@@ -2,22 +2,11 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from rvsm.sim.cli import main
 
-SWEEP = """
-[axes]
-"adc.bits" = [6, 8]
-"weights.frac_bits" = [7, 9]
-"weights.bits" = ["auto"]
-"datapath.accumulator_bits" = ["auto"]
-[run]
-scenes = ["coin"]
-size = "16x24"
-frames = 3
-noise = [false, true]
-[hardware]
-enabled = false
-"""
+SWEEP = (Path(__file__).parents[2] / "data" / "small-sweep.toml").read_text()
 
 
 def test_cli_run_report_and_errors(tmp_path, capsys):

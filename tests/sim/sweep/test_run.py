@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sqlite3
+from pathlib import Path
 
 import pytest
 
@@ -10,20 +11,7 @@ from rvsm.sim.sweep import run as sweep_run
 from rvsm.sim.sweep.run import run_sweep
 from rvsm.sim.sweep.spec import parse_sweep
 
-SWEEP = """
-[axes]
-"adc.bits" = [6, 8]
-"weights.frac_bits" = [7, 9]
-"weights.bits" = ["auto"]
-"datapath.accumulator_bits" = ["auto"]
-[run]
-scenes = ["coin"]
-size = "16x24"
-frames = 3
-noise = [false, true]
-[hardware]
-enabled = false
-"""
+SWEEP = (Path(__file__).parents[2] / "data" / "small-sweep.toml").read_text()
 
 
 @pytest.fixture
