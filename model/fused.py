@@ -32,15 +32,20 @@ DEFAULT_CHUNK_STEPS = 256
 @njit(inline="always", cache=True)
 def _row_pairs(pad, nrows, lmax, width, pairs):
     """``pairs[b, r, x] = pad[r, x + L - b] + pad[r, x + L + b]`` (``b = 0``: the value)."""
+    # Slices first: ``src[x + lmax - b]`` would carry numba's negative-index wraparound
+    # check, which keeps the loop from vectorising.
     for r in range(nrows):
         src = pad[r]
+        mid = src[lmax:lmax + width]
         dst = pairs[0, r]
         for x in range(width):
-            dst[x] = src[x + lmax]
+            dst[x] = mid[x]
         for b in range(1, lmax + 1):
             dst = pairs[b, r]
+            left = src[lmax - b:lmax - b + width]
+            right = src[lmax + b:lmax + b + width]
             for x in range(width):
-                dst[x] = src[x + lmax - b] + src[x + lmax + b]
+                dst[x] = left[x] + right[x]
 
 
 @njit(inline="always", cache=True)

@@ -152,8 +152,9 @@ def pixel_normal(key, t, y, x, zx, zr):
 @njit(inline="always", cache=True)
 def normal_row(key, t, y, width, mean, sd, zx, zr, out, offset):
     """``out[offset + x] = mean + sd * z(t, y, x)`` for ``x = 0 .. width - 1``."""
+    row = out[offset:offset + width]
     for x in range(width):
-        out[offset + x] = mean + sd * pixel_normal(key, t, y, x, zx, zr)
+        row[x] = mean + sd * pixel_normal(key, t, y, x, zx, zr)
 
 
 @njit(parallel=True, cache=True)

@@ -6,7 +6,7 @@ import pytest
 
 from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.design_point import DesignPoint
-from rvsm.model.fixed.fused import exact_in_float, stream_fixed
+from rvsm.model.fixed.fused import exact_dtype, stream_fixed
 from rvsm.model.fixed.twin import simulate_fixed
 from rvsm.model.sampling_stream import ArraySink
 from rvsm.model.scene import Scene
@@ -15,6 +15,13 @@ STATS = ("saturated", "sum_min", "sum_max", "shifted_min", "shifted_max", "acc_m
          "acc_max")
 WIDE = {"adc_rounding": "truncate", "accumulator_bits": 60, "adc_bits": 16,
         "weight_bits": 32, "weight_frac_bits": 30}
+#: design-point overrides -> the exact type the fused kernel computes in
+EXTRAS = {
+    "default": ({}, np.float32),
+    "shift-saturating": ({"shift": 3, "accumulator_bits": 14}, np.float32),
+    "float64": ({"adc_bits": 12, "accumulator_bits": 30}, np.float64),
+    "int64": (WIDE, np.int64),
+}
 
 
 def _scene(seed=3, shape=(4, 21, 19), m=5):
@@ -24,13 +31,13 @@ def _scene(seed=3, shape=(4, 21, 19), m=5):
 @pytest.mark.parametrize("model", ["fsm", "dog1", "dog4", "gauss3"])
 @pytest.mark.parametrize("noise", [False, True])
 @pytest.mark.parametrize("reset", ["zero", "subtract"])
-@pytest.mark.parametrize("extra", [{}, {"shift": 3, "accumulator_bits": 14}, WIDE],
-                         ids=["default", "shift-saturating", "int64"])
-def test_fused_equals_numpy(model, noise, reset, extra):
+@pytest.mark.parametrize("case", EXTRAS)
+def test_fused_equals_numpy(model, noise, reset, case):
+    extra, dtype = EXTRAS[case]
     scene = _scene()
     point = DesignPoint(height=21, width=19, model=model, noise=noise, noise_k=3.0, seed=4,
                         reset=reset, phi=150.0, **extra)
-    assert exact_in_float(point) == (extra is not WIDE)
+    assert exact_dtype(point) is dtype
     ref = simulate_fixed(scene, point, engine="numpy", block_steps=7)
     run = simulate_fixed(scene, point)
     np.testing.assert_array_equal(run.spikes, ref.spikes)
@@ -89,3 +96,23 @@ def test_adc_clip_error_is_raised_by_the_fused_engine():
         simulate_fixed(scene, point)
     with pytest.raises(RvsmError, match="adc.clip"):
         simulate_fixed(scene, point, engine="numpy")
+
+
+def test_float32_datapath_is_exact_at_its_limit():
+    # 12-bit codes and 24-bit accumulators: the largest value, a rail plus the largest
+    # receptive sum, is just inside float32's exact integers; a checkerboard and its
+    # inverse drive the sums to both extremes and the accumulators past the top rail.
+    h, w = 18, 20
+    board = (np.indices((h, w)).sum(axis=0) % 2) * 255.0
+    scene = Scene("board", np.stack([board, 255.0 - board, board, 255.0 - board]), 40)
+    point = DesignPoint(height=h, width=w, model="dog4", adc_bits=12, accumulator_bits=24,
+                        reset="subtract", phi=1000.0)
+    assert exact_dtype(point) is np.float32
+    ref = simulate_fixed(scene, point, engine="numpy")
+    run = simulate_fixed(scene, point)
+    assert ref.stats.saturated.min() > 0
+    # pre-saturation values beyond the top rail, above 2**23
+    assert ref.stats.acc_max.max() > 2**23
+    np.testing.assert_array_equal(run.spikes, ref.spikes)
+    for name in STATS:
+        np.testing.assert_array_equal(getattr(run.stats, name), getattr(ref.stats, name))
