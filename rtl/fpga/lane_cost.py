@@ -34,7 +34,8 @@ from .flow import build_component, place_and_route, synthesise
 from .sensor import state_memory
 from .tools import Progress
 
-__all__ = ["DEFAULT_LANES", "DEFAULT_SIZE", "LaneCost", "lane_cost", "logic_lut4"]
+__all__ = ["DEFAULT_LANES", "DEFAULT_SIZE", "LaneCost", "LaneSynthesis", "combine_lanes",
+           "lane_cost", "lane_synthesis", "logic_lut4"]
 
 #: Array synthesised for the per-lane slope (pixels, H x W).
 DEFAULT_SIZE = (16, 16)
@@ -80,6 +81,78 @@ class LaneCost:
         return d
 
 
+@dataclass(frozen=True)
+class LaneSynthesis:
+    """One synthesis of the streaming array at ``lanes`` lanes: the design's logic
+    (LUT4 sites) and flip-flops, harness excluded, Fmax (MHz) if placed and routed, and the
+    wall ``seconds``. Two of them make a :class:`LaneCost` (:func:`combine_lanes`)."""
+
+    lanes: int
+    logic: int
+    ff: int
+    fmax_mhz: float | None
+    seconds: float
+
+
+def _check_lanes(size: tuple[int, int], lanes: tuple[int, int]) -> None:
+    p1, p2 = lanes
+    if not 1 <= p1 < p2:
+        raise RvsmError(f"lane counts must be 1 <= P1 < P2, got {lanes}")
+    if size[1] % p1 or size[1] % p2:
+        raise RvsmError(f"the synthesised width {size[1]} must be a multiple of {p1} "
+                        f"and {p2}")
+
+
+def lane_synthesis(
+    point: DesignPoint,
+    lanes: int,
+    *,
+    size: tuple[int, int] = DEFAULT_SIZE,
+    fmax: bool = False,
+    device: str = "ecp5-85",
+    work_dir: str | os.PathLike | None = None,
+    on_progress: Callable[[Progress], None] | None = None,
+    timeout: float | None = None,
+) -> LaneSynthesis:
+    """Synthesise ``point``'s streaming array at ``size`` with ``lanes`` lanes (and place
+    and route it if ``fmax``): one independent half of :func:`lane_cost`, so a sweep can
+    run the two lane counts on two workers."""
+    t0 = time.monotonic()
+    contract = point.with_size(*size).contract()
+    with tempfile.TemporaryDirectory(prefix="rvsm-lane-cost-") as tmp:
+        root = Path(work_dir) if work_dir is not None else Path(tmp)
+        component, _ = build_component(contract, "stream", lanes)
+        syn = synthesise(component, root / f"p{lanes}", netlist="verilog",
+                         zero_memory_init=False, on_progress=on_progress, timeout=timeout)
+        fmax_mhz = None
+        if fmax:
+            pnr, _ = place_and_route(syn, get_device(device), on_progress=on_progress,
+                                     timeout=timeout)
+            fmax_mhz = pnr["fmax_mhz"]
+    return LaneSynthesis(lanes=lanes,
+                         logic=logic_lut4(syn.stat["cells"]) - syn.harness.overhead_lut,
+                         ff=syn.stat["ff"] - syn.harness.overhead_ff, fmax_mhz=fmax_mhz,
+                         seconds=time.monotonic() - t0)
+
+
+def combine_lanes(point: DesignPoint, size: tuple[int, int], first: LaneSynthesis,
+                  second: LaneSynthesis) -> LaneCost:
+    """:class:`LaneCost` from the syntheses at two lane counts (Fmax: ``first``'s); the
+    memory bits are counted at the design point's own size; ``seconds`` is the sum."""
+    p1, p2 = first.lanes, second.lanes
+    _check_lanes(size, (p1, p2))
+    slope = (second.logic - first.logic) / (p2 - p1)
+    st = state_memory(point.contract())
+    return LaneCost(
+        size=tuple(size), lanes=(p1, p2), logic=(first.logic, second.logic),
+        ff=(first.ff, second.ff), lut4_per_lane=slope,
+        ff_per_lane=(second.ff - first.ff) / (p2 - p1), lut4_base=first.logic - slope * p1,
+        accumulator_bits=st.accumulators, threshold_bits=st.thresholds,
+        line_buffer_bits=st.line_buffers, fmax_mhz=first.fmax_mhz,
+        seconds=first.seconds + second.seconds,
+    )
+
+
 def lane_cost(
     point: DesignPoint,
     *,
@@ -94,40 +167,12 @@ def lane_cost(
     """Measure :class:`LaneCost` of ``point`` (see the module docstring).
 
     ``size`` is the synthesised array (its width must be a multiple of both lane
-    counts); ``work_dir`` keeps the tool products (default: a temporary folder).
+    counts); ``work_dir`` keeps the tool products (default: a temporary folder); Fmax
+    (``fmax``) is measured at the first lane count.
     """
-    p1, p2 = lanes
-    if not 1 <= p1 < p2:
-        raise RvsmError(f"lane counts must be 1 <= P1 < P2, got {lanes}")
-    if size[1] % p1 or size[1] % p2:
-        raise RvsmError(f"the synthesised width {size[1]} must be a multiple of {p1} "
-                        f"and {p2}")
-    t0 = time.monotonic()
-    contract = point.with_size(*size).contract()
-    logic, ff, syn_p1 = [], [], None
-    with tempfile.TemporaryDirectory(prefix="rvsm-lane-cost-") as tmp:
-        root = Path(work_dir) if work_dir is not None else Path(tmp)
-        for p in (p1, p2):
-            component, _ = build_component(contract, "stream", p)
-            syn = synthesise(component, root / f"p{p}", netlist="verilog",
-                             zero_memory_init=False, on_progress=on_progress,
-                             timeout=timeout)
-            logic.append(logic_lut4(syn.stat["cells"]) - syn.harness.overhead_lut)
-            ff.append(syn.stat["ff"] - syn.harness.overhead_ff)
-            if p == p1:
-                syn_p1 = syn
-        fmax_mhz = None
-        if fmax:
-            pnr, _ = place_and_route(syn_p1, get_device(device), on_progress=on_progress,
-                                     timeout=timeout)
-            fmax_mhz = pnr["fmax_mhz"]
-    slope = (logic[1] - logic[0]) / (p2 - p1)
-    st = state_memory(point.contract())
-    return LaneCost(
-        size=tuple(size), lanes=(p1, p2), logic=tuple(logic), ff=tuple(ff),
-        lut4_per_lane=slope, ff_per_lane=(ff[1] - ff[0]) / (p2 - p1),
-        lut4_base=logic[0] - slope * p1,
-        accumulator_bits=st.accumulators, threshold_bits=st.thresholds,
-        line_buffer_bits=st.line_buffers, fmax_mhz=fmax_mhz,
-        seconds=time.monotonic() - t0,
-    )
+    _check_lanes(size, lanes)
+    first, second = (
+        lane_synthesis(point, p, size=size, fmax=fmax and i == 0, device=device,
+                       work_dir=work_dir, on_progress=on_progress, timeout=timeout)
+        for i, p in enumerate(lanes))
+    return combine_lanes(point, size, first, second)

@@ -104,19 +104,34 @@ def hw_digest(point: DesignPoint, hardware: HardwareSettings) -> str:
     return h.hexdigest()[:16]
 
 
-def synthesise_task(point: DesignPoint, hardware: HardwareSettings) -> dict[str, Any]:
-    """Hardware cost of ``point`` on the streaming array
-    (:func:`~rvsm.rtl.fpga.lane_cost.lane_cost` at ``hardware.size`` and ``.lanes``):
-    ``lut4_per_lane``, ``ff_per_lane``, ``lut4_base``, ``fmax_mhz`` (or None), the
-    memory bits, ``size`` ("HxW"), ``lanes``, ``contract`` (repr) and ``seconds``."""
-    from rvsm.rtl.fpga.lane_cost import lane_cost
+def synthesise_task(point: DesignPoint, hardware: HardwareSettings, lanes: int
+                    ) -> dict[str, Any]:
+    """One of the two syntheses of :func:`~rvsm.rtl.fpga.lane_cost.lane_cost`: the
+    streaming array of ``point`` at ``hardware.size`` with ``lanes`` lanes (placed and
+    routed for Fmax when ``hardware.fmax`` and ``lanes`` is the first lane count). A
+    sweep submits the two lane counts as two tasks, so they run on two workers."""
+    from dataclasses import asdict
 
-    t0 = time.perf_counter()
-    cost = lane_cost(point, size=hardware.size, lanes=hardware.lanes, fmax=hardware.fmax)
+    from rvsm.rtl.fpga.lane_cost import lane_synthesis
+
+    fmax = hardware.fmax and lanes == hardware.lanes[0]
+    return asdict(lane_synthesis(point, lanes, size=hardware.size, fmax=fmax))
+
+
+def hw_record(point: DesignPoint, hardware: HardwareSettings,
+              syntheses: dict[int, dict[str, Any]]) -> dict[str, Any]:
+    """The ``lane_cost`` row of ``point`` from its two :func:`synthesise_task` results:
+    ``lut4_per_lane``, ``ff_per_lane``, ``lut4_base``, ``fmax_mhz`` (or None), the memory
+    bits, ``size`` ("HxW"), ``lanes``, ``contract`` (repr) and ``seconds`` (both
+    syntheses)."""
+    from rvsm.rtl.fpga.lane_cost import LaneSynthesis, combine_lanes
+
+    p1, p2 = hardware.lanes
+    cost = combine_lanes(point, hardware.size, LaneSynthesis(**syntheses[p1]),
+                         LaneSynthesis(**syntheses[p2]))
     rec = cost.to_dict()
     rec.update(size=f"{hardware.size[0]}x{hardware.size[1]}", lanes=list(hardware.lanes),
-               contract=repr(hw_point(point, hardware.size).contract()),
-               seconds=time.perf_counter() - t0)
+               contract=repr(hw_point(point, hardware.size).contract()))
     return rec
 
 
@@ -198,18 +213,27 @@ def _execute(spec, store, pending, hw_todo, digests, summary, workers, scheduler
              on_result, processes) -> None:
     from tqdm import tqdm
 
-    total = len(pending) + len(hw_todo)
+    total = len(pending) + len(hw_todo) * len(spec.hardware.lanes)
     bar = tqdm(total=total, desc="sweep", unit="task", disable=not progress, smoothing=0.1)
     run = spec.run
     args = (run.frames, run.steps_per_frame, run.method, run.match)
 
+    hw = spec.hardware
+    halves: dict[str, dict[int, dict[str, Any]]] = {dig: {} for dig in hw_todo}
+    failed: set[str] = set()
+
     def finished(kind: str, item: Any, value: Any, exc: BaseException | None) -> None:
         if kind == "hw":
-            if exc is None:
-                store.write_hw_cost(item, value)
-                summary.hw_synthesised += 1
+            dig, lanes = item
+            if exc is not None:
+                if dig not in failed:
+                    summary.errors.append(f"synthesis of {dig}: {exc}")
+                failed.add(dig)
             else:
-                summary.errors.append(f"synthesis of {item}: {exc}")
+                halves[dig][lanes] = value
+            if dig not in failed and len(halves[dig]) == len(hw.lanes):
+                store.write_hw_cost(dig, hw_record(hw_todo[dig], hw, halves[dig]))
+                summary.hw_synthesised += 1
         else:
             dig = digests.get(item.design.design_id)
             if exc is None:
@@ -228,7 +252,8 @@ def _execute(spec, store, pending, hw_todo, digests, summary, workers, scheduler
         if workers == 0 and scheduler is None:
             summary.workers = 0
             for dig, point in hw_todo.items():
-                _call(finished, "hw", dig, synthesise_task, point, spec.hardware)
+                for lanes in hw.lanes:
+                    _call(finished, "hw", (dig, lanes), synthesise_task, point, hw, lanes)
             for t in pending:
                 _call(finished, "pt", t, evaluate_task, t, *args)
         else:
@@ -288,11 +313,14 @@ def _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
     try:
         summary.workers = len(client.scheduler_info().get("workers", {}))
         items = {}
+        # The longest tasks first (syntheses, one per lane count), the short evaluations
+        # last, so they fill the workers' tails.
         for dig, point in hw_todo.items():
-            f = client.submit(synthesise_task, point, spec.hardware, key=f"hw-{dig}",
-                              priority=10)
-            items[f.key] = ("hw", dig)
-            futures.append(f)
+            for lanes in spec.hardware.lanes:
+                f = client.submit(synthesise_task, point, spec.hardware, lanes,
+                                  key=f"hw-{dig}-p{lanes}", priority=10)
+                items[f.key] = ("hw", (dig, lanes))
+                futures.append(f)
         for t in pending:
             f = client.submit(evaluate_task, t, *args, key=f"pt-{t.point_id}")
             items[f.key] = ("pt", t)

