@@ -13,6 +13,7 @@ names the tool, its exit status (or the signal that killed it) and its log.
 from __future__ import annotations
 
 import atexit
+import contextlib
 import os
 import signal
 import subprocess
@@ -23,7 +24,8 @@ from typing import IO
 
 from .errors import ToolError
 
-__all__ = ["ToolFailure", "describe_status", "kill_all", "live_groups", "run_tool"]
+__all__ = ["ToolFailure", "describe_status", "kill_all", "live_groups", "run_tool",
+           "stop_group", "tracked"]
 
 #: Seconds a tool's group gets between SIGTERM and SIGKILL when the parent is interrupted.
 GRACE_SECONDS = 2.0
@@ -69,8 +71,9 @@ def _kill_group(pgid: int, sig: int) -> None:
         pass
 
 
-def _stop(proc: subprocess.Popen) -> None:
-    """SIGTERM the group of ``proc``, SIGKILL it after :data:`GRACE_SECONDS`, reap."""
+def stop_group(proc: subprocess.Popen) -> None:
+    """SIGTERM the group of ``proc`` (started with ``start_new_session=True``), SIGKILL it
+    after :data:`GRACE_SECONDS`, reap the leader."""
     _kill_group(proc.pid, signal.SIGTERM)
     try:
         proc.wait(timeout=GRACE_SECONDS)
@@ -80,13 +83,31 @@ def _stop(proc: subprocess.Popen) -> None:
     proc.wait()
 
 
+@contextlib.contextmanager
+def tracked(proc: subprocess.Popen):
+    """Record ``proc``'s group as live (:func:`kill_all` stops it) while the block runs;
+    on any exception in the block (``KeyboardInterrupt``, a timeout) stop the group before
+    the exception propagates. For callers that read a tool's output themselves
+    (:func:`rvsm.rtl.fpga.tools.run_tool`)."""
+    with _lock:
+        _live[proc.pid] = proc
+    try:
+        yield proc
+    except BaseException:
+        stop_group(proc)
+        raise
+    finally:
+        with _lock:
+            _live.pop(proc.pid, None)
+
+
 def kill_all() -> None:
     """Stop every tool group still running (called at interpreter exit too)."""
     with _lock:
         procs = list(_live.values())
         _live.clear()
     for proc in procs:
-        _stop(proc)
+        stop_group(proc)
 
 
 atexit.register(kill_all)
@@ -134,16 +155,8 @@ def run_tool(
                 from exc
         except PermissionError as exc:
             raise ToolFailure(name, 126, log, f"cannot execute {argv[0]}") from exc
-        try:
-            with _lock:
-                _live[proc.pid] = proc
+        with tracked(proc):
             out, err = proc.communicate()
-        except BaseException:
-            _stop(proc)
-            raise
-        finally:
-            with _lock:
-                _live.pop(proc.pid, None)
         _kill_group(proc.pid, signal.SIGKILL)  # stragglers of a tool that died or forked
     finally:
         if handle is not None:

@@ -4,7 +4,9 @@
 line into a log file, and reports progress on a callback: the tool's current phase
 (recognised from its log lines), elapsed time and an expected total. On an interrupt
 (``KeyboardInterrupt``), a timeout or any other exception the whole process group is
-terminated (``SIGTERM``, then ``SIGKILL`` after 5 s) before the exception propagates.
+terminated (``SIGTERM``, then ``SIGKILL``) before the exception propagates: the group is
+:func:`rvsm.model.processes.tracked`, like every other tool the package runs, so the
+CLI's :func:`~rvsm.model.processes.kill_all` stops it too.
 A tool that is missing, exits non-zero or times out raises
 :class:`~rvsm.model.errors.ToolError` (CLI exit status 3) naming the log file.
 
@@ -19,7 +21,6 @@ import os
 import queue
 import re
 import shutil
-import signal
 import subprocess
 import sys
 import threading
@@ -29,6 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rvsm.model.errors import ToolError
+from rvsm.model.processes import tracked
 
 __all__ = ["TOOL_ENV", "Progress", "find_tool", "run_tool"]
 
@@ -173,44 +175,41 @@ def run_tool(
                 break
 
     try:
-        if on_progress:
-            on_progress(Progress(step, "starting", 0.0, expected))
-        finished = False
-        while not finished:
-            try:
-                text = lines.get(timeout=0.5)
-            except queue.Empty:
-                text = ""
-            while text is not None:
-                if text:
-                    log.write(text)
-                    if text.strip():
-                        last_line = text.strip()
-                    if tail is None:
-                        parse(text)
+        with tracked(proc):
+            if on_progress:
+                on_progress(Progress(step, "starting", 0.0, expected))
+            finished = False
+            while not finished:
                 try:
-                    text = lines.get_nowait()
+                    text = lines.get(timeout=0.5)
                 except queue.Empty:
-                    break
-            if text is None:
-                finished = True
-            if tail is not None:
-                for followed_line in tail.read_lines():
-                    parse(followed_line)
-            now = time.monotonic()
-            if on_progress and now - state["reported"] >= heartbeat:
-                detail = state["detail"]
-                shown = f"{state['phase']} ({detail})" if detail else state["phase"]
-                on_progress(Progress(step, shown, now - t0, expected))
-                state["reported"] = now
-            if timeout is not None and now - t0 > timeout:
-                _kill_group(proc)
-                raise ToolError(f"{tool} ran over its time limit of {timeout:.0f} s and was "
-                                f"stopped; log: {followed or log_path}")
-        code = proc.wait()
-    except BaseException:
-        _kill_group(proc)
-        raise
+                    text = ""
+                while text is not None:
+                    if text:
+                        log.write(text)
+                        if text.strip():
+                            last_line = text.strip()
+                        if tail is None:
+                            parse(text)
+                    try:
+                        text = lines.get_nowait()
+                    except queue.Empty:
+                        break
+                if text is None:
+                    finished = True
+                if tail is not None:
+                    for followed_line in tail.read_lines():
+                        parse(followed_line)
+                now = time.monotonic()
+                if on_progress and now - state["reported"] >= heartbeat:
+                    detail = state["detail"]
+                    shown = f"{state['phase']} ({detail})" if detail else state["phase"]
+                    on_progress(Progress(step, shown, now - t0, expected))
+                    state["reported"] = now
+                if timeout is not None and now - t0 > timeout:
+                    raise ToolError(f"{tool} ran over its time limit of {timeout:.0f} s and was "
+                                    f"stopped; log: {followed or log_path}")
+            code = proc.wait()
     finally:
         reader.join(timeout=5.0)
         if proc.stdout is not None:
@@ -252,19 +251,3 @@ class _Tail:
     def close(self) -> None:
         if self.handle is not None:
             self.handle.close()
-
-
-def _kill_group(proc: subprocess.Popen) -> None:
-    """Terminate ``proc``'s whole process group (it leads its own session)."""
-    if proc.poll() is not None:
-        return
-    for sig, wait in ((signal.SIGTERM, 5.0), (signal.SIGKILL, 5.0)):
-        try:
-            os.killpg(proc.pid, sig)
-        except ProcessLookupError:
-            return
-        try:
-            proc.wait(timeout=wait)
-            return
-        except subprocess.TimeoutExpired:
-            continue
