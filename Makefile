@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress bench lint clean
+.PHONY: setup demo test regress bench bench-sweep lint clean
 
 setup: $(STAMP)
 
@@ -30,6 +30,10 @@ regress: setup
 
 bench: setup
 	$(BIN)/python scripts/benchmark.py
+
+# sweep speed-up 1 -> 2 workers on sweeps/example.toml (about 4 minutes per round)
+bench-sweep: setup
+	$(BIN)/python scripts/bench_sweep.py --rounds $(or $(ROUNDS),1)
 
 lint: setup
 	$(BIN)/ruff check .
