@@ -199,7 +199,8 @@ def check_beats(schedule: StreamSchedule, expected: np.ndarray, got: OutputBeats
     Checks the number of beats, every position and ``last`` flag, and every spike.
     Returns ``compared`` (spikes compared), ``mismatches`` (wrong spikes plus one per
     wrong or missing beat), ``first_mismatch`` and up to ``max_listed`` entries in
-    ``mismatch_list`` (``step, scale, row, column, expected, got``; or ``beat, error``).
+    ``mismatch_list`` (``beat, step, scale, row, column, expected, got``; or ``beat,
+    error``), in beat order (``beat``: index of the output beat, from 0).
     """
     exp = schedule.expected_beats(expected)
     n_exp, n_got = exp.shape[0], got.spikes.shape[0]
@@ -222,10 +223,11 @@ def check_beats(schedule: StreamSchedule, expected: np.ndarray, got: OutputBeats
     mismatches += len(diff)
     bpf = schedule.beats_per_frame
     for k, s, i in diff[:max(0, max_listed - len(listed))]:
-        listed.append({"step": int(k // bpf), "scale": int(s), "row": int(rows[k]),
+        listed.append({"beat": int(k), "step": int(k // bpf), "scale": int(s),
+                       "row": int(rows[k]),
                        "column": int(groups[k] * schedule.lanes + i),
                        "expected": int(exp[k, s, i]), "got": int(got.spikes[k, s, i])})
-    listed.sort(key=lambda e: e.get("beat", e.get("step", 0) * bpf))
+    listed.sort(key=lambda e: e["beat"])
     return {
         "compared": int(n * exp.shape[1] * exp.shape[2]),
         "mismatches": int(mismatches),

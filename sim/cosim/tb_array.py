@@ -15,27 +15,18 @@ is high is matched to the next expected step and every accumulator compared.
 from __future__ import annotations
 
 import json
-import os
 import time
 
 import cocotb
 import numpy as np
-from cocotb.clock import Clock
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
 from rvsm.model.fixed.stimulus import load_stimulus
 
+from .tb_common import clock_and_reset, logic_bits, testbench_arg
+
 MAX_LISTED = 50
-
-
-def _arg(name: str) -> str:
-    """Environment variable ``RVSM_<NAME>`` or plusarg ``+rvsm_<name>=``."""
-    plus = cocotb.plusargs.get(f"rvsm_{name}")
-    value = plus if isinstance(plus, str) else os.environ.get(f"RVSM_{name.upper()}")
-    if not value:
-        raise RuntimeError(f"set RVSM_{name.upper()} or +rvsm_{name}=")
-    return value
 
 
 def _pack(bits: np.ndarray) -> int:
@@ -51,21 +42,11 @@ def _pack_codes(codes: np.ndarray, adc_bits: int) -> int:
     return _pack(bits)
 
 
-def _read(handle: object) -> tuple[int, int]:
-    """Value of a vector as ``(int with X/Z as 0, mask of X/Z bits)``."""
-    s = str(handle.value)  # type: ignore[attr-defined]
-    if set(s) <= {"0", "1"}:
-        return int(s, 2), 0
-    clean = "".join(ch if ch in "01" else "0" for ch in s)
-    xmask = "".join("0" if ch in "01" else "1" for ch in s)
-    return int(clean, 2), int(xmask, 2)
-
-
 @cocotb.test()
 async def array_matches_fixed_twin(dut: object) -> None:
     """Compare every spike of every step with the fixed twin's expectation."""
-    stim = load_stimulus(_arg("stimulus"))
-    result_path = _arg("result")
+    stim = load_stimulus(testbench_arg("stimulus"))
+    result_path = testbench_arg("result")
     codes = stim.codes.astype(np.int64)
     thresholds = stim.thresholds
     expected = stim.spikes
@@ -74,13 +55,8 @@ async def array_matches_fixed_twin(dut: object) -> None:
     steps, scales, height, width = expected.shape
     n_acc = scales * height * width
 
-    cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start())
-    for sig, v in (("rst", 1), ("strobe", 0), ("clear", 0), ("cfg_we", 0),
-                   ("cfg_addr", 0), ("cfg_data", 0), ("codes", 0)):
-        getattr(dut, sig).value = v
-    await FallingEdge(dut.clk)
-    await FallingEdge(dut.clk)
-    dut.rst.value = 0
+    await clock_and_reset(dut, ("strobe", "clear", "cfg_we", "cfg_addr", "cfg_data",
+                                "codes"))
 
     for a, thr in enumerate(thresholds.ravel()):
         dut.cfg_we.value = 1
@@ -119,8 +95,8 @@ async def array_matches_fixed_twin(dut: object) -> None:
             mismatches += 1
             listed.append({"step": next_step, "error": "valid without a pending step"})
             continue
-        pos, xp = _read(dut.spike_pos)
-        neg, xn = _read(dut.spike_neg)
+        pos, xp = logic_bits(dut.spike_pos.value)
+        neg, xn = logic_bits(dut.spike_neg.value)
         bad = (pos ^ exp_pos[next_step]) | (neg ^ exp_neg[next_step]) | xp | xn
         compared += n_acc
         if bad:

@@ -19,12 +19,10 @@ reports ``cycles_per_second`` to show whether it or the simulator dominates.
 from __future__ import annotations
 
 import json
-import os
 import time
 
 import cocotb
 import numpy as np
-from cocotb.clock import Clock
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
@@ -32,33 +30,16 @@ from rvsm.model.fixed.stimulus import load_stimulus
 from rvsm.rtl.stream_array import StreamGeometry, threshold_word_bits
 from rvsm.rtl.stream_schedule import OutputBeats, check_beats, pack_lanes
 
-
-def _arg(name: str) -> str:
-    """Environment variable ``RVSM_<NAME>`` or plusarg ``+rvsm_<name>=``."""
-    plus = cocotb.plusargs.get(f"rvsm_{name}")
-    value = plus if isinstance(plus, str) else os.environ.get(f"RVSM_{name.upper()}")
-    if not value:
-        raise RuntimeError(f"set RVSM_{name.upper()} or +rvsm_{name}=")
-    return value
-
-
-def _bits(value: object) -> tuple[int, int]:
-    """A logic vector as ``(int with X/Z as 0, mask of X/Z bits)``."""
-    s = str(value)
-    if set(s) <= {"0", "1"}:
-        return int(s, 2), 0
-    clean = "".join(ch if ch in "01" else "0" for ch in s)
-    xmask = "".join("0" if ch in "01" else "1" for ch in s)
-    return int(clean, 2), int(xmask, 2)
+from .tb_common import clock_and_reset, logic_bits, testbench_arg
 
 
 @cocotb.test()
 async def stream_matches_fixed_twin(dut: object) -> None:
     """Stream every step, compare every output beat with the fixed twin's expectation."""
-    stim = load_stimulus(_arg("stimulus"))
-    with open(_arg("ports"), encoding="utf-8") as f:
+    stim = load_stimulus(testbench_arg("stimulus"))
+    with open(testbench_arg("ports"), encoding="utf-8") as f:
         ports = json.load(f)
-    result_path = _arg("result")
+    result_path = testbench_arg("result")
     c = stim.contract
     codes = stim.codes.astype(np.int64)
     expected = stim.spikes
@@ -78,13 +59,8 @@ async def stream_matches_fixed_twin(dut: object) -> None:
     d = {name: getattr(dut, name) for name in (
         "rst", "clear", "codes_valid", "codes_payload", "thr_we", "thr_addr", "thr_data",
         "spikes_valid", "spikes_payload")}
-    cocotb.start_soon(Clock(clk, 10, unit="ns").start())
-    for name in ("rst", "clear", "codes_valid", "codes_payload", "thr_we", "thr_addr",
-                 "thr_data"):
-        d[name].value = 1 if name == "rst" else 0
-    await FallingEdge(clk)
-    await FallingEdge(clk)
-    d["rst"].value = 0
+    await clock_and_reset(dut, ("clear", "codes_valid", "codes_payload", "thr_we",
+                                "thr_addr", "thr_data"))
 
     t0 = time.perf_counter()
     cycles = 0
@@ -101,13 +77,15 @@ async def stream_matches_fixed_twin(dut: object) -> None:
 
     got: dict[str, list[int]] = {k: [] for k in fields}
     x_beats: list[int] = []
+    beat_times: list[int] = []  # simulation time (ns) at which each output beat was read
     out_valid, out_payload = d["spikes_valid"], d["spikes_payload"]
     in_payload = d["codes_payload"]
 
     def record() -> None:
         """After a falling edge: record the output beat presented, if any."""
         if str(out_valid.value) == "1":
-            value, xmask = _bits(out_payload.value)
+            beat_times.append(int(get_sim_time("ns")))
+            value, xmask = logic_bits(out_payload.value)
             if xmask:
                 x_beats.append(len(got["row"]))
             for k, (off, w) in fields.items():
@@ -140,7 +118,12 @@ async def stream_matches_fixed_twin(dut: object) -> None:
         result["mismatch_list"].insert(0, {"beat": x_beats[0],
                                            "error": f"X/Z in {len(x_beats)} output beat(s)"})
         result["first_mismatch"] = result["mismatch_list"][0]
+    first = result["first_mismatch"]
+    at = None
+    if first is not None and beat_times:  # a missing beat: after the last one received
+        at = beat_times[min(first["beat"], len(beat_times) - 1)]
     result.update({
+        "first_mismatch_time_ns": at,
         "steps": steps,
         "accumulators": scales * height * width,
         "expected_spikes": int(np.count_nonzero(expected)),

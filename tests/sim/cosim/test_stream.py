@@ -90,9 +90,14 @@ def test_checker_catches_wrong_expectation(small_contract, work: Path,
     r = run_rtl(c, codes, thr, "icarus", expected=wrong, work_dir=work, name="wrong",
                 build_root=builds, lanes=3)
     assert r["mismatches"] == 1
-    assert r["first_mismatch"] == {"step": step, "scale": scale, "row": row, "column": col,
-                                   "expected": int(wrong[step, scale, row, col]),
-                                   "got": good}
+    first = dict(r["first_mismatch"])
+    beat = first.pop("beat")
+    assert first == {"step": step, "scale": scale, "row": row, "column": col,
+                     "expected": int(wrong[step, scale, row, col]), "got": good}
+    # the beat of (step, row, column) in the output order (row-major, 2 groups of 3
+    # lanes per row), and where to look in the waves
+    assert beat == step * 5 * 2 + row * 2 + col // 3
+    assert 0 < r["first_mismatch_time_ns"] < r["sim_time_ns"]
     assert r["waves"] and Path(r["waves"]).exists()
 
 
