@@ -96,7 +96,9 @@ def test_checker_passes_and_catches(sched: StreamSchedule) -> None:
     wrong[1, 0, 2, 5] = 1 - abs(wrong[1, 0, 2, 5])
     bad = check_beats(sched, wrong, good)
     assert bad["mismatches"] == 1
-    assert bad["first_mismatch"] == {"step": 1, "scale": 0, "row": 2, "column": 5,
+    # beat 17 = frame 1 (9 beats each) + row 2 (3 beats each) + column 5 // 2 lanes
+    assert bad["first_mismatch"] == {"beat": 17, "step": 1, "scale": 0, "row": 2,
+                                     "column": 5,
                                      "expected": int(wrong[1, 0, 2, 5]),
                                      "got": int(spikes[1, 0, 2, 5])}
 
