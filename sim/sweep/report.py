@@ -189,8 +189,9 @@ def pareto_figure(designs: list[DesignSummary], tolerance: float = 0.1):
         order = np.argsort(hw[mask])
         ax.plot(hw[mask][order], cost[mask][order], "o-", color="tab:blue",
                 drawstyle="steps-post", label="Pareto front")
-        front = [i for i, m in enumerate(mask) if m]
-        for n, i in enumerate(front, 1):  # numbers as in the report's Pareto tables
+        # numbered as in the report's Pareto tables: by this panel's cost axis, then PSNR
+        front = sorted((i for i, m in enumerate(mask) if m), key=lambda i: (hw[i], cost[i]))
+        for n, i in enumerate(front, 1):
             ax.annotate(f"{'PM'[k]}{n}", (hw[i], max(cost[i], 1e-3)), fontsize=7,
                         xytext=(3, 3), textcoords="offset points")
         ax.axhline(tolerance, color="tab:red", lw=0.8, ls="--", label=f"{tolerance} dB")

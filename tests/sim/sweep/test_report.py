@@ -107,3 +107,21 @@ size = "4x4"
     assert "LUT4/lane" in text and "PSNR cost against state memory" in text
     assert info["lut4_per_lane"] == min(d.lut4_per_lane for d in designs)
     assert info["memory_bits"] == by_acc[18].memory_bits
+
+
+def test_pareto_figure_numbers_points_as_the_report_tables():
+    from rvsm.sim.sweep.report import DesignSummary
+
+    def design(n, lut4, memory, cost):
+        return DesignSummary(f"d{n}", {}, {"n": n}, "", "dog4", [], cost, cost, cost, 0.0,
+                             1.0, 0.0, lut4, lut4, None, memory, 0)
+
+    # sorted by logic (as summarise returns them), memory in the opposite order: the
+    # memory panel's M1, M2, M3 must follow memory, as the report's M table does
+    designs = [design(1, 100, 20e6, 0.1), design(2, 200, 10e6, 0.5),
+               design(3, 300, 5e6, 1.0)]
+    fig = pareto_figure(designs)
+    for ax, prefix, count in ((fig.axes[0], "P", 1), (fig.axes[1], "M", 3)):
+        at = {t.get_text(): t.xy[0] for t in ax.texts}
+        xs = [at[f"{prefix}{i}"] for i in range(1, count + 1)]
+        assert len(at) == count and xs == sorted(xs)
