@@ -29,6 +29,17 @@ DEFAULT_TILE_ROWS = 16
 DEFAULT_CHUNK_STEPS = 256
 
 
+def chunk_frames(scene: Scene, t0: int, t1: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What a fused kernel needs for steps ``t0 .. t1 - 1``: the scene's frames the chunk
+    touches ``(F, H, W)``, each step's first frame as an index into them ``(T,) int64``
+    and its interpolation weight ``(T,) float64`` (:meth:`Scene.frame_weights`)."""
+    f, a = scene.frame_weights(t0, t1)
+    first = int(f[0])
+    last = min(int(f[-1]) + 1, scene.num_frames - 1)
+    return (scene.frames[first:last + 1], (f - first).astype(np.int64),
+            np.ascontiguousarray(a, dtype=np.float64))
+
+
 @njit(inline="always", cache=True)
 def _row_pairs(pad, nrows, lmax, width, pairs):
     """``pairs[b, r, x] = pad[r, x + L - b] + pad[r, x + L + b]`` (``b = 0``: the value)."""
@@ -218,10 +229,7 @@ class FusedFloatSampler:
         if t0 != self.next_step:
             raise ValueError(f"chunks must be consecutive: expected step {self.next_step}")
         scene = self.scene
-        f, a = scene.frame_weights(t0, t1)
-        first = int(f[0])
-        last = min(int(f[-1]) + 1, scene.num_frames - 1)
-        frames = scene.frames[first:last + 1]
+        frames, fidx, aw = chunk_frames(scene, t0, t1)
         if self.lmax == 0:  # FSM: 0 + 1.0 * v is v
             kf = frames[:, None]
         else:
@@ -236,7 +244,7 @@ class FusedFloatSampler:
         if out is None:
             out = np.empty((t1 - t0, s, h, w), dtype=np.int8)
         _float_chunk(
-            kf, (f - first).astype(np.int64), np.ascontiguousarray(a, dtype=np.float64),
+            kf, fidx, aw,
             self.thr, self.acc, self.signed, self.zero_reset, self.noisy, self.key,
             int(t0), self.mean, self.sd, ZIG_X, ZIG_RATIO, self.weights, self.halves,
             self.lmax, self.tile_rows, out,

@@ -28,7 +28,7 @@ from numba import njit, prange, types
 from numba.extending import overload
 
 from ..errors import RvsmError
-from ..fused import _row_pairs, _scale_sum
+from ..fused import _row_pairs, _scale_sum, chunk_frames
 from ..noise_streams import ZIG_RATIO, ZIG_X, check_coordinates, pixel_normal
 from ..orbits import kernel_orbits
 from ..scene import Scene
@@ -293,17 +293,13 @@ class FusedFixedTwin:
         """Spikes ``(t1 - t0, S, H, W) int8`` of steps ``t0 .. t1 - 1``."""
         if t0 != self.next_step:
             raise ValueError(f"chunks must be consecutive: expected step {self.next_step}")
-        scene = self.scene
-        f, a = scene.frame_weights(t0, t1)
-        first = int(f[0])
-        last = min(int(f[-1]) + 1, scene.num_frames - 1)
-        frames = scene.frames[first:last + 1]
+        frames, fidx, aw = chunk_frames(self.scene, t0, t1)
         s, h, w = self.acc.shape
         if out is None:
             out = np.empty((t1 - t0, s, h, w), dtype=np.int8)
         analog_range = np.zeros((self._stats.shape[0], 2))
         _fixed_chunk(
-            frames, (f - first).astype(np.int64), np.ascontiguousarray(a, dtype=np.float64),
+            frames, fidx, aw,
             self.thr, self.acc, self.weights, self.halves, self.lmax, self.gain, self.half,
             self.top, self.shift, self.scale, self.lo, self.hi, self.signed, self.zero_reset,
             self.noisy, self.key, int(t0), self.mean, self.sd, ZIG_X, ZIG_RATIO, self.tile_rows,
