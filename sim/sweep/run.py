@@ -213,12 +213,14 @@ def _execute(spec, store, pending, hw_todo, digests, summary, workers, scheduler
              on_result, processes) -> None:
     from tqdm import tqdm
 
-    total = len(pending) + len(hw_todo) * len(spec.hardware.lanes)
-    bar = tqdm(total=total, desc="sweep", unit="task", disable=not progress, smoothing=0.1)
     run = spec.run
     args = (run.frames, run.steps_per_frame, run.method, run.match)
-
     hw = spec.hardware
+    # one synthesis task per (design digest, lane count); a digest's row is written when
+    # all of its lane counts are in
+    syntheses = [((dig, lanes), point) for dig, point in hw_todo.items() for lanes in hw.lanes]
+    total = len(pending) + len(syntheses)
+    bar = tqdm(total=total, desc="sweep", unit="task", disable=not progress, smoothing=0.1)
     halves: dict[str, dict[int, dict[str, Any]]] = {dig: {} for dig in hw_todo}
     failed: set[str] = set()
 
@@ -251,13 +253,12 @@ def _execute(spec, store, pending, hw_todo, digests, summary, workers, scheduler
     try:
         if workers == 0 and scheduler is None:
             summary.workers = 0
-            for dig, point in hw_todo.items():
-                for lanes in hw.lanes:
-                    _call(finished, "hw", (dig, lanes), synthesise_task, point, hw, lanes)
+            for (dig, lanes), point in syntheses:
+                _call(finished, "hw", (dig, lanes), synthesise_task, point, hw, lanes)
             for t in pending:
                 _call(finished, "pt", t, evaluate_task, t, *args)
         else:
-            _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
+            _dask(spec, pending, syntheses, args, finished, summary, workers, scheduler,
                   processes)
     finally:
         bar.close()
@@ -290,7 +291,7 @@ def local_cluster(workers: int, processes: bool = True):
                         worker_dashboard_address=f"{LOCAL_HOST}:0", silence_logs=logging.ERROR)
 
 
-def _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
+def _dask(spec, pending, syntheses, args, finished, summary, workers, scheduler,
           processes) -> None:
     from dask.distributed import Client, as_completed
 
@@ -315,12 +316,11 @@ def _dask(spec, pending, hw_todo, args, finished, summary, workers, scheduler,
         items = {}
         # The longest tasks first (syntheses, one per lane count), the short evaluations
         # last, so they fill the workers' tails.
-        for dig, point in hw_todo.items():
-            for lanes in spec.hardware.lanes:
-                f = client.submit(synthesise_task, point, spec.hardware, lanes,
-                                  key=f"hw-{dig}-p{lanes}", priority=10)
-                items[f.key] = ("hw", (dig, lanes))
-                futures.append(f)
+        for (dig, lanes), point in syntheses:
+            f = client.submit(synthesise_task, point, spec.hardware, lanes,
+                              key=f"hw-{dig}-p{lanes}", priority=10)
+            items[f.key] = ("hw", (dig, lanes))
+            futures.append(f)
         for t in pending:
             f = client.submit(evaluate_task, t, *args, key=f"pt-{t.point_id}")
             items[f.key] = ("pt", t)
