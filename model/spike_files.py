@@ -107,10 +107,9 @@ def export_dat(path: str | os.PathLike, spikes: np.ndarray, flip: bool = False) 
         packed.tofile(tmp)
 
 
-def import_dat(
-    path: str | os.PathLike, height: int, width: int, flip: bool = False
-) -> np.ndarray:
-    """Read a camera ``.dat`` file into spikes ``(T, 1, H, W) int8``."""
+def dat_steps(path: str | os.PathLike, height: int, width: int) -> np.ndarray:
+    """The steps of a camera ``.dat`` file, checked against ``height x width``, as a
+    read-only memory map ``(T, H*W/8) uint8`` (one row of packed bits per step)."""
     path = Path(path)
     if not path.is_file():
         raise RvsmError(f".dat file {path} does not exist")
@@ -119,16 +118,29 @@ def import_dat(
             f".dat size {height}x{width} invalid: H*W must be positive and divisible by 8"
         )
     step_bytes = height * width // 8
-    require_memory(9 * path.stat().st_size, f"{path} (one int8 per pixel)",
-                   "split the .dat file into shorter recordings")
-    raw = np.fromfile(path, dtype=np.uint8)
-    if raw.size == 0 or raw.size % step_bytes:
+    size = path.stat().st_size
+    if size == 0 or size % step_bytes:
         raise RvsmError(
-            f"{path} is truncated or not {height}x{width}: {raw.size} bytes is not a whole "
+            f"{path} is truncated or not {height}x{width}: {size} bytes is not a whole "
             f"number of steps of {step_bytes} bytes; check --size"
         )
-    bits = np.unpackbits(raw.reshape(-1, step_bytes), axis=1, bitorder="little")
+    return np.memmap(path, dtype=np.uint8, mode="r").reshape(-1, step_bytes)
+
+
+def unpack_dat(rows: np.ndarray, height: int, width: int, flip: bool = False) -> np.ndarray:
+    """Spikes ``(T, 1, H, W) int8`` of ``.dat`` step rows ``(T, H*W/8) uint8``."""
+    bits = np.unpackbits(np.asarray(rows), axis=1, bitorder="little")
     frames = bits.reshape(-1, height, width)
     if flip:
         frames = frames[:, ::-1]
     return np.ascontiguousarray(frames[:, None]).astype(np.int8)
+
+
+def import_dat(
+    path: str | os.PathLike, height: int, width: int, flip: bool = False
+) -> np.ndarray:
+    """Read a camera ``.dat`` file into spikes ``(T, 1, H, W) int8``."""
+    raw = dat_steps(path, height, width)
+    require_memory(9 * raw.size, f"{path} (one int8 per pixel)",
+                   "split the .dat file into shorter recordings")
+    return unpack_dat(raw, height, width, flip)

@@ -31,7 +31,7 @@ import numpy as np
 
 from .atomic import _UMASK
 from .errors import RvsmError
-from .spike_files import _check_spikes, load_spikes
+from .spike_files import _check_spikes, dat_steps, load_spikes, unpack_dat
 from .spike_packing import pack_spikes, packed_width, unpack_spikes
 from .versions import with_versions
 
@@ -301,28 +301,10 @@ def dat_source(path: str | os.PathLike, height: int, width: int,
                flip: bool = False) -> SpikeSource:
     """A camera ``.dat`` file as a :class:`SpikeSource` of ``(T, 1, H, W)`` spikes, read
     step range by step range (memory-mapped)."""
-    path = Path(path)
-    if not path.is_file():
-        raise RvsmError(f".dat file {path} does not exist")
-    if height < 1 or width < 1 or (height * width) % 8:
-        raise RvsmError(
-            f".dat size {height}x{width} invalid: H*W must be positive and divisible by 8"
-        )
-    step_bytes = height * width // 8
-    size = path.stat().st_size
-    if size == 0 or size % step_bytes:
-        raise RvsmError(
-            f"{path} is truncated or not {height}x{width}: {size} bytes is not a whole "
-            f"number of steps of {step_bytes} bytes; check --size"
-        )
-    raw = np.memmap(path, dtype=np.uint8, mode="r").reshape(-1, step_bytes)
+    raw = dat_steps(path, height, width)
 
     def read(t0: int, t1: int) -> np.ndarray:
-        bits = np.unpackbits(np.asarray(raw[t0:t1]), axis=1, bitorder="little")
-        frames = bits.reshape(-1, height, width)
-        if flip:
-            frames = frames[:, ::-1]
-        return np.ascontiguousarray(frames[:, None]).astype(np.int8)
+        return unpack_dat(raw[t0:t1], height, width, flip)
 
     return SpikeSource((raw.shape[0], 1, height, width), {}, read, None, str(path))
 
