@@ -7,17 +7,22 @@
   test), so a failing RTL test can be opened in a waveform viewer.
 - :func:`cosim_work` / :func:`rtl_builds`: a work folder per worker and a Verilog build
   cache shared by every pytest-xdist worker of the session.
+- :func:`fsm_point` / :func:`fake_tool`: the smallest design point for the FPGA flow, and
+  stand-in tool scripts for its failure paths.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import re
+import stat
 from collections.abc import Awaitable, Callable
 from pathlib import Path
 
 import pytest
 
 from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.design_point import DesignPoint, default_design_point
 from rvsm.model.fixed.weights import quantise_model
 
 
@@ -90,3 +95,22 @@ def rtl_builds(tmp_path_factory: pytest.TempPathFactory) -> Path:
     base = tmp_path_factory.getbasetemp()
     root = base.parent if base.name.startswith("popen-gw") else base
     return root / "rvsm-builds"
+
+
+@pytest.fixture
+def fsm_point() -> DesignPoint:
+    """The default design point with the FSM model: the smallest RTL, for tool flows."""
+    return dataclasses.replace(default_design_point(), model="fsm")
+
+
+@pytest.fixture
+def fake_tool() -> Callable[[Path, str], Path]:
+    """Factory ``fake_tool(path, body)``: an executable ``/bin/sh`` script at ``path``
+    running ``body``, standing in for yosys or nextpnr."""
+
+    def make(path: Path, body: str) -> Path:
+        path.write_text("#!/bin/sh\n" + body)
+        path.chmod(path.stat().st_mode | stat.S_IXUSR)
+        return path
+
+    return make

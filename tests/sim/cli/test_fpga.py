@@ -2,15 +2,12 @@
 
 from __future__ import annotations
 
-import dataclasses
 import json
-import stat
 from pathlib import Path
 
 import pytest
 
 from rvsm.model.errors import ToolError
-from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.fixed.point_toml import save_design_point
 from rvsm.rtl.fpga.flow import run_fpga
 from rvsm.sim.cli import main
@@ -18,18 +15,9 @@ from rvsm.sim.cli import main
 TINY = (2, 2)
 
 
-def _point():
-    return dataclasses.replace(default_design_point(), model="fsm")
-
-
-def _script(path: Path, body: str) -> Path:
-    path.write_text("#!/bin/sh\n" + body)
-    path.chmod(path.stat().st_mode | stat.S_IXUSR)
-    return path
-
-
-def test_cli_synth_only_json(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
-    save_design_point(tmp_path / "p.toml", _point())
+def test_cli_synth_only_json(tmp_path: Path, capsys: pytest.CaptureFixture,
+                             fsm_point) -> None:
+    save_design_point(tmp_path / "p.toml", fsm_point)
     code = main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",
                  "--synth-only", "--json", "--rtlil", "-o", str(tmp_path / "w")])
     out, err = capsys.readouterr()
@@ -42,12 +30,13 @@ def test_cli_synth_only_json(tmp_path: Path, capsys: pytest.CaptureFixture) -> N
 
 
 def test_failing_tool_is_a_tool_error_and_exit_3(tmp_path: Path, capsys: pytest.CaptureFixture,
-                                                 monkeypatch: pytest.MonkeyPatch) -> None:
-    fake = _script(tmp_path / "fake-yosys", "echo 'ERROR: something broke'\nexit 1\n")
+                                                 monkeypatch: pytest.MonkeyPatch,
+                                                 fsm_point, fake_tool) -> None:
+    fake = fake_tool(tmp_path / "fake-yosys", "echo 'ERROR: something broke'\nexit 1\n")
     monkeypatch.setenv("RVSM_YOSYS", str(fake))
     with pytest.raises(ToolError, match="exit 1.*something broke"):
-        run_fpga(_point(), tmp_path / "a", arch="parallel", size=TINY, synth_only=True)
-    save_design_point(tmp_path / "p.toml", _point())
+        run_fpga(fsm_point, tmp_path / "a", arch="parallel", size=TINY, synth_only=True)
+    save_design_point(tmp_path / "p.toml", fsm_point)
     code = main(["fpga", str(tmp_path / "p.toml"), "--size", "2x2", "--arch", "parallel",
                  "--synth-only", "--quiet", "-o", str(tmp_path / "b")])
     _, err = capsys.readouterr()
@@ -58,8 +47,8 @@ def test_failing_tool_is_a_tool_error_and_exit_3(tmp_path: Path, capsys: pytest.
                  "--synth-only", "--quiet", "-o", str(tmp_path / "c")]) == 3
 
 
-def test_bad_input_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
-    save_design_point(tmp_path / "p.toml", _point())
+def test_bad_input_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture, fsm_point) -> None:
+    save_design_point(tmp_path / "p.toml", fsm_point)
     assert main(["fpga", str(tmp_path / "p.toml"), "--lanes", "0", "--arch", "parallel"]) == 2
     assert main(["fpga", str(tmp_path / "p.toml"), "--arch", "stream", "--size", "2x2",
                  "--lanes", "3", "--synth-only", "-o", str(tmp_path / "w")]) == 2
