@@ -15,6 +15,7 @@ import argparse
 import os
 import sqlite3
 import statistics
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -50,6 +51,9 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=1, help="1-worker/2-worker pairs")
     args = parser.parse_args()
     sweep = Path(args.sweep)
+    from rvsm.sim.sweep.spec import load_sweep
+
+    load_sweep(sweep)  # a bad file fails here, before any run
     print(f"{sweep.name}: fresh database per run; {os.cpu_count()} CPUs; load = 1-min load "
           "average at the start of the run; work = sum of the tasks' own seconds")
     print(f"{'round':>5s} {'workers':>7s} {'wall s':>7s} {'work s':>7s} {'start-up s':>10s} "
@@ -73,4 +77,10 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from rvsm.model.errors import RvsmError
+
+    try:
+        main()
+    except RvsmError as exc:  # a bad sweep file: one line, exit 2 as the CLI does
+        print(f"bench_sweep: error: {exc}", file=sys.stderr)
+        sys.exit(2)
