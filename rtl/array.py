@@ -36,10 +36,9 @@ from amaranth.lib.wiring import In, Out
 
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.widths import index_bits, unsigned_max
-
-from .interfaces import ThresholdWriteSignature
-from .pixel_cell import PixelCell
-from .receptive_sum import sum_width, weighted_sum
+from rvsm.rtl.interfaces import ThresholdWriteSignature
+from rvsm.rtl.pixel_cell import PixelCell
+from rvsm.rtl.receptive_sum import sum_width, weighted_sum
 
 __all__ = ["RvsmArray", "accumulator_index", "simulate"]
 

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from amaranth.hdl import Cat, Const, Module, Signal, Value, unsigned
 
-from .receptive_sum import csd_digits
+from rvsm.rtl.receptive_sum import csd_digits
 
 __all__ = ["Orbit", "Pipeline", "Timed", "kernel_orbits", "kernel_radius", "orbit_terms"]
 

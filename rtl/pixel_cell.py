@@ -24,8 +24,7 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from rvsm.model.fixed.widths import signed_range
-
-from .interfaces import ThresholdWriteSignature
+from rvsm.rtl.interfaces import ThresholdWriteSignature
 
 __all__ = ["PixelCell"]
 

@@ -80,13 +80,12 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
-
-from .interfaces import ThresholdWriteSignature
-from .pipelined_sum import Pipeline, Timed, kernel_orbits, kernel_radius, orbit_terms
-from .receptive_sum import sum_width
-from .stream_schedule import OutputBeats, StreamSchedule, pack_lanes
+from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.interfaces import ThresholdWriteSignature
+from rvsm.rtl.pipelined_sum import Pipeline, Timed, kernel_orbits, kernel_radius, orbit_terms
+from rvsm.rtl.receptive_sum import sum_width
+from rvsm.rtl.stream_schedule import OutputBeats, StreamSchedule, pack_lanes
 
 __all__ = [
     "RvsmStreamArray",

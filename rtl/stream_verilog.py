@@ -25,13 +25,12 @@ from pathlib import Path
 
 from amaranth.back import verilog as amaranth_verilog
 
-from rvsm.model.atomic import write_text_atomic
 from rvsm.model.fixed.core import ArrayContract
-
-from .ports import port_map as signature_port_map
-from .ports import verilog_ports
-from .stream_array import RvsmStreamArray, StreamGeometry
-from .verilog import GeneratedVerilog, check_top
+from rvsm.model.infra.atomic import write_text_atomic
+from rvsm.rtl.ports import port_map as signature_port_map
+from rvsm.rtl.ports import verilog_ports
+from rvsm.rtl.stream_array import RvsmStreamArray, StreamGeometry
+from rvsm.rtl.verilog import GeneratedVerilog, check_top
 
 __all__ = [
     "STREAM_TOP",

@@ -23,14 +23,13 @@ from pathlib import Path
 
 from amaranth.back import verilog as amaranth_verilog
 
-from rvsm.model.atomic import write_text_atomic
-from rvsm.model.errors import RvsmError, ToolError
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.processes import ToolFailure, run_tool
-
-from .array import RvsmArray
-from .ports import port_map as signature_port_map
-from .ports import verilog_ports
+from rvsm.model.infra.atomic import write_text_atomic
+from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.model.infra.tools import ToolFailure, run_tool
+from rvsm.rtl.array import RvsmArray
+from rvsm.rtl.ports import port_map as signature_port_map
+from rvsm.rtl.ports import verilog_ports
 
 __all__ = [
     "LINT_WAIVERS",
@@ -174,7 +173,7 @@ def verilator_lint(verilog_path: str | os.PathLike, top: str = DEFAULT_TOP) -> s
     """``verilator --lint-only -Wall`` with :data:`LINT_WAIVERS`; returns its output.
 
     Raises :class:`RvsmError` (with the output) if Verilator reports anything, a
-    :class:`~rvsm.model.processes.ToolFailure` if it crashes or is killed.
+    :class:`~rvsm.model.infra.tools.ToolFailure` if it crashes or is killed.
     """
     env = verilator_env()
     cmd = ["verilator", "--lint-only", "-Wall", *LINT_WAIVERS, "--top-module", check_top(top),
@@ -198,7 +197,7 @@ def yosys_stats(verilog_path: str | os.PathLike, top: str = DEFAULT_TOP) -> dict
     The Verilog path reaches yosys as its own argument (never inside the script text), so
     any path works and none is interpreted. Returns ``{"cells", "flip_flops",
     "cell_types", "seconds"}``. Raises :class:`RvsmError` if ``yosys`` is missing, a
-    :class:`~rvsm.model.processes.ToolFailure` (exit 3) if it fails or is killed.
+    :class:`~rvsm.model.infra.tools.ToolFailure` (exit 3) if it fails or is killed.
     """
     exe = shutil.which("yosys")
     if exe is None:

@@ -77,7 +77,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    from rvsm.model.errors import RvsmError
+    from rvsm.model.infra.errors import RvsmError
 
     try:
         main()

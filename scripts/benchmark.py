@@ -29,10 +29,10 @@ import numba
 
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.fused import stream_fixed
-from rvsm.model.noise import NoiseParams
-from rvsm.model.samplers import SamplerConfig
-from rvsm.model.sampling_stream import stream_float
-from rvsm.model.scene_library import builtin_scene
+from rvsm.model.noise.sensor import NoiseParams
+from rvsm.model.sampling.samplers import SamplerConfig
+from rvsm.model.sampling.stream import stream_float
+from rvsm.model.scene.library import builtin_scene
 
 #: (label, kind, model, noise) -> target acc-steps/s (None: no target)
 CASES = [

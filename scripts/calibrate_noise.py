@@ -3,7 +3,7 @@
 Usage: ``.venv/bin/python scripts/calibrate_noise.py [--size 250x400] [--frames 41]
 [--steps-per-frame 10] [--seed 0] [-o docs/reproduction/noise-calibration.json]``.
 Prints ``D(k)`` for every evaluated ``k`` and the chosen ``k``; the rule is in
-:mod:`rvsm.model.noise_calibration`. Defaults are those of ``rvsm table``.
+:mod:`rvsm.sim.studies.noise_calibration`. Defaults are those of ``rvsm table``.
 """
 
 from __future__ import annotations
@@ -12,8 +12,9 @@ import argparse
 import json
 import time
 
-from rvsm.model.atomic import write_text_atomic
-from rvsm.model.noise_calibration import (
+from rvsm.model.infra.atomic import write_text_atomic
+from rvsm.sim.cli.studies import TABLE_FRAMES, TABLE_STEPS_PER_FRAME, scored_size
+from rvsm.sim.studies.noise_calibration import (
     DEFAULT_GRID,
     DEFAULT_REFINE,
     calibrate_k,
@@ -21,7 +22,6 @@ from rvsm.model.noise_calibration import (
     fsm_ssim_drop,
     paper_fsm_ssim_drop,
 )
-from rvsm.sim.cli.studies import TABLE_FRAMES, TABLE_STEPS_PER_FRAME, scored_size
 from rvsm.sim.studies.table import load_scenes
 
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""Write ``model/orbit_kernels.py``: the per-half-width orbit sums, unrolled for numba.
+"""Write ``model/sampling/orbit_kernels.py``: the per-half-width orbit sums, unrolled for numba.
 
 Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
-``model/orbits.py``; ``tests/model/test_fused.py`` checks the file is up to date.
+``model/kernels/orbits.py``; ``tests/model/sampling/test_fused.py`` checks the file is up to date.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ HEADER = '''"""Unrolled orbit sums for numba (written by scripts/gen_orbit_kerne
 ``scale_sum_L(pairs, pr, w, width, out)``: ``out[x]`` = the receptive sum of padded row
 ``pr`` for one scale of half-width ``L`` with orbit weights ``w``, where
 ``pairs[b, r, x] = v(r, x - b) + v(r, x + b)`` (``pairs[0] = v``); the same float
-operations in the same order as :func:`rvsm.model.orbits.orbit_receptive_sums` (``t``
+operations in the same order as :func:`rvsm.model.kernels.orbits.orbit_receptive_sums` (``t``
 starts at ``w[0] - w[0]``, i.e. 0 of the weights' type, so the same code sums integers
 exactly for the fixed twin). The weighted sum stays in a register, so the loop over
 ``x`` vectorises.
@@ -73,7 +73,7 @@ def generate() -> str:
 
 
 def main() -> None:
-    target = Path(__file__).resolve().parent.parent / "model" / "orbit_kernels.py"
+    target = Path(__file__).resolve().parent.parent / "model" / "sampling" / "orbit_kernels.py"
     target.write_text(generate())
     print(f"wrote {target}", file=sys.stderr)
 

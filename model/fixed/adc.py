@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import RvsmError
-from .widths import unsigned_max
+from rvsm.model.fixed.widths import unsigned_max
+from rvsm.model.infra.errors import RvsmError
 
 ROUNDINGS = ("truncate", "round-half-up")
 ADC_CLIPS = ("saturate", "error")

@@ -23,9 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import RvsmError
-from ..samplers import RESET_MODES
-from .widths import signed_range, unsigned_max
+from rvsm.model.fixed.widths import signed_range, unsigned_max
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.sampling.samplers import RESET_MODES
 
 
 def integer_receptive_sums(codes: np.ndarray, weights: Sequence[np.ndarray]) -> np.ndarray:

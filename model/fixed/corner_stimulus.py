@@ -18,10 +18,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import RvsmError
-from .core import ArrayContract, FixedIntegrator, arithmetic_shift, integer_receptive_sums
-from .stimulus import Stimulus
-from .widths import signed_range, unsigned_max
+from rvsm.model.fixed.core import (
+    ArrayContract,
+    FixedIntegrator,
+    arithmetic_shift,
+    integer_receptive_sums,
+)
+from rvsm.model.fixed.stimulus import Stimulus
+from rvsm.model.fixed.widths import signed_range, unsigned_max
+from rvsm.model.infra.errors import RvsmError
 
 __all__ = ["BINS", "corner_stimulus", "coverage", "coverage_summary"]
 

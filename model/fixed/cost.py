@@ -2,7 +2,7 @@
 
 Both run on the same scene with the same seed and noise (the float sampler with
 ``point.sampler_config()``); both are scored with
-:func:`~rvsm.model.evaluation.evaluate_spikes` using the nominal float thresholds.
+:func:`~rvsm.model.decode.evaluation.evaluate_spikes` using the nominal float thresholds.
 
 Spike agreement (:func:`spike_agreement`): over every (step, scale, pixel) where either
 model fired, the fraction where both fired the same spike (+1 or -1), i.e.
@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..samplers import sample
-from ..scene import Scene
-from .design_point import DesignPoint
-from .twin import fit_point, simulate_fixed
+from rvsm.model.fixed.design_point import DesignPoint
+from rvsm.model.fixed.twin import fit_point, simulate_fixed
+from rvsm.model.sampling.samplers import sample
+from rvsm.model.scene.scene import Scene
 
 
 def spike_agreement(fixed: np.ndarray, float_: np.ndarray) -> dict:
@@ -61,7 +61,7 @@ def quantisation_cost(
     ``ssim_cost``, ``mse_float``, ``mse_fixed``, ``saturated`` (per scale), ``method``,
     ``scene``, ``model``, ``height``, ``width``, ``steps``, ``design_point``.
     """
-    from ..evaluation import evaluate_spikes
+    from rvsm.model.decode.evaluation import evaluate_spikes
 
     point = fit_point(scene, point)
     config = point.sampler_config()

@@ -24,16 +24,9 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import RvsmError
-from ..kernels import MODEL_NAMES, ModelSpec, model_spec
-from ..noise import MAX_K, NoiseParams, NoiseSource
-from ..noise_presets import NOISE_PRESETS, preset_noise
-from ..samplers import RESET_MODES, SamplerConfig
-from ..scene_library import SCENE_NAMES
-from ..thresholds import DEFAULT_CALIBRATION_SCENE, THRESHOLD_RULES, calibration_thresholds
-from .adc import ADC_CLIPS, ROUNDINGS, adc_gain
-from .core import ArrayContract
-from .fields import (
+from rvsm.model.fixed.adc import ADC_CLIPS, ROUNDINGS, adc_gain
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.fields import (
     Choice,
     Field,
     Flag,
@@ -44,8 +37,19 @@ from .fields import (
     declare,
     fields_of,
 )
-from .weights import quantise_model
-from .widths import signed_bits, signed_range
+from rvsm.model.fixed.weights import quantise_model
+from rvsm.model.fixed.widths import signed_bits, signed_range
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kernels.receptive_fields import MODEL_NAMES, ModelSpec, model_spec
+from rvsm.model.noise.presets import NOISE_PRESETS, preset_noise
+from rvsm.model.noise.sensor import MAX_K, NoiseParams, NoiseSource
+from rvsm.model.sampling.samplers import RESET_MODES, SamplerConfig
+from rvsm.model.sampling.thresholds import (
+    DEFAULT_CALIBRATION_SCENE,
+    THRESHOLD_RULES,
+    calibration_thresholds,
+)
+from rvsm.model.scene.library import SCENE_NAMES
 
 THRESHOLD_ROUNDINGS = ("ceil", "round-half-up", "truncate")
 MAX_ADC_BITS = 16
@@ -206,7 +210,7 @@ class DesignPoint:
         """Nominal float threshold per scale, ``(S,) float64`` (8-bit brightness units):
         ``scale_phi``, or under ``threshold.rule = "response"`` the response-rule
         thresholds on ``threshold.calibration_scene`` at this size
-        (:func:`rvsm.model.thresholds.calibration_thresholds`), else ``phi``."""
+        (:func:`rvsm.model.sampling.thresholds.calibration_thresholds`), else ``phi``."""
         if self.scale_phi is not None:
             return np.array(self.scale_phi, dtype=np.float64)
         if self.rule == "response":
@@ -264,7 +268,7 @@ class DesignPoint:
 
     def noise_params(self) -> NoiseParams | None:
         """The float model's noise parameters (SPEC defaults, this point's k and seed; a
-        ``noise.preset`` replaces k, :mod:`rvsm.model.noise_presets`)."""
+        ``noise.preset`` replaces k, :mod:`rvsm.model.noise.presets`)."""
         if not self.noise:
             return None
         if self.noise_preset is not None:

@@ -21,7 +21,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ..errors import RvsmError
+from rvsm.model.infra.errors import RvsmError
 
 __all__ = [
     "Choice", "Field", "Flag", "Integer", "Kind", "Number", "OptionalChoice",

@@ -3,9 +3,9 @@
 :class:`FusedFixedTwin` runs a design point chunk by chunk; :func:`_fixed_chunk` processes
 tiles of rows in parallel and, inside a tile, loops over the chunk's steps: interpolate the
 brightness of the tile's rows plus a halo of ``L`` rows (SPEC section 1's expression), add
-the dark current (counter-based streams, :mod:`rvsm.model.noise_streams`), ADC (the
+the dark current (counter-based streams, :mod:`rvsm.model.noise.streams`), ADC (the
 rounding and clipping of :mod:`.adc`), exact receptive sums with the integer weights
-(orbit sums, :mod:`rvsm.model.orbit_kernels`), arithmetic right shift (floor division by
+(orbit sums, :mod:`rvsm.model.sampling.orbit_kernels`), arithmetic right shift (floor division by
 ``2**shift``), W-bit saturating accumulators, compare with the integer thresholds, reset.
 
 Exact integers: the integer arithmetic runs in the narrowest type that holds every
@@ -27,12 +27,12 @@ import numpy as np
 from numba import njit, prange, types
 from numba.extending import overload
 
-from ..errors import RvsmError
-from ..fused import _row_pairs, _scale_sum, chunk_frames
-from ..noise_streams import ZIG_RATIO, ZIG_X, check_coordinates, pixel_normal
-from ..orbits import kernel_orbits
-from ..scene import Scene
-from .widths import signed_range
+from rvsm.model.fixed.widths import signed_range
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kernels.orbits import kernel_orbits
+from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, check_coordinates, pixel_normal
+from rvsm.model.sampling.fused import _row_pairs, _scale_sum, chunk_frames
+from rvsm.model.scene.scene import Scene
 
 #: integers of magnitude below ``2**bits`` are exact in the type (its mantissa + 1 bits)
 EXACT_BITS = {np.float32: 24, np.float64: 53}
@@ -354,12 +354,12 @@ def stream_fixed(
     skips the min/max datapath statistics of the fused engine (they stay None; the
     saturation counts are always kept): about 1.5x faster.
     """
-    from ..progress import progress_bar
-    from ..samplers import ENGINES
-    from ..sampling_stream import check_chunking, run_chunks
-    from .adc import adc_codes
-    from .core import FixedIntegrator, arithmetic_shift, integer_receptive_sums
-    from .twin import FixedRun, FixedStats, fit_point, fixed_meta
+    from rvsm.model.fixed.adc import adc_codes
+    from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift, integer_receptive_sums
+    from rvsm.model.fixed.twin import FixedRun, FixedStats, fit_point, fixed_meta
+    from rvsm.model.infra.progress import progress_bar
+    from rvsm.model.sampling.samplers import ENGINES
+    from rvsm.model.sampling.stream import check_chunking, run_chunks
 
     if engine not in ENGINES:
         raise RvsmError(f"engine must be one of {ENGINES}, got {engine!r}")

@@ -20,11 +20,11 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-from ..atomic import write_text_atomic
-from ..errors import RvsmError
-from ..text_files import read_utf8_text
-from ..thresholds import DEFAULT_CALIBRATION_SCENE
-from .design_point import FIELDS, DesignPoint
+from rvsm.model.fixed.design_point import FIELDS, DesignPoint
+from rvsm.model.infra.atomic import write_text_atomic
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.text_files import read_utf8_text
+from rvsm.model.sampling.thresholds import DEFAULT_CALIBRATION_SCENE
 
 __all__ = [
     "SECTION_COMMENTS", "design_point_toml", "from_toml_dict", "load_design_point",

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import RvsmError
-from .twin import FixedRun
-from .weights import weight_error_report
-from .widths import signed_range
+from rvsm.model.fixed.twin import FixedRun
+from rvsm.model.fixed.weights import weight_error_report
+from rvsm.model.fixed.widths import signed_range
+from rvsm.model.infra.errors import RvsmError
 
 
 def profile_report(run: FixedRun) -> dict:

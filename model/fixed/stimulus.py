@@ -31,15 +31,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_path
-from ..errors import RvsmError
-from ..npy_guard import check_npz_members
-from ..scene import Scene
-from ..versions import with_versions
-from .core import ArrayContract
-from .design_point import DesignPoint
-from .point_toml import design_point_toml, parse_design_point
-from .twin import simulate_fixed
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.design_point import DesignPoint
+from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
+from rvsm.model.fixed.twin import simulate_fixed
+from rvsm.model.infra.atomic import atomic_path
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.npy_guard import check_npz_members
+from rvsm.model.infra.versions import with_versions
+from rvsm.model.scene.scene import Scene
 
 STIMULUS_KEYS = (
     "codes", "thresholds", "spikes", "weights", "half_widths", "contract", "point", "meta",

@@ -4,7 +4,7 @@ Per step ``t``: analogue brightness ``I_t`` (+ dark current, when the point has 
 ADC codes (:mod:`.adc`) -> exact integer receptive-field sums with the quantised weights
 -> arithmetic right shift -> W-bit saturating accumulators -> compare with each
 accumulator's integer threshold -> spike +1 / -1 -> reset (:mod:`.core`). The noise comes
-from the same :class:`~rvsm.model.noise.NoiseSource` (same seed, same streams) as the float
+from the same :class:`~rvsm.model.noise.sensor.NoiseSource` (same seed, same streams) as the float
 sampler, so float and fixed see identical analogue noise.
 
 Two engines with identical spikes and statistics: ``"fused"`` (default; numba, the time
@@ -20,20 +20,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..memory import require_spike_memory
-from ..noise import NoiseSource
-from ..progress import progress_bar
-from ..samplers import DEFAULT_BLOCK_STEPS, sampling_meta
-from ..scene import Scene
-from .adc import adc_codes
-from .core import (
+from rvsm.model.fixed.adc import adc_codes
+from rvsm.model.fixed.core import (
     ArrayContract,
     FixedIntegrator,
     arithmetic_shift,
     bit_length_histogram,
     integer_receptive_sums,
 )
-from .design_point import DesignPoint
+from rvsm.model.fixed.design_point import DesignPoint
+from rvsm.model.infra.memory import require_spike_memory
+from rvsm.model.infra.progress import progress_bar
+from rvsm.model.noise.sensor import NoiseSource
+from rvsm.model.sampling.samplers import DEFAULT_BLOCK_STEPS, sampling_meta
+from rvsm.model.scene.scene import Scene
 
 
 @dataclass
@@ -118,15 +118,15 @@ def simulate_fixed(
     ``ranges=False`` lets the fused engine skip the min/max statistics (None then).
     """
     if engine == "fused" and not keep_codes and not histograms:
-        from ..sampling_stream import ArraySink
-        from .fused import stream_fixed
+        from rvsm.model.fixed.fused import stream_fixed
+        from rvsm.model.sampling.stream import ArraySink
 
         sink = ArraySink()
         run = stream_fixed(scene, point, sink, progress=progress, ranges=ranges)
         run.spikes = sink.spikes
         return run
     if engine not in ("fused", "numpy"):
-        from ..errors import RvsmError
+        from rvsm.model.infra.errors import RvsmError
 
         raise RvsmError(f"engine must be fused or numpy, got {engine!r}")
     point = fit_point(scene, point)

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels import model_spec
-from .adc import quantise
-from .widths import signed_range
+from rvsm.model.fixed.adc import quantise
+from rvsm.model.fixed.widths import signed_range
+from rvsm.model.kernels.receptive_fields import model_spec
 
 
 def quantise_kernel(kernel: np.ndarray, frac_bits: int, rounding: str) -> np.ndarray:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from rvsm.model.errors import RvsmError
+from rvsm.model.infra.errors import RvsmError
 
 __all__ = ["BRAM_BITS", "DEVICES", "Device", "get_device"]
 

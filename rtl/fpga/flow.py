@@ -32,16 +32,15 @@ from amaranth.back import rtlil as amaranth_rtlil
 from amaranth.back import verilog as amaranth_verilog
 from amaranth.lib import wiring
 
-from rvsm.model.atomic import write_text_atomic
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
-
-from .devices import Device, get_device
-from .harness import IoHarness
-from .report import FpgaReport, Usage, parse_nextpnr_report, parse_yosys_stat
-from .sensor import state_memory
-from .tools import Progress, find_tool, run_tool
+from rvsm.model.infra.atomic import write_text_atomic
+from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.fpga.devices import Device, get_device
+from rvsm.rtl.fpga.harness import IoHarness
+from rvsm.rtl.fpga.report import FpgaReport, Usage, parse_nextpnr_report, parse_yosys_stat
+from rvsm.rtl.fpga.sensor import state_memory
+from rvsm.rtl.fpga.tools import Progress, find_tool, run_tool
 
 __all__ = [
     "ARCHES",
@@ -233,7 +232,7 @@ def run_fpga(
     ``point`` is the sensor (its height and width give the camera arithmetic and the
     state memory); ``size`` (H, W) overrides the size of the array actually built.
     Products and logs go into ``work_dir``. Raises :class:`RvsmError` for bad input and
-    :class:`~rvsm.model.errors.ToolError` when a tool is missing or fails.
+    :class:`~rvsm.model.infra.errors.ToolError` when a tool is missing or fails.
     """
     dev = get_device(device) if isinstance(device, str) else device
     if speed not in (6, 7, 8):
@@ -283,7 +282,7 @@ def run_fpga(
 
 
 def _read_json(path: Path, what: str) -> dict:
-    from rvsm.model.errors import ToolError
+    from rvsm.model.infra.errors import ToolError
 
     try:
         return json.loads(path.read_text())

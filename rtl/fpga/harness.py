@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from amaranth.hdl import Cat, Const, Elaboratable, Module, Signal, Value, unsigned
 from amaranth.lib import wiring
 
-from rvsm.model.errors import RvsmError
+from rvsm.model.infra.errors import RvsmError
 
 __all__ = [
     "DEFAULT_HOLD_NAMES",

@@ -26,13 +26,12 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.design_point import DesignPoint
-
-from .devices import get_device
-from .flow import build_component, place_and_route, synthesise
-from .sensor import state_memory
-from .tools import Progress
+from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.fpga.devices import get_device
+from rvsm.rtl.fpga.flow import build_component, place_and_route, synthesise
+from rvsm.rtl.fpga.sensor import state_memory
+from rvsm.rtl.fpga.tools import Progress
 
 __all__ = ["DEFAULT_LANES", "DEFAULT_SIZE", "LaneCost", "LaneSynthesis", "combine_lanes",
            "lane_cost", "lane_synthesis", "logic_lut4"]

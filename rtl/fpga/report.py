@@ -18,10 +18,9 @@ import re
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
-from rvsm.model.errors import ToolError
-
-from .devices import Device
-from .sensor import (
+from rvsm.model.infra.errors import ToolError
+from rvsm.rtl.fpga.devices import Device
+from rvsm.rtl.fpga.sensor import (
     CAMERA_STEP_HZ,
     StateMemory,
     clock_needed_hz,

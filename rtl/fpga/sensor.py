@@ -24,8 +24,7 @@ import math
 from dataclasses import asdict, dataclass
 
 from rvsm.model.fixed.core import ArrayContract
-
-from .devices import DEVICES
+from rvsm.rtl.fpga.devices import DEVICES
 
 __all__ = [
     "BRAM_SHAPES",

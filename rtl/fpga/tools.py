@@ -5,10 +5,10 @@ line into a log file, and reports progress on a callback: the tool's current pha
 (recognised from its log lines), elapsed time and an expected total. On an interrupt
 (``KeyboardInterrupt``), a timeout or any other exception the whole process group is
 terminated (``SIGTERM``, then ``SIGKILL``) before the exception propagates: the group is
-:func:`rvsm.model.processes.tracked`, like every other tool the package runs, so the
-CLI's :func:`~rvsm.model.processes.kill_all` stops it too.
+:func:`rvsm.model.infra.tools.tracked`, like every other tool the package runs, so the
+CLI's :func:`~rvsm.model.infra.tools.kill_all` stops it too.
 A tool that is missing, exits non-zero or times out raises
-:class:`~rvsm.model.errors.ToolError` (CLI exit status 3) naming the log file.
+:class:`~rvsm.model.infra.errors.ToolError` (CLI exit status 3) naming the log file.
 
 Tools are found next to the running Python (the virtualenv's ``bin/``), then on
 ``PATH``; the environment variables ``RVSM_YOSYS`` and ``RVSM_NEXTPNR_ECP5`` override
@@ -29,8 +29,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from rvsm.model.errors import ToolError
-from rvsm.model.processes import tracked
+from rvsm.model.infra.errors import ToolError
+from rvsm.model.infra.tools import tracked
 
 __all__ = ["TOOL_ENV", "Progress", "find_tool", "run_tool"]
 

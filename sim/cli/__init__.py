@@ -5,6 +5,6 @@ lists them, in the order ``rvsm --help`` shows them. To add a command, write its
 here and add it to that list.
 """
 
-from .main import build_parser, main
+from rvsm.sim.cli.main import build_parser, main
 
 __all__ = ["build_parser", "main"]

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import argparse
 
-from rvsm.model.errors import RvsmError
-from rvsm.model.noise import NoiseParams
-from rvsm.model.noise_presets import NOISE_PRESETS, preset_noise
-from rvsm.model.scene import DEFAULT_STEPS_PER_FRAME, Scene
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.noise.presets import NOISE_PRESETS, preset_noise
+from rvsm.model.noise.sensor import NoiseParams
+from rvsm.model.scene.scene import DEFAULT_STEPS_PER_FRAME, Scene
 
 
 def add_scene_arguments(parser: argparse.ArgumentParser, positional: bool = True) -> None:
@@ -42,7 +42,7 @@ def add_noise_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_force_argument(parser: argparse.ArgumentParser) -> None:
-    """``--force``: replace an existing output of another kind (:mod:`rvsm.model.outputs`)."""
+    """``--force``: replace an existing output of another kind (:mod:`rvsm.sim.cli.outputs`)."""
     parser.add_argument("--force", action="store_true",
                         help="replace an existing output file even if it holds another kind "
                         "of file (never an input)")
@@ -67,10 +67,10 @@ def noise_from_args(args: argparse.Namespace) -> NoiseParams | None:
 
 def parse_size_arg(text: str | None) -> tuple[int, int] | None:
     """``--size``: ``"HxW"`` (or ``H*W``) -> ``(H, W)`` via
-    :func:`rvsm.model.scene_io.parse_size`, the one size parser; ``None`` stays ``None``."""
+    :func:`rvsm.model.scene.loaders.parse_size`, the one size parser; ``None`` stays ``None``."""
     if text is None:
         return None
-    from rvsm.model.scene_io import parse_size
+    from rvsm.model.scene.loaders import parse_size
 
     return parse_size(text)
 
@@ -81,7 +81,7 @@ def load_scene_from_args(
     size: tuple[int, int] | None = None,
 ) -> Scene:
     """Load the scene named on the command line with its stepping options."""
-    from rvsm.model.scene_io import load_scene
+    from rvsm.model.scene.loaders import load_scene
 
     return load_scene(
         scene_arg if scene_arg is not None else args.scene,
@@ -105,7 +105,7 @@ def positive_or_default(value: int | None, option: str, default: int) -> int:
 
 def scene_from_meta(meta: dict, override: str | None = None) -> Scene:
     """Reload the scene a spike file was made from (``override`` replaces its source)."""
-    from rvsm.model.scene_io import load_scene
+    from rvsm.model.scene.loaders import load_scene
 
     source = override if override is not None else meta.get("scene_arg")
     if source is None:

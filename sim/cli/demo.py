@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from rvsm.model.outputs import FOLDER, PLAIN, Output, check_outputs
+from rvsm.sim.cli.args import add_force_argument, load_scene_from_args
+from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.cosim import SIMULATORS
 from rvsm.sim.studies.demo import (
     DEMO_MODELS,
@@ -15,8 +16,6 @@ from rvsm.sim.studies.demo import (
     DEMO_SCENE,
     run_float_demo,
 )
-
-from .args import add_force_argument, load_scene_from_args
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -7,12 +7,16 @@ import json
 import sys
 from pathlib import Path
 
-from rvsm.model.errors import RvsmError
-from rvsm.model.outputs import PLAIN, Output, check_outputs
-from rvsm.model.reconstruction import MATCH_MODES, METHODS
-from rvsm.model.thresholds import THRESHOLD_RULES
-
-from .args import add_force_argument, add_scene_arguments, load_scene_from_args, parse_size_arg
+from rvsm.model.decode.reconstruction import MATCH_MODES, METHODS
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.sampling.thresholds import THRESHOLD_RULES
+from rvsm.sim.cli.args import (
+    add_force_argument,
+    add_scene_arguments,
+    load_scene_from_args,
+    parse_size_arg,
+)
+from rvsm.sim.cli.outputs import PLAIN, Output, check_outputs
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -137,9 +141,9 @@ def cmd_stimulus(args: argparse.Namespace) -> int:
 
 def run_profile(args: argparse.Namespace) -> int:
     """``rvsm profile``."""
-    from rvsm.model.atomic import atomic_path
     from rvsm.model.fixed.profile import format_profile, profile_figure, profile_report
     from rvsm.model.fixed.twin import simulate_fixed
+    from rvsm.model.infra.atomic import atomic_path
 
     check_outputs([args.plot and Output(args.plot, "--plot")], [args.scene, args.fixed],
                   args.force)

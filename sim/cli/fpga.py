@@ -5,12 +5,12 @@ from __future__ import annotations
 import argparse
 import sys
 
-from rvsm.model.errors import RvsmError
-from rvsm.model.outputs import FOLDER, Output, check_outputs
+from rvsm.model.infra.errors import RvsmError
+from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 
 
 def _size(text: str) -> tuple[int, int]:
-    from rvsm.model.scene_io import parse_size
+    from rvsm.model.scene.loaders import parse_size
 
     return parse_size(text)
 

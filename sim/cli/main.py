@@ -3,7 +3,7 @@
 Each module in :data:`FAMILIES` exposes ``register(subparsers)``, which adds its
 sub-command(s) and sets ``func(args) -> int`` on them; this list is the one place a
 command is registered. Errors a user can fix are raised as
-:class:`~rvsm.model.errors.RvsmError` and printed here on one line, with exit status 2.
+:class:`~rvsm.model.infra.errors.RvsmError` and printed here on one line, with exit status 2.
 """
 
 from __future__ import annotations
@@ -13,9 +13,8 @@ import signal
 import sys
 from types import ModuleType
 
-from rvsm.model.errors import RvsmError, ToolError
-
-from . import demo, fixed, fpga, rtl, sampling, scenes, studies, sweep
+from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.sim.cli import demo, fixed, fpga, rtl, sampling, scenes, studies, sweep
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
 #: co-simulation, FPGA timing and area, paper studies, the demo, design sweeps.
@@ -31,7 +30,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--debug", action="store_true",
                         help="on an error, print the Python traceback too")
-    from rvsm.model.versions import version_line
+    from rvsm.model.infra.versions import version_line
 
     parser.add_argument("--version", action="version", version=version_line())
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -83,7 +82,7 @@ def _interrupted(exc: KeyboardInterrupt) -> int:
     """Stop every tool still running, say so on one line; exit status 130."""
     for sig in _INTERRUPTS:
         signal.signal(sig, signal.SIG_IGN)
-    from rvsm.model.processes import kill_all
+    from rvsm.model.infra.tools import kill_all
 
     kill_all()
     why = f" by {exc.args[0]}" if exc.args else ""

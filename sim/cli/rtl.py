@@ -6,11 +6,10 @@ import argparse
 import json
 import shlex
 
-from rvsm.model.errors import RvsmError
-from rvsm.model.outputs import FOLDER, PLAIN, Output, check_outputs
+from rvsm.model.infra.errors import RvsmError
+from rvsm.sim.cli.args import add_force_argument, parse_size_arg
+from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.cosim import SIMULATORS
-
-from .args import add_force_argument, parse_size_arg
 
 
 def register(sub: argparse._SubParsersAction) -> None:

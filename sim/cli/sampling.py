@@ -7,14 +7,13 @@ import json
 
 import numpy as np
 
-from rvsm.model.errors import RvsmError
-from rvsm.model.fused import DEFAULT_CHUNK_STEPS
-from rvsm.model.outputs import PLAIN, Output, check_outputs
-from rvsm.model.reconstruction import MATCH_MODES, METHODS
-from rvsm.model.samplers import DEFAULT_PHI, ENGINES, RESET_MODES, SamplerConfig
-from rvsm.model.sampling_stream import ArraySink, CountSink, TeeSink, stream_float
-from rvsm.model.spike_files import save_spikes
-from rvsm.model.spike_h5 import (
+from rvsm.model.decode.reconstruction import MATCH_MODES, METHODS
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.sampling.fused import DEFAULT_CHUNK_STEPS
+from rvsm.model.sampling.samplers import DEFAULT_PHI, ENGINES, RESET_MODES, SamplerConfig
+from rvsm.model.sampling.stream import ArraySink, CountSink, TeeSink, stream_float
+from rvsm.model.sampling.thresholds import THRESHOLD_RULES, rule_thresholds
+from rvsm.model.spikes.h5 import (
     DatWriter,
     H5SpikeWriter,
     copy_source,
@@ -22,9 +21,8 @@ from rvsm.model.spike_h5 import (
     is_h5_path,
     open_spikes,
 )
-from rvsm.model.thresholds import THRESHOLD_RULES, rule_thresholds
-
-from .args import (
+from rvsm.model.spikes.npz import save_spikes
+from rvsm.sim.cli.args import (
     add_force_argument,
     add_noise_arguments,
     add_scene_arguments,
@@ -33,6 +31,7 @@ from .args import (
     parse_size_arg,
     scene_from_meta,
 )
+from rvsm.sim.cli.outputs import PLAIN, Output, check_outputs
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -182,7 +181,7 @@ def run_simulate(args: argparse.Namespace) -> int:
             scene, config, sink, chunk_steps=args.chunk_steps, engine=args.engine,
             progress=True)
     if collect is not None:  # .npz collects every spike in memory: refuse what cannot fit
-        from rvsm.model.memory import require_spike_memory
+        from rvsm.model.infra.memory import require_spike_memory
 
         require_spike_memory(scene, point.num_scales if args.fixed else config.spec.num_scales)
     run_fn(TeeSink(counts, main_sink, dat_sink))
@@ -198,8 +197,8 @@ def run_simulate(args: argparse.Namespace) -> int:
 
 def run_evaluate(args: argparse.Namespace) -> int:
     """``rvsm evaluate``."""
-    from rvsm.model.evaluation import evaluate_spikes
-    from rvsm.model.stream_eval import evaluate_source
+    from rvsm.model.decode.evaluation import evaluate_spikes
+    from rvsm.model.decode.streaming import evaluate_source
 
     with open_spikes(args.spikes) as source:
         meta = source.meta

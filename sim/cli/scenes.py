@@ -6,18 +6,17 @@ import argparse
 
 import numpy as np
 
-from rvsm.model.atomic import atomic_path
-from rvsm.model.errors import RvsmError
-from rvsm.model.outputs import Output, check_outputs
-from rvsm.model.scene_library import (
+from rvsm.model.infra.atomic import atomic_path
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.scene.library import (
     DEFAULT_FRAMES,
     DEFAULT_SIZE,
     SCENE_NAMES,
     render_frames,
     scene_descriptions,
 )
-
-from .args import add_force_argument, parse_size_arg
+from rvsm.sim.cli.args import add_force_argument, parse_size_arg
+from rvsm.sim.cli.outputs import Output, check_outputs
 
 SHEET_FRAMES = 4
 

@@ -6,16 +6,15 @@ import argparse
 import json
 from pathlib import Path
 
-from rvsm.model.atomic import atomic_path, write_text_atomic
-from rvsm.model.errors import RvsmError
-from rvsm.model.noise_presets import NOISE_PRESETS
-from rvsm.model.outputs import FOLDER, PLAIN, Output, check_outputs
-from rvsm.model.samplers import DEFAULT_PHI
-from rvsm.model.thresholds import DEFAULT_CALIBRATION_SCENE, THRESHOLD_RULES
+from rvsm.model.infra.atomic import atomic_path, write_text_atomic
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.noise.presets import NOISE_PRESETS
+from rvsm.model.sampling.samplers import DEFAULT_PHI
+from rvsm.model.sampling.thresholds import DEFAULT_CALIBRATION_SCENE, THRESHOLD_RULES
+from rvsm.sim.cli.args import add_force_argument, parse_size_arg
+from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.studies import claims, robustness, table
 from rvsm.sim.studies.settings_table import run_settings_table, settings_csv
-
-from .args import add_force_argument, parse_size_arg
 
 # Defaults of ``rvsm table``: the built-in scenes' full 250 x 400 canvas and 41 frames
 # (400 steps): 108 runs in ~6.5 min on a 2-core machine; see docs/reproduction.md.

@@ -9,8 +9,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from rvsm.model.errors import RvsmError
-from rvsm.model.outputs import FOLDER, Output, check_outputs
+from rvsm.model.infra.errors import RvsmError
+from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -6,8 +6,8 @@ checked by checksum before each use and reused by every stimulus (``run_testbenc
 a Verilator compile is paid once. Icarus builds always include the FST dump module;
 Verilator builds get ``--trace-fst`` only when waves are asked for (a second cached
 build), since tracing doubles the C++. Every command of cocotb's runner runs through
-:func:`rvsm.model.processes.run_tool` (own process group, killed with us, one-line
-:class:`~rvsm.model.processes.ToolFailure`); each run gets a fresh folder
+:func:`rvsm.model.infra.tools.run_tool` (own process group, killed with us, one-line
+:class:`~rvsm.model.infra.tools.ToolFailure`); each run gets a fresh folder
 (:func:`new_run_dir`).
 """
 
@@ -29,9 +29,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from rvsm.model.errors import RvsmError, ToolError
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.processes import ToolFailure, run_tool
+from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.model.infra.tools import ToolFailure, run_tool
 from rvsm.rtl.stream_verilog import STREAM_TOP, write_stream_outputs
 from rvsm.rtl.verilog import (
     DEFAULT_TOP,
@@ -40,8 +40,7 @@ from rvsm.rtl.verilog import (
     verilator_env,
     write_outputs,
 )
-
-from . import SIMULATORS
+from rvsm.sim.cosim import SIMULATORS
 
 if TYPE_CHECKING:
     from cocotb_tools.runner import Runner
@@ -187,8 +186,8 @@ def build_key(contract: ArrayContract, sim: str, top: str, traced: bool,
 
 def _runner(sim: str) -> Runner:
     """A fresh cocotb runner for ``sim`` whose commands run through
-    :func:`~rvsm.model.processes.run_tool` (own process group, killed with us, a
-    :class:`~rvsm.model.processes.ToolFailure` naming the tool, status and log) and whose
+    :func:`~rvsm.model.infra.tools.run_tool` (own process group, killed with us, a
+    :class:`~rvsm.model.infra.tools.ToolFailure` naming the tool, status and log) and whose
     testbench sees no relative or current-folder ``PYTHONPATH`` entry.
 
     For Verilator, cocotb's ``--public-flat-rw`` (every signal of every cell visible to
@@ -426,7 +425,7 @@ def run_testbench(
     ``test_dir`` (the simulator's current folder) should be a fresh folder
     (:func:`new_run_dir`). The result has ``compared``, ``mismatches``,
     ``first_mismatch`` (or None), ``stream_seconds`` and ``simulator``; ``waves`` the FST
-    path when kept. Raises :class:`~rvsm.model.processes.ToolFailure` when the simulator
+    path when kept. Raises :class:`~rvsm.model.infra.tools.ToolFailure` when the simulator
     fails or is killed, :class:`ToolError` when the testbench ends without a result or
     its cocotb verdict contradicts the result (both: exit status 3).
     """

@@ -23,8 +23,7 @@ from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
 from rvsm.model.fixed.stimulus import load_stimulus
-
-from .tb_common import clock_and_reset, logic_bits, testbench_arg
+from rvsm.sim.cosim.tb_common import clock_and_reset, logic_bits, testbench_arg
 
 MAX_LISTED = 50
 

@@ -29,8 +29,7 @@ from cocotb.triggers import FallingEdge
 from rvsm.model.fixed.stimulus import load_stimulus
 from rvsm.rtl.stream_array import StreamGeometry, threshold_word_bits
 from rvsm.rtl.stream_schedule import OutputBeats, check_beats, pack_lanes
-
-from .tb_common import clock_and_reset, logic_bits, testbench_arg
+from rvsm.sim.cosim.tb_common import clock_and_reset, logic_bits, testbench_arg
 
 
 @cocotb.test()

@@ -19,12 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.stimulus import Stimulus, load_stimulus, save_stimulus
 from rvsm.model.fixed.widths import unsigned_max
-
-from .runner import SimBuild, build, check_simulator, new_run_dir, run_testbench
+from rvsm.model.infra.errors import RvsmError
+from rvsm.sim.cosim.runner import SimBuild, build, check_simulator, new_run_dir, run_testbench
 
 __all__ = ["MAX_PARALLEL_SIDE", "check_stimulus", "random_verify", "replay", "run_rtl",
            "verify"]
@@ -205,7 +204,7 @@ def verify(
     """
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.model.fixed.stimulus import make_stimulus
-    from rvsm.model.scene_io import load_scene
+    from rvsm.model.scene.loaders import load_scene
 
     check_simulator(sim)
     point = load_design_point(fixed)

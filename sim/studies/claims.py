@@ -18,8 +18,8 @@ Rules (fixed before any table was run; a scene counts only on a strict improveme
 
 from __future__ import annotations
 
-from .robustness import RobustnessResult
-from .table import TableResult
+from rvsm.sim.studies.robustness import RobustnessResult
+from rvsm.sim.studies.table import TableResult
 
 _LADDER = {"dog": ("dog1", "dog2", "dog3", "dog4"),
            "gauss": ("gauss1", "gauss2", "gauss3", "gauss4")}

@@ -15,12 +15,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rvsm.model.atomic import atomic_path, write_text_atomic
-from rvsm.model.evaluation import evaluate_spikes, reconstruct_for_display, scored_steps
-from rvsm.model.noise import NoiseParams
-from rvsm.model.samplers import SamplerConfig, sample
-from rvsm.model.scene import Scene
-from rvsm.model.spike_files import save_spikes
+from rvsm.model.decode.evaluation import evaluate_spikes, reconstruct_for_display, scored_steps
+from rvsm.model.infra.atomic import atomic_path, write_text_atomic
+from rvsm.model.noise.sensor import NoiseParams
+from rvsm.model.sampling.samplers import SamplerConfig, sample
+from rvsm.model.scene.scene import Scene
+from rvsm.model.spikes.npz import save_spikes
 
 DEMO_SCENE = "flyball"
 DEMO_MODELS = ("fsm", "dog4", "gauss4")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from rvsm.model.kernels import model_spec
+from rvsm.model.kernels.receptive_fields import model_spec
 
 _WORDS = ("One", "Two", "Three", "Four")
 

@@ -14,19 +14,18 @@ from dataclasses import dataclass
 
 from matplotlib.figure import Figure
 
-from rvsm.model.errors import RvsmError
-from rvsm.model.kernels import model_spec
-from rvsm.model.metrics import robustness_indices
-from rvsm.model.noise import NoiseParams
-from rvsm.model.samplers import DEFAULT_PHI, SamplerConfig, sample
-from rvsm.model.scene_library import black_scene
-from rvsm.model.thresholds import (
+from rvsm.model.decode.metrics import robustness_indices
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kernels.receptive_fields import model_spec
+from rvsm.model.noise.sensor import NoiseParams
+from rvsm.model.sampling.samplers import DEFAULT_PHI, SamplerConfig, sample
+from rvsm.model.sampling.thresholds import (
     DEFAULT_CALIBRATION_SCENE,
     THRESHOLD_RULES,
     calibration_thresholds,
 )
-
-from .labels import method_label
+from rvsm.model.scene.library import black_scene
+from rvsm.sim.studies.labels import method_label
 
 ROBUST_MODELS: tuple[str, ...] = ("fsm", "dog1", "dog2", "dog3", "dog4", "gauss4")
 DEFAULT_KS: tuple[float, ...] = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)
@@ -59,7 +58,7 @@ def run_robustness(
     Every model sees ``NoiseParams(k, seed)``; returns ASS, ASAS and ASASS per run. With
     ``thresholds="response"`` each RVSM model's per-scale thresholds are those of the
     response rule on the built-in ``calibration_scene`` at ``size`` (a black scene has no
-    response of its own; :func:`rvsm.model.thresholds.calibration_thresholds`).
+    response of its own; :func:`rvsm.model.sampling.thresholds.calibration_thresholds`).
     """
     from tqdm.auto import tqdm
 

@@ -1,13 +1,13 @@
 """Table 1 under several settings in one run: threshold rule x noise preset x decoder.
 
 A *setting* is ``(thresholds, noise_preset, decoder)``: the per-scale threshold rule
-(:mod:`rvsm.model.thresholds`), the noise regime of the ``(N)`` columns
-(:mod:`rvsm.model.noise_presets`) and the RVSM decoder (``rvsm`` = the paper's adjoint,
-``inverse`` = least squares, :mod:`rvsm.model.inverse`; FSM is always TFI). Work is
+(:mod:`rvsm.model.sampling.thresholds`), the noise regime of the ``(N)`` columns
+(:mod:`rvsm.model.noise.presets`) and the RVSM decoder (``rvsm`` = the paper's adjoint,
+``inverse`` = least squares, :mod:`rvsm.model.decode.inverse`; FSM is always TFI). Work is
 shared: each (scene, noise, model, rule) is sampled once and decoded by every decoder;
 FSM does not depend on the rule or the decoder and the clean columns do not depend on the
 preset, so their runs are shared too. Every model of a scene is scored on the same steps
-(:func:`rvsm.model.evaluation.scored_steps` at the nominal ``phi``).
+(:func:`rvsm.model.decode.evaluation.scored_steps` at the nominal ``phi``).
 """
 
 from __future__ import annotations
@@ -18,14 +18,13 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from rvsm.model.evaluation import evaluate_spikes, reconstruct_for_display, scored_steps
-from rvsm.model.kernels import model_spec
-from rvsm.model.noise_presets import preset_noise
-from rvsm.model.samplers import DEFAULT_PHI, SamplerConfig, sample
-from rvsm.model.scene import Scene
-from rvsm.model.thresholds import rule_thresholds
-
-from .table import FIG6_CLEAN, FIG6_NOISY, TABLE_MODELS, TableResult
+from rvsm.model.decode.evaluation import evaluate_spikes, reconstruct_for_display, scored_steps
+from rvsm.model.kernels.receptive_fields import model_spec
+from rvsm.model.noise.presets import preset_noise
+from rvsm.model.sampling.samplers import DEFAULT_PHI, SamplerConfig, sample
+from rvsm.model.sampling.thresholds import rule_thresholds
+from rvsm.model.scene.scene import Scene
+from rvsm.sim.studies.table import FIG6_CLEAN, FIG6_NOISY, TABLE_MODELS, TableResult
 
 DECODERS = ("rvsm", "inverse")
 

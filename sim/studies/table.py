@@ -15,15 +15,14 @@ from dataclasses import dataclass, field
 
 from matplotlib.figure import Figure
 
-from rvsm.model import scene_library
-from rvsm.model.errors import RvsmError
-from rvsm.model.evaluation import evaluate_spikes, reconstruct_for_display, scored_steps
-from rvsm.model.kernels import MODEL_NAMES, model_spec
-from rvsm.model.noise import NoiseParams
-from rvsm.model.samplers import DEFAULT_PHI, SamplerConfig, sample
-from rvsm.model.scene import Scene
-
-from .labels import column_label, method_label
+from rvsm.model.decode.evaluation import evaluate_spikes, reconstruct_for_display, scored_steps
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kernels.receptive_fields import MODEL_NAMES, model_spec
+from rvsm.model.noise.sensor import NoiseParams
+from rvsm.model.sampling.samplers import DEFAULT_PHI, SamplerConfig, sample
+from rvsm.model.scene.scene import Scene
+from rvsm.model.scene import library as scene_library
+from rvsm.sim.studies.labels import column_label, method_label
 
 TABLE_MODELS: tuple[str, ...] = MODEL_NAMES
 FIG6_CLEAN: tuple[str, ...] = ("fsm", "gauss1", "dog3")
@@ -58,7 +57,7 @@ def load_scenes(
     num_frames: int,
     steps_per_frame: int,
 ) -> list[Scene]:
-    """Built-in scenes (``rvsm.model.scene_library``) at the given size and length."""
+    """Built-in scenes (``rvsm.model.scene.library``) at the given size and length."""
     chosen = list(names) if names else list(scene_library.SCENE_NAMES)
     unknown = [n for n in chosen if n not in scene_library.SCENE_NAMES]
     if unknown:
@@ -86,7 +85,7 @@ def run_table(
 
     Noise is ``NoiseParams(k=noise_k, seed=seed)`` (same dark current and fixed pattern for
     every model). Reconstruction: TFI for FSM, the RVSM adjoint otherwise; one gain per
-    frame; scored on original-frame steps after the warm-up (:mod:`rvsm.model.evaluation`).
+    frame; scored on original-frame steps after the warm-up (:mod:`rvsm.model.decode.evaluation`).
     """
     from tqdm.auto import tqdm
 

@@ -24,13 +24,12 @@ from typing import Any
 
 import numpy as np
 
-from rvsm.model.atomic import atomic_path, write_text_atomic
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.design_point import FIELD_BY_PATH, FIELD_PATH
 from rvsm.model.fixed.point_toml import parse_design_point
+from rvsm.model.infra.atomic import atomic_path, write_text_atomic
+from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.sensor import state_memory
-
-from .store import open_existing
+from rvsm.sim.sweep.store import open_existing
 
 PROXY_LABEL = "adc + weight + accumulator bits (proxy: no synthesis)"
 LOGIC_LABEL = "logic per lane (ECP5 LUT4, yosys)"

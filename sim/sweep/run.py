@@ -26,11 +26,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.design_point import DesignPoint
-
-from .spec import HardwareSettings, SweepSpec, SweepTask
-from .store import SweepStore, database_error
+from rvsm.model.infra.errors import RvsmError
+from rvsm.sim.sweep.spec import HardwareSettings, SweepSpec, SweepTask
+from rvsm.sim.sweep.store import SweepStore, database_error
 
 
 @dataclass
@@ -64,7 +63,7 @@ def evaluate_task(task: SweepTask, frames: int, steps_per_frame: int, method: st
     in this process (a local cluster gives each of its ``n`` worker processes
     ``cores // n``, so workers x threads never oversubscribe the cores)."""
     from rvsm.model.fixed.cost import quantisation_cost
-    from rvsm.model.scene_io import load_scene
+    from rvsm.model.scene.loaders import load_scene
 
     if threads is not None:
         import numba
@@ -199,7 +198,7 @@ def _run_sweep(spec, db_path, workers, scheduler, progress, on_result, processes
 
 def _check_scenes(spec: SweepSpec) -> None:
     """Fail early, naming the field, if a scene cannot be loaded."""
-    from rvsm.model.scene_io import load_scene
+    from rvsm.model.scene.loaders import load_scene
 
     for name in spec.run.scenes:
         try:

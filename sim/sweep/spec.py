@@ -32,7 +32,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-from rvsm.model.errors import RvsmError
+from rvsm.model.decode.reconstruction import MATCH_MODES, METHODS
 from rvsm.model.fixed.design_point import (
     FIELDS,
     DesignPoint,
@@ -44,8 +44,8 @@ from rvsm.model.fixed.point_toml import (
     load_design_point,
     to_toml_dict,
 )
-from rvsm.model.reconstruction import MATCH_MODES, METHODS
-from rvsm.model.scene_io import parse_size
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.scene.loaders import parse_size
 
 #: ``section.key`` -> design point field name of every field a sweep may vary.
 AXES: dict[str, str] = {f.path: f.name for f in FIELDS if f.sweep}
@@ -174,7 +174,7 @@ def task_id(
 
 def load_sweep(path: str | os.PathLike) -> SweepSpec:
     """Read and validate a sweep file; errors name the file and the field."""
-    from rvsm.model.text_files import read_utf8_text
+    from rvsm.model.infra.text_files import read_utf8_text
 
     p = Path(path)
     return parse_sweep(read_utf8_text(p, "sweep file"), str(p), base_dir=p.parent)

@@ -26,9 +26,8 @@ import time
 from pathlib import Path
 from typing import Any
 
-from rvsm.model.errors import RvsmError, ToolError
-
-from .spec import SweepSpec, SweepTask
+from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.sim.sweep.spec import SweepSpec, SweepTask
 
 SCHEMA_VERSION = 2
 SCHEMA = """

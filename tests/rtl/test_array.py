@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvsm.model.kernels import MODEL_NAMES
+from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.rtl.array import RvsmArray, simulate
 from rvsm.rtl.pixel_cell import PixelCell
 

@@ -8,7 +8,7 @@ from amaranth.hdl import Module, Signal, unsigned
 from amaranth.sim import Simulator
 
 from rvsm.model.fixed.weights import quantise_model
-from rvsm.model.kernels import MODEL_NAMES
+from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.rtl.pipelined_sum import Pipeline, kernel_orbits, kernel_radius
 from rvsm.rtl.receptive_sum import sum_width
 

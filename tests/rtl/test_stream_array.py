@@ -7,7 +7,6 @@ import time
 import numpy as np
 import pytest
 
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import (
     ArrayContract,
     FixedIntegrator,
@@ -16,7 +15,8 @@ from rvsm.model.fixed.core import (
 )
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.weights import quantise_model
-from rvsm.model.kernels import MODEL_NAMES
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.rtl.stream_array import (
     RvsmStreamArray,
     StreamGeometry,

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift, integer_receptive_sums
 from rvsm.model.fixed.corner_stimulus import BINS, corner_stimulus, coverage, coverage_summary
+from rvsm.model.infra.errors import RvsmError
 
 
 def test_same_seed_same_stimulus_and_expectation_from_the_contract(small_contract) -> None:

@@ -7,7 +7,6 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.design_point import FIELD_PATH, FIELDS, DesignPoint, default_design_point
 from rvsm.model.fixed.point_toml import (
     design_point_toml,
@@ -15,6 +14,7 @@ from rvsm.model.fixed.point_toml import (
     parse_design_point,
     save_design_point,
 )
+from rvsm.model.infra.errors import RvsmError
 
 # The widths the numbers in these tests were worked out for (8-bit ADC, 12/10 weights,
 # 21-bit accumulator), pinned so that the tests do not move with the project default.

@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.core import (
     ArrayContract,
     FixedIntegrator,
@@ -16,6 +15,7 @@ from rvsm.model.fixed.core import (
     run_integer_array,
 )
 from rvsm.model.fixed.design_point import DesignPoint
+from rvsm.model.infra.errors import RvsmError
 
 
 def _one(value: int) -> np.ndarray:

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.adc import adc_codes, quantise
 from rvsm.model.fixed.weights import quantise_model, weight_error_report
-from rvsm.model.kernels import MODEL_NAMES, model_spec
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kernels.receptive_fields import MODEL_NAMES, model_spec
 
 
 def test_rounding_rules():

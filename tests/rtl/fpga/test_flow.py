@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.model.errors import ToolError
 from rvsm.model.fixed.design_point import default_design_point
+from rvsm.model.infra.errors import ToolError
 from rvsm.rtl.fpga.flow import run_fpga, synthesis_script
 from rvsm.rtl.fpga.tools import run_tool
 
@@ -109,7 +109,7 @@ def test_place_and_route_on_a_tiny_array(tmp_path: Path, fsm_point) -> None:
 
 def test_a_design_too_big_for_the_device_is_refused_before_place_and_route(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fsm_point, fake_tool) -> None:
-    from rvsm.model.errors import RvsmError
+    from rvsm.model.infra.errors import RvsmError
     from rvsm.rtl.fpga.devices import Device
 
     tiny = Device("ecp5-tiny", "--25k", "CABGA381", lut4=10, ff=10, bram=0, lutram_slices=0)

@@ -8,7 +8,7 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.sim import Simulator
 
-from rvsm.model.errors import RvsmError
+from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.harness import LFSR_TAPS, XOR_GROUP, IoHarness, component_ports
 
 

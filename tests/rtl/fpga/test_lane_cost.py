@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.model.errors import RvsmError
 from rvsm.model.fixed.design_point import default_design_point
+from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.lane_cost import lane_cost, logic_lut4
 from rvsm.rtl.fpga.report import parse_yosys_stat
 from rvsm.rtl.fpga.sensor import state_memory

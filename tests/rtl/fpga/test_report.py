@@ -6,8 +6,8 @@ import json
 
 import pytest
 
-from rvsm.model.errors import ToolError
 from rvsm.model.fixed.design_point import default_design_point
+from rvsm.model.infra.errors import ToolError
 from rvsm.rtl.fpga.devices import DEVICES, get_device
 from rvsm.rtl.fpga.report import FpgaReport, Usage, parse_nextpnr_report, parse_yosys_stat
 from rvsm.rtl.fpga.sensor import state_memory
@@ -128,7 +128,7 @@ def test_report_synthesis_only_has_no_fmax() -> None:
 
 def test_devices_and_unknown_device() -> None:
     assert DEVICES["ecp5-85"].bram_bits == 208 * 18 * 1024
-    from rvsm.model.errors import RvsmError
+    from rvsm.model.infra.errors import RvsmError
 
     with pytest.raises(RvsmError, match="ecp5-85"):
         get_device("ice40")

@@ -20,11 +20,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rvsm.model import atomic, outputs
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.fixed.point_toml import save_design_point
-from rvsm.model.spike_files import load_spikes, save_spikes
-from rvsm.sim.cli import main
+from rvsm.model.infra import atomic
+from rvsm.model.spikes.npz import load_spikes, save_spikes
+from rvsm.sim.cli import main, outputs
 
 SMALL = ["--size", "16x24", "--frames", "3"]
 
@@ -224,7 +224,7 @@ def test_sweep_database_on_a_full_disk_exits_3(tmpfs, tmp_path, capsys):
 def test_sqlite_errors_map_to_statuses(tmp_path):
     import sqlite3
 
-    from rvsm.model.errors import ToolError
+    from rvsm.model.infra.errors import ToolError
     from rvsm.sim.sweep.store import database_error
 
     def err(code):
@@ -306,7 +306,7 @@ def test_npz_header_is_checked_before_allocating(tmp_path, capsys):
 
 
 def test_npz_claiming_more_than_the_memory_is_refused(tmp_path, capsys, monkeypatch):
-    from rvsm.model import memory
+    from rvsm.model.infra import memory
 
     spikes = tmp_path / "s.npz"
     save_spikes(spikes, np.zeros((40, 1, 16, 16), np.int8), {"model": "fsm"})
@@ -387,7 +387,7 @@ def test_more_rendered_frames_than_memory_are_refused(capsys, tmp_path):
 
 
 def test_npy_scene_header_is_checked_before_loading(tmp_path, capsys, monkeypatch):
-    from rvsm.model import memory
+    from rvsm.model.infra import memory
 
     scene = tmp_path / "scene.npy"
     np.save(scene, np.full((4, 16, 24), 100.0))
@@ -397,8 +397,8 @@ def test_npy_scene_header_is_checked_before_loading(tmp_path, capsys, monkeypatc
 
 
 def test_non_finite_analogue_values_are_never_cast(capsys):
-    from rvsm.model.errors import RvsmError
     from rvsm.model.fixed.adc import adc_codes
+    from rvsm.model.infra.errors import RvsmError
 
     with pytest.raises(RvsmError, match="NaN or infinite"):
         adc_codes(np.array([[[1.0, np.nan]]]), 7, 255.0)

@@ -6,9 +6,9 @@ import json
 
 import pytest
 
-from rvsm.model.noise_presets import PAPER_K
-from rvsm.model.spike_files import load_spikes
-from rvsm.model.thresholds import response_thresholds
+from rvsm.model.noise.presets import PAPER_K
+from rvsm.model.sampling.thresholds import response_thresholds
+from rvsm.model.spikes.npz import load_spikes
 from rvsm.sim.cli import main
 from rvsm.sim.studies import claims, robustness
 from rvsm.sim.studies.table import load_scenes

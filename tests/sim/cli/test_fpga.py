@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.model.errors import ToolError
 from rvsm.model.fixed.point_toml import save_design_point
+from rvsm.model.infra.errors import ToolError
 from rvsm.rtl.fpga.flow import run_fpga
 from rvsm.sim.cli import main
 

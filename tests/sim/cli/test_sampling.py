@@ -27,7 +27,7 @@ def test_simulate_then_evaluate_json(tmp_path, capsys):
     result = json.loads(out)
     assert {"mse", "psnr", "ssim"} <= set(result)
     assert 5 < result["psnr"] < 60 and 0 < result["ssim"] <= 1
-    from rvsm.model.spike_files import load_spikes
+    from rvsm.model.spikes.npz import load_spikes
 
     data, meta = load_spikes(spikes)
     assert data.shape == (24, 2, 24, 32)
@@ -38,7 +38,7 @@ def test_simulate_is_reproducible(tmp_path, capsys):
     for name in ("a.npz", "b.npz"):
         assert _run(capsys, "simulate", "flyball", *SMALL, "--model", "dog3", "--noise",
                     "-o", tmp_path / name)[0] == 0
-    from rvsm.model.spike_files import load_spikes
+    from rvsm.model.spikes.npz import load_spikes
 
     np.testing.assert_array_equal(load_spikes(tmp_path / "a.npz")[0],
                                   load_spikes(tmp_path / "b.npz")[0])
@@ -49,7 +49,7 @@ def test_dat_export_import_round_trip(tmp_path, capsys):
     assert _run(capsys, "simulate", "character", *SMALL, "--model", "fsm", "-o", npz,
                 "--dat", dat)[0] == 0
     assert _run(capsys, "dat", "import", dat, "--size", "24x32", "-o", back)[0] == 0
-    from rvsm.model.spike_files import load_spikes
+    from rvsm.model.spikes.npz import load_spikes
 
     np.testing.assert_array_equal(load_spikes(npz)[0], load_spikes(back)[0])
 
@@ -128,7 +128,7 @@ def test_simulate_fixed_then_evaluate(tmp_path, capsys):
     spikes = tmp_path / "fx.npz"
     code, out, err = _run(capsys, "simulate", "coin", *SMALL, "--fixed", point, "-o", spikes)
     assert code == 0, err
-    from rvsm.model.spike_files import load_spikes
+    from rvsm.model.spikes.npz import load_spikes
 
     data, meta = load_spikes(spikes)
     assert data.shape == (24, 4, 24, 32) and meta["kind"] == "fixed"
@@ -148,7 +148,7 @@ def test_simulate_fixed_refuses_float_options(tmp_path, capsys):
 
 
 def test_evaluate_refuses_spikes_that_do_not_fit_the_scene(tmp_path, capsys):
-    from rvsm.model.spike_files import save_spikes
+    from rvsm.model.spikes.npz import save_spikes
 
     meta = {"scene_arg": "coin", "height": 16, "width": 16, "num_frames": 3,
             "steps_per_frame": 2, "hold": False, "model": "fsm", "phis": [400.0]}

@@ -5,7 +5,7 @@ from __future__ import annotations
 import imageio.v3 as iio
 import numpy as np
 
-from rvsm.model import scene_library as lib
+from rvsm.model.scene import library as lib
 from rvsm.sim.cli import main
 
 

@@ -4,8 +4,8 @@ import json
 
 import numpy as np
 
-from rvsm.model.spike_files import load_spikes
-from rvsm.model.spike_h5 import load_any_spikes
+from rvsm.model.spikes.h5 import load_any_spikes
+from rvsm.model.spikes.npz import load_spikes
 from rvsm.sim.cli import main
 
 SMALL = ["--size", "24x32", "--frames", "4", "--steps-per-frame", "8"]

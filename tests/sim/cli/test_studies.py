@@ -6,7 +6,7 @@ import csv
 
 import pytest
 
-from rvsm.model.kernels import MODEL_NAMES
+from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.sim.cli import main
 from rvsm.sim.studies.robustness import ROBUST_MODELS
 

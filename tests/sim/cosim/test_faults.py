@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rvsm.model.errors import RvsmError, ToolError
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.fixed.point_toml import save_design_point
+from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.sim.cosim.runner import build, build_key, run_testbench
 
 RVSM = str(Path(sys.executable).parent / "rvsm")

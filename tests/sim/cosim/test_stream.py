@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.kernels import MODEL_NAMES
+from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.sim.cosim.verify import run_rtl
 
 SIMS = ["icarus", "verilator"]

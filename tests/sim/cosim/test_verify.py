@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rvsm.model.errors import RvsmError, ToolError
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.kernels import MODEL_NAMES
+from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.sim.cosim.runner import check_simulator
 from rvsm.sim.cosim.verify import run_rtl
 

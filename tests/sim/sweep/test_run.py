@@ -166,7 +166,7 @@ def test_hw_cost_is_two_syntheses_combined_as_lane_cost_does(tmp_path):
 
 def test_a_failed_synthesis_is_one_error_and_retried(tmp_path, monkeypatch):
     import rvsm.rtl.fpga.lane_cost as lane_cost_module
-    from rvsm.model.errors import ToolError
+    from rvsm.model.infra.errors import ToolError
 
     real = lane_cost_module.lane_synthesis
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from rvsm.model.errors import RvsmError
+from rvsm.model.infra.errors import RvsmError
 from rvsm.sim.sweep.spec import make_design, parse_sweep
 
 GOOD = """

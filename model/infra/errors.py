@@ -1,0 +1,38 @@
+"""The one exception type users see: a message that says what is wrong and how to fix it."""
+
+from __future__ import annotations
+
+import errno
+import os
+
+
+class RvsmError(Exception):
+    """A user-facing error (bad input, bad configuration, missing tool).
+
+    The CLI prints ``rvsm: error: <message>`` on one line and exits non-zero; the message
+    must name what is wrong and, where possible, how to fix it.
+    """
+
+
+class ToolError(RvsmError):
+    """An external tool (synthesis, place-and-route, simulator) failed or is missing.
+
+    The CLI prints it like :class:`RvsmError` but exits with status 3 (tool/environment
+    failure) instead of 2 (bad input).
+    """
+
+def os_error(exc: OSError, target: str | os.PathLike, what: str = "write") -> RvsmError:
+    """The user-facing error for an ``OSError`` met writing ``target``: a full disk or an
+    I/O error, a read-only or forbidden location is a :class:`ToolError` (exit 3: the
+    environment cannot take the output); a missing or malformed path an
+    :class:`RvsmError` (exit 2) saying what to fix."""
+    code = exc.errno
+    reason = os.strerror(code) if code else str(exc)
+    if code in (errno.ENOSPC, errno.EDQUOT):
+        return ToolError(f"cannot {what} {target}: {reason} (disk full); free space or "
+                         "choose another location; no partial file was left")
+    if code in (errno.EROFS, errno.EACCES, errno.EPERM):
+        return ToolError(f"cannot {what} {target}: {reason}; choose a writable location")
+    if code in (errno.ENOENT, errno.ENOTDIR, errno.EISDIR, errno.ENAMETOOLONG):
+        return RvsmError(f"cannot {what} {target}: {reason}; check the path")
+    return ToolError(f"cannot {what} {target}: {reason}")

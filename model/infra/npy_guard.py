@@ -1,0 +1,85 @@
+"""Check ``.npy`` headers before loading: the shape a file claims is checked against the
+bytes it holds and the memory available, so a hostile or corrupt header is refused in one
+line instead of allocating ``(100000, 4, 250, 400)`` first."""
+
+from __future__ import annotations
+
+import math
+import os
+import zipfile
+from pathlib import Path
+from typing import BinaryIO
+
+import numpy as np
+import numpy.lib.format as npformat
+
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.memory import require_memory
+
+#: Largest ratio of uncompressed to compressed size deflate can reach (about 1032:1).
+MAX_DEFLATE_RATIO = 1100
+
+
+def _header(handle: BinaryIO, source: str) -> tuple[tuple[int, ...], np.dtype, int]:
+    """``(shape, dtype, header bytes)`` of the ``.npy`` stream at ``handle``."""
+    try:
+        version = npformat.read_magic(handle)
+        if version == (1, 0):
+            shape, _, dtype = npformat.read_array_header_1_0(handle)
+        else:
+            shape, _, dtype = npformat.read_array_header_2_0(handle)
+    except (ValueError, OSError, EOFError, SyntaxError) as exc:
+        raise RvsmError(f"{source}: cannot load .npy data, bad array header ({exc})") from None
+    return tuple(int(v) for v in shape), np.dtype(dtype), handle.tell()
+
+
+def _check(shape: tuple[int, ...], dtype: np.dtype, data_bytes: int, source: str) -> int:
+    if dtype.hasobject:
+        raise RvsmError(f"{source}: holds Python objects (pickles), which rvsm never loads")
+    nbytes = math.prod(shape) * dtype.itemsize
+    if nbytes > data_bytes:
+        raise RvsmError(f"{source}: header claims shape {shape} ({nbytes} bytes) but only "
+                        f"{data_bytes} bytes follow; the file is truncated or corrupt")
+    require_memory(nbytes, f"{source} (shape {shape}, {dtype})",
+                   "use a smaller file or a machine with more memory")
+    return nbytes
+
+
+def check_npy_file(path: str | os.PathLike) -> tuple[int, ...]:
+    """Check an ``.npy`` file's header against its size and the memory; returns the shape."""
+    p = Path(path)
+    with open(p, "rb") as handle:
+        shape, dtype, offset = _header(handle, str(p))
+    _check(shape, dtype, p.stat().st_size - offset, str(p))
+    return shape
+
+
+def check_npz_members(path: str | os.PathLike, ndims: dict[str, int | None]) -> None:
+    """Check the headers of the members ``ndims`` names (``name -> ndim``, None = any) of
+    an ``.npz`` file before :func:`numpy.load` allocates them; missing members and
+    unreadable archives are left to the loader's own messages."""
+    p = Path(path)
+    try:
+        zf = zipfile.ZipFile(p)
+    except (zipfile.BadZipFile, OSError):
+        return
+    with zf:
+        names = set(zf.namelist())
+        for name, ndim in ndims.items():
+            member = f"{name}.npy"
+            if member not in names:
+                continue
+            info = zf.getinfo(member)
+            source = f"{p}: {name!r}"
+            if info.compress_type != zipfile.ZIP_STORED and \
+                    info.file_size > MAX_DEFLATE_RATIO * max(info.compress_size, 1) + 4096:
+                raise RvsmError(f"{source} claims {info.file_size} bytes from "
+                                f"{info.compress_size} compressed; the archive is corrupt")
+            try:
+                with zf.open(info) as handle:
+                    shape, dtype, offset = _header(handle, source)
+            except (zipfile.BadZipFile, OSError, EOFError) as exc:
+                raise RvsmError(f"{source}: unreadable member ({exc})") from None
+            if ndim is not None and len(shape) != ndim:
+                raise RvsmError(f"{source} must have {ndim} dimensions, got shape {shape}")
+            _check(shape, dtype, info.file_size - offset, source)

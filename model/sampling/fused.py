@@ -1,0 +1,259 @@
+"""Fused numba kernels of the float samplers: the time loop inside, tiles of rows in parallel.
+
+:class:`FusedFloatSampler` runs a scene chunk by chunk in time. Per chunk, the frames the
+chunk touches are filtered once (:func:`filter_frames`, parallel over rows); then
+:func:`_float_chunk` processes tiles of ``tile_rows`` rows in parallel (``prange``), and
+inside each tile loops over the chunk's steps with the tile's accumulators in cache:
+interpolate between filtered frames, add the filtered dark current (drawn inside the tile
+from the counter-based streams of :mod:`.noise_streams`, with a halo of ``L`` rows),
+integrate, compare, fire, reset.
+
+Every float operation is the one :mod:`.samplers`' numpy path does, in the same order
+(filtering in the orbit order of :mod:`.orbits`), and every pixel's arithmetic depends on
+nothing but its own coordinates, so the spikes are bit-identical to the numpy path for any
+tile size, chunk length and thread count.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from rvsm.model.kernels.orbits import kernel_orbits
+from rvsm.model.noise.sensor import NoiseSource
+from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, check_coordinates, normal_row
+from rvsm.model.sampling.orbit_kernels import (
+    scale_sum_0,
+    scale_sum_1,
+    scale_sum_2,
+    scale_sum_3,
+    scale_sum_4,
+)
+from rvsm.model.scene.scene import Scene
+
+DEFAULT_TILE_ROWS = 16
+DEFAULT_CHUNK_STEPS = 256
+
+
+def chunk_frames(scene: Scene, t0: int, t1: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What a fused kernel needs for steps ``t0 .. t1 - 1``: the scene's frames the chunk
+    touches ``(F, H, W)``, each step's first frame as an index into them ``(T,) int64``
+    and its interpolation weight ``(T,) float64`` (:meth:`Scene.frame_weights`)."""
+    f, a = scene.frame_weights(t0, t1)
+    first = int(f[0])
+    last = min(int(f[-1]) + 1, scene.num_frames - 1)
+    return (scene.frames[first:last + 1], (f - first).astype(np.int64),
+            np.ascontiguousarray(a, dtype=np.float64))
+
+
+@njit(inline="always", cache=True)
+def _row_pairs(pad, nrows, lmax, width, pairs):
+    """``pairs[b, r, x] = pad[r, x + L - b] + pad[r, x + L + b]`` (``b = 0``: the value)."""
+    # Slices first: ``src[x + lmax - b]`` would carry numba's negative-index wraparound
+    # check, which keeps the loop from vectorising.
+    for r in range(nrows):
+        src = pad[r]
+        mid = src[lmax:lmax + width]
+        dst = pairs[0, r]
+        for x in range(width):
+            dst[x] = mid[x]
+        for b in range(1, lmax + 1):
+            dst = pairs[b, r]
+            left = src[lmax - b:lmax - b + width]
+            right = src[lmax + b:lmax + b + width]
+            for x in range(width):
+                dst[x] = left[x] + right[x]
+
+
+@njit(inline="always", cache=True)
+def _scale_sum(pairs, pr, w, half, width, out):
+    if half == 0:
+        scale_sum_0(pairs, pr, w, width, out)
+    elif half == 1:
+        scale_sum_1(pairs, pr, w, width, out)
+    elif half == 2:
+        scale_sum_2(pairs, pr, w, width, out)
+    elif half == 3:
+        scale_sum_3(pairs, pr, w, width, out)
+    else:
+        scale_sum_4(pairs, pr, w, width, out)
+
+
+@njit(inline="always", cache=True)
+def _filter_rows(pairs, r0, nrows, weights, halves, width, out):
+    """``out[s, r, x]``: receptive sums of rows ``r0 .. r0 + nrows - 1`` of the padded
+    image whose row pairs are ``pairs`` (orbit order of :mod:`.orbits`)."""
+    for r in range(nrows):
+        for s in range(weights.shape[0]):
+            _scale_sum(pairs, r0 + r, weights[s], halves[s], width, out[s, r])
+
+
+@njit(parallel=True, cache=True)
+def _filter_frames(padded, weights, halves, lmax, height, width, tile_rows, out):
+    num_frames = padded.shape[0]
+    num_scales = weights.shape[0]
+    num_tiles = (height + tile_rows - 1) // tile_rows
+    for i in prange(num_frames * num_tiles):
+        f = i // num_tiles
+        y0 = (i - f * num_tiles) * tile_rows
+        rows = min(height, y0 + tile_rows) - y0
+        pairs = np.empty((lmax + 1, rows + 2 * lmax, width))
+        local = np.empty((num_scales, rows, width))
+        _row_pairs(padded[f, y0:y0 + rows + 2 * lmax], rows + 2 * lmax, lmax, width, pairs)
+        _filter_rows(pairs, lmax, rows, weights, halves, width, local)
+        out[f, :, y0:y0 + rows] = local
+
+
+def filter_frames(frames: np.ndarray, weights, halves, lmax: int, tile_rows: int = 32,
+                  out: np.ndarray | None = None, padded: np.ndarray | None = None) -> np.ndarray:
+    """Receptive sums ``(F, S, H, W) float64`` of ``frames (F, H, W)`` in orbit order.
+
+    ``out`` and ``padded`` (``(F', H + 2L, W + 2L)`` zeros outside, ``F' >= F``) are
+    optional buffers to reuse.
+    """
+    f, h, w = frames.shape
+    if padded is None or padded.shape[0] < f:
+        padded = np.zeros((f, h + 2 * lmax, w + 2 * lmax))
+    padded = padded[:f]
+    padded[:, lmax:lmax + h, lmax:lmax + w] = frames
+    if out is None or out.shape[0] < f:
+        out = np.empty((f, weights.shape[0], h, w))
+    out = out[:f]
+    _filter_frames(padded, weights, halves, lmax, h, w, tile_rows, out)
+    return out
+
+
+@njit(inline="always", cache=True)
+def _integrate_row(acc, thr, drive, spikes, width, signed, zero_reset):
+    """Integrate one row of one scale, compare, fire, reset (the numpy Integrator's rules)."""
+    if zero_reset:
+        if signed:
+            for x in range(width):
+                v = acc[x] + drive[x]
+                th = thr[x]
+                sp = np.int8(1) if v >= th else (np.int8(-1) if v <= -th else np.int8(0))
+                spikes[x] = sp
+                acc[x] = v if sp == 0 else 0.0
+        else:
+            for x in range(width):
+                v = acc[x] + drive[x]
+                fired = v >= thr[x]
+                spikes[x] = np.int8(1) if fired else np.int8(0)
+                acc[x] = 0.0 if fired else v
+    else:
+        for x in range(width):
+            v = acc[x] + drive[x]
+            th = thr[x]
+            if v >= th:
+                spikes[x] = 1
+                v = v - th
+            elif signed and v <= -th:
+                spikes[x] = -1
+                v = v + th
+            else:
+                spikes[x] = 0
+            acc[x] = v
+
+
+@njit(parallel=True, cache=True)
+def _float_chunk(kf, fidx, aw, thr, acc, signed, zero_reset, noisy, key, t0, mean, sd,
+                 zx, zr, weights, halves, lmax, tile_rows, out):
+    num_scales, height, width = acc.shape
+    num_steps = fidx.shape[0]
+    num_tiles = (height + tile_rows - 1) // tile_rows
+    halo = lmax if noisy else 0
+    for ti in prange(num_tiles):
+        y0 = ti * tile_rows
+        y1 = min(height, y0 + tile_rows)
+        rows = y1 - y0
+        pad = np.zeros((rows + 2 * halo, width + 2 * halo))
+        pairs = np.empty((halo + 1, rows + 2 * halo, width)) if noisy else np.empty((1, 1, 1))
+        dark = np.empty((num_scales, rows, width)) if noisy else np.empty((1, 1, 1))
+        drive = np.empty(width)
+        for b in range(num_steps):
+            f = fidx[b]
+            a = aw[b]
+            oma = 1.0 - a
+            if noisy:
+                for r in range(rows + 2 * halo):
+                    y = y0 - halo + r
+                    if y >= 0 and y < height:
+                        normal_row(key, t0 + b, y, width, mean, sd, zx, zr, pad[r], halo)
+                _row_pairs(pad, rows + 2 * halo, halo, width, pairs)
+                _filter_rows(pairs, halo, rows, weights, halves, width, dark)
+            for r in range(rows):
+                y = y0 + r
+                for s in range(num_scales):
+                    k0 = kf[f, s, y]
+                    if a == 0.0:
+                        for x in range(width):
+                            drive[x] = k0[x]
+                    else:
+                        k1 = kf[f + 1, s, y]
+                        for x in range(width):
+                            drive[x] = k0[x] * oma + k1[x] * a
+                    if noisy:
+                        for x in range(width):
+                            drive[x] = drive[x] + dark[s, r, x]
+                    _integrate_row(acc[s, y], thr[s, y], drive, out[b, s, y], width,
+                                   signed, zero_reset)
+
+
+class FusedFloatSampler:
+    """The float sampler's state and fused chunk kernel for one scene and configuration.
+
+    ``thresholds`` is ``(S, H, W) float64`` (from :func:`.samplers.accumulator_thresholds`);
+    :meth:`run` advances the accumulators over steps ``t0 .. t1 - 1`` (consecutive calls
+    must cover consecutive ranges) and returns ``(t1 - t0, S, H, W) int8`` spikes.
+    """
+
+    def __init__(self, scene: Scene, config, thresholds: np.ndarray,
+                 tile_rows: int = DEFAULT_TILE_ROWS):
+        spec = config.spec
+        self.scene = scene
+        _, self.weights, self.halves, self.lmax = kernel_orbits(spec.kernels())
+        self.weights = np.ascontiguousarray(self.weights, dtype=np.float64)
+        self.thr = np.ascontiguousarray(thresholds, dtype=np.float64)
+        self.acc = np.zeros_like(self.thr)
+        self.signed = bool(spec.signed)
+        self.zero_reset = config.reset == "zero"
+        self.tile_rows = max(1, int(tile_rows))
+        if config.noise is not None:
+            check_coordinates(scene.num_steps, scene.shape)
+            src = NoiseSource(config.noise, scene.shape, spec.num_scales)
+            self.key = src.dark_key
+            self.mean, self.sd = src.dark_mean_sd
+            self.noisy = True
+        else:
+            self.key, self.mean, self.sd, self.noisy = np.uint64(0), 0.0, 0.0, False
+        self.next_step = 0
+        self._kf: np.ndarray | None = None
+        self._padded: np.ndarray | None = None
+
+    def run(self, t0: int, t1: int, out: np.ndarray | None = None) -> np.ndarray:
+        """Spikes ``(t1 - t0, S, H, W) int8`` of steps ``t0 .. t1 - 1``."""
+        if t0 != self.next_step:
+            raise ValueError(f"chunks must be consecutive: expected step {self.next_step}")
+        scene = self.scene
+        frames, fidx, aw = chunk_frames(scene, t0, t1)
+        if self.lmax == 0:  # FSM: 0 + 1.0 * v is v
+            kf = frames[:, None]
+        else:
+            nf = frames.shape[0]
+            if self._kf is None or self._kf.shape[0] < nf:
+                h, w = scene.shape
+                self._kf = np.empty((nf, self.weights.shape[0], h, w))
+                self._padded = np.zeros((nf, h + 2 * self.lmax, w + 2 * self.lmax))
+            kf = filter_frames(frames, self.weights, self.halves, self.lmax,
+                               out=self._kf, padded=self._padded)
+        s, h, w = self.acc.shape
+        if out is None:
+            out = np.empty((t1 - t0, s, h, w), dtype=np.int8)
+        _float_chunk(
+            kf, fidx, aw,
+            self.thr, self.acc, self.signed, self.zero_reset, self.noisy, self.key,
+            int(t0), self.mean, self.sd, ZIG_X, ZIG_RATIO, self.weights, self.halves,
+            self.lmax, self.tile_rows, out,
+        )
+        self.next_step = t1
+        return out

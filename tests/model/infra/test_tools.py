@@ -1,0 +1,96 @@
+"""Tools in their own process group: failures named, groups killed with the parent."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from rvsm.model.infra.errors import ToolError
+from rvsm.model.infra.tools import ToolFailure, describe_status, live_groups, run_tool
+
+
+def _alive(pid: int) -> bool:
+    """True while ``pid`` runs (a zombie counts as dead)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, IndexError):
+        return False
+    return state != "Z"
+
+
+def _wait_dead(pid: int, seconds: float = 15.0) -> bool:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if not _alive(pid):
+            return True
+        time.sleep(0.05)
+    return False
+
+
+def test_success_and_captured_output() -> None:
+    r = run_tool(["sh", "-c", "echo hello"], capture=True)
+    assert r.returncode == 0 and r.stdout.strip() == "hello"
+    assert live_groups() == []
+
+
+def test_failure_names_tool_status_and_log(tmp_path: Path) -> None:
+    log = tmp_path / "t.log"
+    with pytest.raises(ToolFailure) as info:
+        run_tool(["sh", "-c", "echo oops; exit 7"], tool="fake compiler", log=log)
+    exc = info.value
+    assert isinstance(exc, ToolError) and exc.status == 7
+    assert str(exc) == f"fake compiler exited with status 7; log: {log}"
+    assert log.read_text().strip() == "oops"
+
+
+def test_killed_tool_names_the_signal() -> None:
+    with pytest.raises(ToolFailure, match=r"sh was killed by SIGKILL \(status -9\)"):
+        run_tool(["sh", "-c", "kill -9 $$"])
+    assert describe_status(-15) == "was killed by SIGTERM (status -15)"
+    assert describe_status(0) == "exited with status 0"
+
+
+def test_missing_tool_is_a_tool_failure(tmp_path: Path) -> None:
+    with pytest.raises(ToolFailure, match="not found"):
+        run_tool([str(tmp_path / "no-such-tool")])
+
+
+def test_stragglers_of_a_dead_tool_are_killed(tmp_path: Path) -> None:
+    """A tool that dies (make under the OOM killer) leaves no child (cc1plus) behind."""
+    pid_file = tmp_path / "pid"
+    with pytest.raises(ToolFailure):
+        run_tool(["sh", "-c", f"sleep 60 & echo $! > {pid_file}; exit 3"])
+    assert _wait_dead(int(pid_file.read_text()))
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_interrupted_parent_kills_the_tool_group(tmp_path: Path, sig: int) -> None:
+    """A Python parent interrupted while its tool runs takes the tool's children along."""
+    pid_file = tmp_path / "pid"
+    script = textwrap.dedent(f"""
+        import signal, sys
+        from rvsm.model.infra.tools import run_tool
+        signal.signal(signal.SIGTERM, signal.default_int_handler)
+        try:
+            run_tool(["sh", "-c", "sleep 60 & echo $! > {pid_file}; wait"])
+        except KeyboardInterrupt:
+            sys.exit(130)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script])
+    end = time.monotonic() + 20
+    while not (pid_file.exists() and pid_file.read_text().strip()):
+        assert time.monotonic() < end and proc.poll() is None
+        time.sleep(0.05)
+    child = int(pid_file.read_text())
+    assert _alive(child)
+    time.sleep(0.5)  # the parent is waiting for its tool now
+    os.kill(proc.pid, sig)
+    assert proc.wait(timeout=20) == 130
+    assert _wait_dead(child)
