@@ -28,10 +28,10 @@ from pathlib import Path
 import numba
 
 from rvsm.model.fixed.design_point import DesignPoint
-from rvsm.model.fixed.fused import stream_fixed
+from rvsm.model.fixed.twin import stream_fixed
 from rvsm.model.noise.sensor import NoiseParams
-from rvsm.model.sampling.samplers import SamplerConfig
-from rvsm.model.sampling.stream import stream_float
+from rvsm.model.sampling.config import SamplerConfig
+from rvsm.model.sampling.twin import stream_float
 from rvsm.model.scene.library import builtin_scene
 
 #: (label, kind, model, noise) -> target acc-steps/s (None: no target)

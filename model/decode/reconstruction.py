@@ -21,7 +21,7 @@ import numpy as np
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.filtering import adjoint_sums
 from rvsm.model.kernels.receptive_fields import ModelSpec, model_spec
-from rvsm.model.spikes.npz import single_scale_spikes
+from rvsm.model.spikes.arrays import single_scale_spikes
 
 METHODS = ("auto", "tfi", "tfp", "rvsm", "inverse")
 MATCH_MODES = ("gain", "affine")

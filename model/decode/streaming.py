@@ -35,7 +35,7 @@ from rvsm.model.decode.reconstruction import (
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import ModelSpec, model_spec
 from rvsm.model.scene.scene import Scene
-from rvsm.model.spikes.h5 import SpikeSource
+from rvsm.model.spikes.source import SpikeSource
 
 DEFAULT_EVAL_CHUNK = 256
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from rvsm.model.fixed.widths import signed_range, unsigned_max
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.sampling.samplers import RESET_MODES
+from rvsm.model.sampling.config import RESET_MODES
 
 
 def integer_receptive_sums(codes: np.ndarray, weights: Sequence[np.ndarray]) -> np.ndarray:

@@ -15,7 +15,7 @@ import numpy as np
 
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.twin import fit_point, simulate_fixed
-from rvsm.model.sampling.samplers import sample
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.scene import Scene
 
 

@@ -43,7 +43,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES, ModelSpec, model_spec
 from rvsm.model.noise.presets import NOISE_PRESETS, preset_noise
 from rvsm.model.noise.sensor import MAX_K, NoiseParams, NoiseSource
-from rvsm.model.sampling.samplers import RESET_MODES, SamplerConfig
+from rvsm.model.sampling.config import RESET_MODES, SamplerConfig
 from rvsm.model.sampling.thresholds import (
     DEFAULT_CALIBRATION_SCENE,
     THRESHOLD_RULES,

@@ -5,8 +5,9 @@ tiles of rows in parallel and, inside a tile, loops over the chunk's steps: inte
 brightness of the tile's rows plus a halo of ``L`` rows (SPEC section 1's expression), add
 the dark current (counter-based streams, :mod:`rvsm.model.noise.streams`), ADC (the
 rounding and clipping of :mod:`.adc`), exact receptive sums with the integer weights
-(orbit sums, :mod:`rvsm.model.sampling.orbit_kernels`), arithmetic right shift (floor division by
-``2**shift``), W-bit saturating accumulators, compare with the integer thresholds, reset.
+(the row sums of :mod:`rvsm.model.sampling.row_sums`), arithmetic right shift (floor
+division by ``2**shift``), W-bit saturating accumulators, compare with the integer
+thresholds, reset.
 
 Exact integers: the integer arithmetic runs in the narrowest type that holds every
 per-step sum and accumulator value exactly (:func:`exact_dtype`, checked from the
@@ -27,11 +28,13 @@ import numpy as np
 from numba import njit, prange, types
 from numba.extending import overload
 
+from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.widths import signed_range
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, check_coordinates, pixel_normal
-from rvsm.model.sampling.fused import _row_pairs, _scale_sum, chunk_frames
+from rvsm.model.sampling.fused import DEFAULT_TILE_ROWS, chunk_frames
+from rvsm.model.sampling.row_sums import row_pairs, scale_sum
 from rvsm.model.scene.scene import Scene
 
 #: integers of magnitude below ``2**bits`` are exact in the type (its mantissa + 1 bits)
@@ -199,11 +202,11 @@ def _fixed_chunk(frames, fidx, aw, thr, acc, weights, halves, lmax, gain, half, 
                     c = np.floor(v * gain + half)
                     c = 0.0 if c < 0.0 else (top if c > top else c)
                     prow[x] = c
-            _row_pairs(pad, nrows, lmax, width, pairs)
+            row_pairs(pad, nrows, lmax, width, pairs)
             for r in range(rows):
                 y = y0 + r
                 for s in range(num_scales):
-                    _scale_sum(pairs, lmax + r, weights[s], halves[s], width, sums)
+                    scale_sum(pairs, lmax + r, weights[s], halves[s], width, sums)
                     if ranges:
                         _integrate_fixed_row(sums, acc[s, y], thr[s, y], out[b, s, y], st[s],
                                              width, shift, scale, lo, hi, signed, zero_reset)
@@ -217,7 +220,7 @@ def _fixed_chunk(frames, fidx, aw, thr, acc, weights, halves, lmax, gain, half, 
         analog_range[ti, 1] = max(analog_range[ti, 1], amax)
 
 
-def exact_dtype(point) -> type:
+def exact_dtype(point: DesignPoint) -> type:
     """The narrowest of float32, float64 and int64 that holds every value of ``point``'s
     integer datapath exactly.
 
@@ -242,8 +245,8 @@ class FusedFixedTwin:
     datapath counters so far (per scale: sum, shifted and accumulator min/max, saturated).
     """
 
-    def __init__(self, scene: Scene, point, thresholds: np.ndarray, tile_rows: int = 16,
-                 ranges: bool = True):
+    def __init__(self, scene: Scene, point: DesignPoint, thresholds: np.ndarray,
+                 tile_rows: int = DEFAULT_TILE_ROWS, ranges: bool = True):
         self.scene = scene
         self.ranges = bool(ranges)
         self.point = point
@@ -334,110 +337,3 @@ class FusedFixedTwin:
             out[name] = col.astype(np.int64)
         out["saturated"] = st[:, :, 6].sum(axis=0).astype(np.int64)
         return out
-
-
-def stream_fixed(
-    scene: Scene,
-    point,
-    sink,
-    chunk_steps: int = 256,
-    engine: str = "fused",
-    tile_rows: int = 16,
-    progress: bool = False,
-    ranges: bool = True,
-):
-    """Run the fixed twin of ``point`` over ``scene`` chunk by chunk into ``sink``.
-
-    Returns a :class:`~.twin.FixedRun` whose ``spikes`` is ``None`` (they went to the
-    sink). ``engine`` ``"numpy"`` runs the vectorised reference
-    (:func:`~.twin.simulate_fixed` ``engine="numpy"``) step by step. ``ranges=False``
-    skips the min/max datapath statistics of the fused engine (they stay None; the
-    saturation counts are always kept): about 1.5x faster.
-    """
-    from rvsm.model.fixed.adc import adc_codes
-    from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift, integer_receptive_sums
-    from rvsm.model.fixed.twin import FixedRun, FixedStats, fit_point, fixed_meta
-    from rvsm.model.infra.progress import progress_bar
-    from rvsm.model.sampling.samplers import ENGINES
-    from rvsm.model.sampling.stream import check_chunking, run_chunks
-
-    if engine not in ENGINES:
-        raise RvsmError(f"engine must be one of {ENGINES}, got {engine!r}")
-    check_chunking(chunk_steps, tile_rows)
-    point = fit_point(scene, point)
-    contract = point.contract()
-    noise = point.noise_source()
-    thresholds = point.integer_thresholds(noise)
-    s_count, (h, w), t_total = point.num_scales, point.shape, scene.num_steps
-    shape = (t_total, s_count, h, w)
-    buf = np.empty((min(chunk_steps, max(t_total, 1)), s_count, h, w), dtype=np.int8)
-    if engine == "fused":
-        twin = FusedFixedTwin(scene, point, thresholds, tile_rows, ranges)
-
-        def produce(t0: int, t1: int) -> np.ndarray:
-            return twin.run(t0, t1, buf[:t1 - t0])
-
-        def final_stats() -> dict:
-            return twin.stats()
-    else:
-        integrator = FixedIntegrator(thresholds, point.accumulator_bits, point.signed,
-                                     point.reset, track=True)
-        weights = contract.weight_arrays
-        big, small = np.iinfo(np.int64).max, np.iinfo(np.int64).min
-        acc_stats = {"sum_min": np.full(s_count, big), "sum_max": np.full(s_count, small),
-                     "shifted_min": np.full(s_count, big),
-                     "shifted_max": np.full(s_count, small)}
-
-        def produce(t0: int, t1: int) -> np.ndarray:
-            analog = scene.brightness(t0, t1)
-            if noise is not None:
-                analog += noise.dark_current_at(t0, t1 - t0)
-            codes = adc_codes(analog, point.adc_bits, point.adc_full_scale,
-                              point.adc_rounding, point.adc_clip)
-            sums = integer_receptive_sums(codes, weights)
-            np.minimum(acc_stats["sum_min"], sums.min(axis=(0, 2, 3)), out=acc_stats["sum_min"])
-            np.maximum(acc_stats["sum_max"], sums.max(axis=(0, 2, 3)), out=acc_stats["sum_max"])
-            shifted = arithmetic_shift(sums, point.shift) if point.shift else sums
-            np.minimum(acc_stats["shifted_min"], shifted.min(axis=(0, 2, 3)),
-                       out=acc_stats["shifted_min"])
-            np.maximum(acc_stats["shifted_max"], shifted.max(axis=(0, 2, 3)),
-                       out=acc_stats["shifted_max"])
-            for b in range(t1 - t0):
-                buf[b] = integrator.step(shifted[b])
-            return buf[:t1 - t0]
-
-        def final_stats() -> dict:
-            return {**acc_stats, "acc_min": integrator.acc_min.copy(),
-                    "acc_max": integrator.acc_max.copy(),
-                    "saturated": integrator.saturated.copy()}
-
-    placeholder = FixedStats(steps=t_total, accumulators=h * w,
-                             saturated=np.zeros(s_count, dtype=np.int64),
-                             sum_min=np.zeros(s_count, dtype=np.int64),
-                             sum_max=np.zeros(s_count, dtype=np.int64),
-                             shifted_min=np.zeros(s_count, dtype=np.int64),
-                             shifted_max=np.zeros(s_count, dtype=np.int64),
-                             acc_min=np.zeros(s_count, dtype=np.int64),
-                             acc_max=np.zeros(s_count, dtype=np.int64))
-    meta = fixed_meta(scene, point, thresholds, placeholder)
-    bar = progress_bar(t_total, f"fixed {point.model} {scene.name}", progress)
-    stats_box: dict = {}
-
-    class _StatsSink:
-        def begin(self, shape, meta):
-            sink.begin(shape, meta)
-
-        def write(self, t0, spikes):
-            sink.write(t0, spikes)
-
-        def finish(self, meta):
-            st = final_stats()
-            stats_box["stats"] = FixedStats(steps=t_total, accumulators=h * w, **st)
-            meta.update(fixed_meta(scene, point, thresholds, stats_box["stats"]))
-            sink.finish(meta)
-
-        def abort(self):
-            sink.abort()
-
-    run_chunks(_StatsSink(), shape, meta, t_total, int(chunk_steps), produce, bar)
-    return FixedRun(None, thresholds, point, contract, stats_box["stats"], meta)

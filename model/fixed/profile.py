@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rvsm.model.fixed.twin import FixedRun
+from rvsm.model.fixed.results import FixedRun
 from rvsm.model.fixed.weights import weight_error_report
 from rvsm.model.fixed.widths import signed_range
 from rvsm.model.infra.errors import RvsmError

@@ -5,13 +5,13 @@ chunk touches are filtered once (:func:`filter_frames`, parallel over rows); the
 :func:`_float_chunk` processes tiles of ``tile_rows`` rows in parallel (``prange``), and
 inside each tile loops over the chunk's steps with the tile's accumulators in cache:
 interpolate between filtered frames, add the filtered dark current (drawn inside the tile
-from the counter-based streams of :mod:`.noise_streams`, with a halo of ``L`` rows),
-integrate, compare, fire, reset.
+from the counter-based streams of :mod:`rvsm.model.noise.streams`, with a halo of ``L``
+rows), integrate, compare, fire, reset. Row sums are the shared kernels of :mod:`.row_sums`.
 
-Every float operation is the one :mod:`.samplers`' numpy path does, in the same order
-(filtering in the orbit order of :mod:`.orbits`), and every pixel's arithmetic depends on
-nothing but its own coordinates, so the spikes are bit-identical to the numpy path for any
-tile size, chunk length and thread count.
+Every float operation is the one :mod:`.numpy_engine` does, in the same order (filtering
+in the orbit order of :mod:`rvsm.model.kernels.orbits`), and every pixel's arithmetic
+depends on nothing but its own coordinates, so the spikes are bit-identical to the numpy
+engine for any tile size, chunk length and thread count.
 """
 
 from __future__ import annotations
@@ -22,17 +22,11 @@ from numba import njit, prange
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.sensor import NoiseSource
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, check_coordinates, normal_row
-from rvsm.model.sampling.orbit_kernels import (
-    scale_sum_0,
-    scale_sum_1,
-    scale_sum_2,
-    scale_sum_3,
-    scale_sum_4,
-)
+from rvsm.model.sampling.config import SamplerConfig
+from rvsm.model.sampling.row_sums import row_pairs, scale_sum
 from rvsm.model.scene.scene import Scene
 
 DEFAULT_TILE_ROWS = 16
-DEFAULT_CHUNK_STEPS = 256
 
 
 def chunk_frames(scene: Scene, t0: int, t1: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -47,45 +41,12 @@ def chunk_frames(scene: Scene, t0: int, t1: int) -> tuple[np.ndarray, np.ndarray
 
 
 @njit(inline="always", cache=True)
-def _row_pairs(pad, nrows, lmax, width, pairs):
-    """``pairs[b, r, x] = pad[r, x + L - b] + pad[r, x + L + b]`` (``b = 0``: the value)."""
-    # Slices first: ``src[x + lmax - b]`` would carry numba's negative-index wraparound
-    # check, which keeps the loop from vectorising.
-    for r in range(nrows):
-        src = pad[r]
-        mid = src[lmax:lmax + width]
-        dst = pairs[0, r]
-        for x in range(width):
-            dst[x] = mid[x]
-        for b in range(1, lmax + 1):
-            dst = pairs[b, r]
-            left = src[lmax - b:lmax - b + width]
-            right = src[lmax + b:lmax + b + width]
-            for x in range(width):
-                dst[x] = left[x] + right[x]
-
-
-@njit(inline="always", cache=True)
-def _scale_sum(pairs, pr, w, half, width, out):
-    if half == 0:
-        scale_sum_0(pairs, pr, w, width, out)
-    elif half == 1:
-        scale_sum_1(pairs, pr, w, width, out)
-    elif half == 2:
-        scale_sum_2(pairs, pr, w, width, out)
-    elif half == 3:
-        scale_sum_3(pairs, pr, w, width, out)
-    else:
-        scale_sum_4(pairs, pr, w, width, out)
-
-
-@njit(inline="always", cache=True)
 def _filter_rows(pairs, r0, nrows, weights, halves, width, out):
     """``out[s, r, x]``: receptive sums of rows ``r0 .. r0 + nrows - 1`` of the padded
-    image whose row pairs are ``pairs`` (orbit order of :mod:`.orbits`)."""
+    image whose row pairs are ``pairs`` (:func:`.row_sums.scale_sum`)."""
     for r in range(nrows):
         for s in range(weights.shape[0]):
-            _scale_sum(pairs, r0 + r, weights[s], halves[s], width, out[s, r])
+            scale_sum(pairs, r0 + r, weights[s], halves[s], width, out[s, r])
 
 
 @njit(parallel=True, cache=True)
@@ -99,7 +60,7 @@ def _filter_frames(padded, weights, halves, lmax, height, width, tile_rows, out)
         rows = min(height, y0 + tile_rows) - y0
         pairs = np.empty((lmax + 1, rows + 2 * lmax, width))
         local = np.empty((num_scales, rows, width))
-        _row_pairs(padded[f, y0:y0 + rows + 2 * lmax], rows + 2 * lmax, lmax, width, pairs)
+        row_pairs(padded[f, y0:y0 + rows + 2 * lmax], rows + 2 * lmax, lmax, width, pairs)
         _filter_rows(pairs, lmax, rows, weights, halves, width, local)
         out[f, :, y0:y0 + rows] = local
 
@@ -179,7 +140,7 @@ def _float_chunk(kf, fidx, aw, thr, acc, signed, zero_reset, noisy, key, t0, mea
                     y = y0 - halo + r
                     if y >= 0 and y < height:
                         normal_row(key, t0 + b, y, width, mean, sd, zx, zr, pad[r], halo)
-                _row_pairs(pad, rows + 2 * halo, halo, width, pairs)
+                row_pairs(pad, rows + 2 * halo, halo, width, pairs)
                 _filter_rows(pairs, halo, rows, weights, halves, width, dark)
             for r in range(rows):
                 y = y0 + r
@@ -202,12 +163,12 @@ def _float_chunk(kf, fidx, aw, thr, acc, signed, zero_reset, noisy, key, t0, mea
 class FusedFloatSampler:
     """The float sampler's state and fused chunk kernel for one scene and configuration.
 
-    ``thresholds`` is ``(S, H, W) float64`` (from :func:`.samplers.accumulator_thresholds`);
+    ``thresholds`` is ``(S, H, W) float64`` (from :func:`.config.accumulator_thresholds`);
     :meth:`run` advances the accumulators over steps ``t0 .. t1 - 1`` (consecutive calls
     must cover consecutive ranges) and returns ``(t1 - t0, S, H, W) int8`` spikes.
     """
 
-    def __init__(self, scene: Scene, config, thresholds: np.ndarray,
+    def __init__(self, scene: Scene, config: SamplerConfig, thresholds: np.ndarray,
                  tile_rows: int = DEFAULT_TILE_ROWS):
         spec = config.spec
         self.scene = scene

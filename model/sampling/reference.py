@@ -2,8 +2,9 @@
 
 Per step it builds ``I_t`` from the frames, adds the dark current, forms every
 accumulator's receptive-field sum by explicit shifts of a zero-padded image, integrates,
-compares and resets. It shares no code with :mod:`samplers` beyond the kernels, the noise
-draws and the scene, so agreement between the two is evidence that the fast path is right.
+compares and resets. It shares no code with the engines (:mod:`.numpy_engine`,
+:mod:`.fused`) beyond the kernels, the noise draws and the scene, so agreement is evidence
+that the fast paths are right.
 It is slow on purpose; do not use it for real work.
 """
 
@@ -12,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from rvsm.model.noise.sensor import NoiseSource
-from rvsm.model.sampling.samplers import SamplerConfig
+from rvsm.model.sampling.config import SamplerConfig
 from rvsm.model.scene.scene import Scene
 
 

@@ -52,7 +52,7 @@ import numpy as np
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.filtering import receptive_field_sums
 from rvsm.model.kernels.receptive_fields import model_spec
-from rvsm.model.sampling.samplers import DEFAULT_PHI
+from rvsm.model.sampling.config import DEFAULT_PHI
 from rvsm.model.scene.scene import Scene
 
 THRESHOLD_RULES = ("equal", "response")

@@ -1,4 +1,5 @@
-"""HDF5 spike files, written chunk by chunk, and a common reader for every spike format.
+"""HDF5 spike files: written chunk by chunk (:class:`H5SpikeWriter`), read lazily
+(:func:`open_h5`).
 
 Layout (``.h5``): dataset ``spikes``, chunked along time (about 1 MiB per chunk, one
 scale per chunk) and compressed (LZF by default, gzip or none as options); root
@@ -6,17 +7,14 @@ attributes ``meta`` (the same JSON text as in ``.npz`` files), ``format =
 "rvsm-spikes"``, ``format_version = 1``, ``encoding``, ``shape`` (``T, S, H, W``) and
 ``complete`` (True only once every step was written). ``encoding = "2bit"`` (default):
 ``spikes`` is ``(T, S, H, ceil(W / 4)) uint8``, four spikes per byte
-(:mod:`.spike_packing`: 0 -> 00, 1 -> 01, -1 -> 11, pixel ``x`` at bits ``2 (x mod 4)``);
+(:mod:`.packing`: 0 -> 00, 1 -> 01, -1 -> 11, pixel ``x`` at bits ``2 (x mod 4)``);
 ``encoding = "int8"``: ``spikes`` is ``(T, S, H, W) int8`` in {-1, 0, 1}, readable by any
 HDF5 tool as is. Packing first makes the file smaller and the compression 4x cheaper.
 
 Atomicity: :class:`H5SpikeWriter` writes to a temporary ``.NAME.*.partial.h5`` beside the
 target, sets ``complete`` and renames it onto the target only after the last chunk, so a
 killed run never leaves a file under the target's name, and a partial file (if one were
-renamed by hand) is refused by :func:`open_spikes`.
-
-:func:`open_spikes` opens ``.h5`` lazily and ``.npz`` in memory behind one interface
-(:class:`SpikeSource`: ``shape``, ``meta``, ``read(t0, t1)``), so readers stream any file.
+renamed by hand) is refused by :func:`open_h5`.
 """
 
 from __future__ import annotations
@@ -32,8 +30,8 @@ import numpy as np
 from rvsm.model.infra.atomic import _UMASK
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.versions import with_versions
-from rvsm.model.spikes.npz import _check_spikes, dat_steps, load_spikes, unpack_dat
 from rvsm.model.spikes.packing import pack_spikes, packed_width, unpack_spikes
+from rvsm.model.spikes.source import SpikeSource
 
 FORMAT = "rvsm-spikes"
 FORMAT_VERSION = 1
@@ -57,7 +55,7 @@ def _h5py():
 
 
 class H5SpikeWriter:
-    """A spike sink (see :mod:`.sampling_stream`) writing an HDF5 spike file atomically."""
+    """A spike sink (:mod:`.sinks`) writing an HDF5 spike file atomically."""
 
     def __init__(self, path: str | os.PathLike, compression: str = "lzf",
                  encoding: str = "2bit"):
@@ -128,62 +126,10 @@ class H5SpikeWriter:
         self._tmp = None
 
 
-class SpikeSource:
-    """Read access to a spike file: ``shape (T, S, H, W)``, ``meta``, ``read(t0, t1)``.
-
-    Use as a context manager (closes an HDF5 file).
-    """
-
-    def __init__(self, shape, meta: dict, reader, closer=None, path: str = ""):
-        self.shape = tuple(int(v) for v in shape)
-        self.meta = meta
-        self._reader = reader
-        self._closer = closer
-        self.path = path
-
-    @property
-    def num_steps(self) -> int:
-        """T."""
-        return self.shape[0]
-
-    def read(self, t0: int, t1: int) -> np.ndarray:
-        """Spikes of steps ``t0 .. t1 - 1``: ``(t1 - t0, S, H, W) int8``."""
-        return np.asarray(self._reader(int(t0), int(t1)), dtype=np.int8)
-
-    def chunks(self, chunk_steps: int):
-        """Yield ``(t0, spikes)`` over the whole file in chunks of ``chunk_steps``."""
-        for t0 in range(0, self.num_steps, chunk_steps):
-            t1 = min(t0 + chunk_steps, self.num_steps)
-            yield t0, self.read(t0, t1)
-
-    def close(self) -> None:
-        if self._closer is not None:
-            self._closer()
-            self._closer = None
-
-    def __enter__(self) -> SpikeSource:
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
-
-
-def array_source(spikes: np.ndarray, meta: dict | None = None) -> SpikeSource:
-    """An in-memory ``(T, S, H, W)`` array as a :class:`SpikeSource`."""
-    arr = np.asarray(spikes)
-    if arr.ndim == 3:
-        arr = arr[:, None]
-    return SpikeSource(arr.shape, meta or {}, lambda t0, t1: arr[t0:t1])
-
-
-def open_spikes(path: str | os.PathLike) -> SpikeSource:
-    """Open an ``.h5`` (lazily) or ``.npz`` (in memory) spike file for reading."""
+def open_h5(path: str | os.PathLike) -> SpikeSource:
+    """Open an HDF5 spike file lazily; refuses foreign, incomplete or inconsistent
+    files."""
     path = Path(path)
-    if not is_h5_path(path):
-        spikes, meta = load_spikes(path)
-        src = array_source(spikes, meta)
-        src.path = str(path)
-        return src
     if not path.is_file():
         raise RvsmError(f"spike file {path} does not exist")
     h5py = _h5py()
@@ -220,102 +166,3 @@ def open_spikes(path: str | os.PathLike) -> SpikeSource:
         def read(t0: int, t1: int) -> np.ndarray:
             return dset[t0:t1]
     return SpikeSource(shape, meta, read, handle.close, str(path))
-
-
-def load_any_spikes(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
-    """Whole spike array and meta of an ``.h5`` or ``.npz`` file (small files only)."""
-    with open_spikes(path) as src:
-        return _check_spikes(src.read(0, src.num_steps), str(path)), src.meta
-
-
-def write_spikes(path: str | os.PathLike, spikes: np.ndarray, meta: dict,
-                 chunk_steps: int = 256) -> None:
-    """Write a whole spike array to ``.h5`` (chunked) or ``.npz``, by suffix."""
-    if not is_h5_path(path):
-        from rvsm.model.spikes.npz import save_spikes
-
-        save_spikes(path, spikes, meta)
-        return
-    arr = _check_spikes(np.asarray(spikes), str(path))
-    sink = H5SpikeWriter(path)
-    sink.begin(arr.shape, meta)
-    try:
-        for t0 in range(0, arr.shape[0], chunk_steps):
-            sink.write(t0, arr[t0:t0 + chunk_steps])
-        sink.finish(meta)
-    except BaseException:
-        sink.abort()
-        raise
-
-
-class DatWriter:
-    """A spike sink writing FSM spikes in the camera's ``.dat`` layout, chunk by chunk,
-    atomically (see :func:`rvsm.model.spikes.npz.export_dat` for the layout)."""
-
-    def __init__(self, path: str | os.PathLike, flip: bool = False):
-        self.path = Path(path)
-        self.flip = flip
-        self._handle = None
-        self._tmp: Path | None = None
-
-    def begin(self, shape, meta) -> None:
-        t, s, h, w = shape
-        if s != 1:
-            raise RvsmError(f".dat (one bit per pixel) needs single-scale (FSM) spikes; these "
-                            f"have {s} scales")
-        if (h * w) % 8:
-            raise RvsmError(f".dat needs H*W divisible by 8 (8 pixels per byte), got {h}x{w}")
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.stem}.", suffix=".partial.dat",
-                                   dir=self.path.parent)
-        self._handle = os.fdopen(fd, "wb")
-        self._tmp = Path(tmp)
-
-    def write(self, t0, spikes) -> None:
-        arr = spikes[:, 0]
-        if arr.size and (arr.min() < 0 or arr.max() > 1):
-            raise RvsmError(".dat holds only 0/1 spikes; RVSM's -1 spikes cannot be exported")
-        if self.flip:
-            arr = arr[:, ::-1]
-        t, h, w = arr.shape
-        np.packbits(arr.reshape(t, h * w).astype(bool), axis=1,
-                    bitorder="little").tofile(self._handle)
-
-    def finish(self, meta) -> None:
-        self._handle.close()
-        self._handle = None
-        os.chmod(self._tmp, 0o666 & ~_UMASK)
-        os.replace(self._tmp, self.path)
-        self._tmp = None
-
-    def abort(self) -> None:
-        if self._handle is not None:
-            self._handle.close()
-            self._handle = None
-        if self._tmp is not None and self._tmp.exists():
-            self._tmp.unlink()
-        self._tmp = None
-
-
-def dat_source(path: str | os.PathLike, height: int, width: int,
-               flip: bool = False) -> SpikeSource:
-    """A camera ``.dat`` file as a :class:`SpikeSource` of ``(T, 1, H, W)`` spikes, read
-    step range by step range (memory-mapped)."""
-    raw = dat_steps(path, height, width)
-
-    def read(t0: int, t1: int) -> np.ndarray:
-        return unpack_dat(raw[t0:t1], height, width, flip)
-
-    return SpikeSource((raw.shape[0], 1, height, width), {}, read, None, str(path))
-
-
-def copy_source(source: SpikeSource, sink, meta: dict, chunk_steps: int = 256) -> None:
-    """Stream every step of ``source`` into ``sink``."""
-    sink.begin(source.shape, meta)
-    try:
-        for t0, chunk in source.chunks(chunk_steps):
-            sink.write(t0, chunk)
-        sink.finish(meta)
-    except BaseException:
-        sink.abort()
-        raise

@@ -9,19 +9,20 @@ import numpy as np
 
 from rvsm.model.decode.reconstruction import MATCH_MODES, METHODS
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.sampling.fused import DEFAULT_CHUNK_STEPS
-from rvsm.model.sampling.samplers import DEFAULT_PHI, ENGINES, RESET_MODES, SamplerConfig
-from rvsm.model.sampling.stream import ArraySink, CountSink, TeeSink, stream_float
-from rvsm.model.sampling.thresholds import THRESHOLD_RULES, rule_thresholds
-from rvsm.model.spikes.h5 import (
-    DatWriter,
-    H5SpikeWriter,
-    copy_source,
-    dat_source,
-    is_h5_path,
-    open_spikes,
+from rvsm.model.sampling.config import (
+    DEFAULT_CHUNK_STEPS,
+    DEFAULT_PHI,
+    ENGINES,
+    RESET_MODES,
+    SamplerConfig,
 )
+from rvsm.model.sampling.thresholds import THRESHOLD_RULES, rule_thresholds
+from rvsm.model.sampling.twin import stream_float
+from rvsm.model.spikes.dat import DatWriter, dat_source
+from rvsm.model.spikes.files import copy_source, open_spikes
+from rvsm.model.spikes.h5 import H5SpikeWriter, is_h5_path
 from rvsm.model.spikes.npz import save_spikes
+from rvsm.model.spikes.sinks import ArraySink, CountSink, TeeSink
 from rvsm.sim.cli.args import (
     add_force_argument,
     add_noise_arguments,
@@ -163,8 +164,8 @@ def run_simulate(args: argparse.Namespace) -> int:
         if given:
             raise RvsmError(f"{', '.join(given)} come(s) from the design point with --fixed; "
                             "edit the TOML instead")
-        from rvsm.model.fixed.fused import stream_fixed
         from rvsm.model.fixed.point_toml import load_design_point
+        from rvsm.model.fixed.twin import stream_fixed
 
         point = load_design_point(args.fixed)
         size = parse_size_arg(args.size)

@@ -9,7 +9,7 @@ from pathlib import Path
 from rvsm.model.infra.atomic import atomic_path, write_text_atomic
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.noise.presets import NOISE_PRESETS
-from rvsm.model.sampling.samplers import DEFAULT_PHI
+from rvsm.model.sampling.config import DEFAULT_PHI
 from rvsm.model.sampling.thresholds import DEFAULT_CALIBRATION_SCENE, THRESHOLD_RULES
 from rvsm.sim.cli.args import add_force_argument, parse_size_arg
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs

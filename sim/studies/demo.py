@@ -18,7 +18,8 @@ import numpy as np
 from rvsm.model.decode.evaluation import evaluate_spikes, reconstruct_for_display, scored_steps
 from rvsm.model.infra.atomic import atomic_path, write_text_atomic
 from rvsm.model.noise.sensor import NoiseParams
-from rvsm.model.sampling.samplers import SamplerConfig, sample
+from rvsm.model.sampling.config import SamplerConfig
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.scene import Scene
 from rvsm.model.spikes.npz import save_spikes
 

@@ -22,7 +22,8 @@ import numpy as np
 from rvsm.model.decode.evaluation import evaluate_spikes
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.noise.sensor import NoiseParams
-from rvsm.model.sampling.samplers import DEFAULT_PHI, SamplerConfig, sample
+from rvsm.model.sampling.config import DEFAULT_PHI, SamplerConfig
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.scene import Scene
 
 # Paper Table 1, SSIM of FSM per scene (Character, Teapot, Coin, Grasshopper, Flyball,

@@ -18,12 +18,13 @@ from rvsm.model.decode.metrics import robustness_indices
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import model_spec
 from rvsm.model.noise.sensor import NoiseParams
-from rvsm.model.sampling.samplers import DEFAULT_PHI, SamplerConfig, sample
+from rvsm.model.sampling.config import DEFAULT_PHI, SamplerConfig
 from rvsm.model.sampling.thresholds import (
     DEFAULT_CALIBRATION_SCENE,
     THRESHOLD_RULES,
     calibration_thresholds,
 )
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.library import black_scene
 from rvsm.sim.studies.labels import method_label
 

@@ -21,8 +21,9 @@ from dataclasses import dataclass
 from rvsm.model.decode.evaluation import evaluate_spikes, reconstruct_for_display, scored_steps
 from rvsm.model.kernels.receptive_fields import model_spec
 from rvsm.model.noise.presets import preset_noise
-from rvsm.model.sampling.samplers import DEFAULT_PHI, SamplerConfig, sample
+from rvsm.model.sampling.config import DEFAULT_PHI, SamplerConfig
 from rvsm.model.sampling.thresholds import rule_thresholds
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.scene import Scene
 from rvsm.sim.studies.table import FIG6_CLEAN, FIG6_NOISY, TABLE_MODELS, TableResult
 

@@ -14,7 +14,8 @@ from rvsm.model.decode.evaluation import (
     warmup_steps,
 )
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.sampling.samplers import SamplerConfig, sample
+from rvsm.model.sampling.config import SamplerConfig
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.scene import Scene
 
 

@@ -18,7 +18,8 @@ from rvsm.model.decode.reconstruction import (
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.filtering import adjoint_sums, receptive_field_sums
 from rvsm.model.kernels.receptive_fields import model_spec
-from rvsm.model.sampling.samplers import SamplerConfig, sample
+from rvsm.model.sampling.config import SamplerConfig
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.scene import Scene
 
 PHI = 400.0

@@ -6,9 +6,11 @@ import pytest
 from rvsm.model.decode.evaluation import evaluate_spikes
 from rvsm.model.decode.streaming import evaluate_source
 from rvsm.model.noise.sensor import NoiseParams
-from rvsm.model.sampling.samplers import SamplerConfig, sample
+from rvsm.model.sampling.config import SamplerConfig
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.library import builtin_scene
-from rvsm.model.spikes.h5 import array_source, open_spikes, write_spikes
+from rvsm.model.spikes.files import open_spikes, write_spikes
+from rvsm.model.spikes.source import array_source
 
 
 @pytest.fixture(scope="module")

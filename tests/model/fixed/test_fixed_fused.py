@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 
 from rvsm.model.fixed.design_point import DesignPoint
-from rvsm.model.fixed.fused import exact_dtype, stream_fixed
-from rvsm.model.fixed.twin import simulate_fixed
+from rvsm.model.fixed.fused import exact_dtype
+from rvsm.model.fixed.twin import simulate_fixed, stream_fixed
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.sampling.stream import ArraySink
 from rvsm.model.scene.scene import Scene
+from rvsm.model.spikes.sinks import ArraySink
 
 STATS = ("saturated", "sum_min", "sum_max", "shifted_min", "shifted_max", "acc_min",
          "acc_max")
@@ -79,7 +79,7 @@ def test_float_and_fixed_twins_see_the_same_dark_current():
     point = DesignPoint(height=12, width=10, model="fsm", noise=True, seed=6, phi=40.0,
                         adc_bits=12, weight_frac_bits=8, accumulator_bits=24)
     from rvsm.model.fixed.adc import adc_codes
-    from rvsm.model.sampling.samplers import iter_step_drives
+    from rvsm.model.sampling.numpy_engine import iter_step_drives
 
     drives = np.stack([d[0].copy() for _, d in iter_step_drives(scene,
                                                                point.sampler_config())])

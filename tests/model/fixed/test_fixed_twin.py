@@ -14,7 +14,7 @@ from rvsm.model.fixed.design_point import DesignPoint, default_design_point
 from rvsm.model.fixed.profile import format_profile, profile_figure, profile_report
 from rvsm.model.fixed.stimulus import load_stimulus, make_stimulus, save_stimulus
 from rvsm.model.fixed.twin import simulate_fixed
-from rvsm.model.sampling.samplers import sample
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.library import builtin_scene
 
 SIZE = (24, 32)

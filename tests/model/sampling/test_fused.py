@@ -11,10 +11,11 @@ from rvsm.model.kernels.filtering import receptive_field_sums
 from rvsm.model.kernels.orbits import kernel_orbits, orbit_receptive_sums
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES, model_spec
 from rvsm.model.noise.sensor import NoiseParams
+from rvsm.model.sampling.config import SamplerConfig
 from rvsm.model.sampling.fused import filter_frames
-from rvsm.model.sampling.samplers import SamplerConfig, sample
-from rvsm.model.sampling.stream import ArraySink, CountSink, stream_float
+from rvsm.model.sampling.twin import sample, stream_float
 from rvsm.model.scene.scene import Scene
+from rvsm.model.spikes.sinks import ArraySink, CountSink
 
 ROOT = Path(__file__).resolve().parents[3]
 

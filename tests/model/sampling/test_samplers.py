@@ -4,8 +4,9 @@ import pytest
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES, dog_kernel
 from rvsm.model.noise.sensor import NoiseParams
+from rvsm.model.sampling.config import SamplerConfig
 from rvsm.model.sampling.reference import reference_sample
-from rvsm.model.sampling.samplers import SamplerConfig, sample
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.scene import Scene
 
 
@@ -66,7 +67,7 @@ def test_zero_padding_at_borders():
     """A uniform scene: a corner accumulator sees only the in-array part of its kernel."""
     scene = _scene(np.full((2, 9, 9), 50.0), m=1)
     config = SamplerConfig(model="gauss4", phi=1e9)
-    from rvsm.model.sampling.samplers import iter_step_drives
+    from rvsm.model.sampling.numpy_engine import iter_step_drives
 
     _, drive = next(iter_step_drives(scene, config))
     k = config.spec.kernels()[3]

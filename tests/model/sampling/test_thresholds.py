@@ -6,7 +6,7 @@ import pytest
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import model_spec
-from rvsm.model.sampling.samplers import SamplerConfig, sample
+from rvsm.model.sampling.config import SamplerConfig
 from rvsm.model.sampling.thresholds import (
     calibration_thresholds,
     first_spike_steps,
@@ -16,6 +16,7 @@ from rvsm.model.sampling.thresholds import (
     response_time,
     rule_thresholds,
 )
+from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.library import builtin_scene
 from rvsm.model.scene.scene import Scene
 

@@ -4,16 +4,9 @@ import pytest
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.versions import with_versions
-from rvsm.model.spikes.h5 import (
-    DatWriter,
-    H5SpikeWriter,
-    copy_source,
-    dat_source,
-    load_any_spikes,
-    open_spikes,
-    write_spikes,
-)
-from rvsm.model.spikes.npz import export_dat, import_dat
+from rvsm.model.spikes.dat import DatWriter, dat_source, export_dat, import_dat
+from rvsm.model.spikes.files import copy_source, load_any_spikes, open_spikes, write_spikes
+from rvsm.model.spikes.h5 import H5SpikeWriter
 from rvsm.model.spikes.packing import count_spikes, pack_spikes, unpack_spikes
 
 
@@ -110,6 +103,6 @@ def test_dat_streams_match_whole_file_functions(tmp_path):
 
 
 def open_spikes_array(a):
-    from rvsm.model.spikes.h5 import array_source
+    from rvsm.model.spikes.source import array_source
 
     return array_source(a)

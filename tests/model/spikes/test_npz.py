@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.spikes.npz import export_dat, import_dat, load_spikes, save_spikes
+from rvsm.model.spikes.dat import export_dat, import_dat
+from rvsm.model.spikes.npz import load_spikes, save_spikes
 
 
 def test_npz_round_trip(tmp_path):

@@ -1,0 +1,137 @@
+"""The spike camera's ``.dat`` files (FSM spikes only, one bit per pixel).
+
+Layout, as the camera writes it: no header; step after step, each step ``H*W/8`` bytes
+holding one bit per pixel in row-major order, 8 pixels per byte, least significant bit
+first. The camera stores rows bottom-up; ``flip=True`` flips vertically on both export and
+import (SpikeCV's loaders do). Whole arrays (:func:`export_dat`, :func:`import_dat`), a
+chunked writer (:class:`DatWriter`, a spike sink) and a chunked reader
+(:func:`dat_source`).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from rvsm.model.infra.atomic import _UMASK, atomic_path
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.memory import require_memory
+from rvsm.model.spikes.arrays import single_scale_spikes
+from rvsm.model.spikes.source import SpikeSource
+
+
+def export_dat(path: str | os.PathLike, spikes: np.ndarray, flip: bool = False) -> None:
+    """Write FSM spikes ``(T, H, W)`` or ``(T, 1, H, W)`` of 0/1 in the camera's layout."""
+    spikes = single_scale_spikes(spikes, ".dat (one bit per pixel)")
+    if spikes.size and (spikes.min() < 0 or spikes.max() > 1):
+        raise RvsmError(".dat holds only 0/1 spikes; RVSM's -1 spikes cannot be exported")
+    t, h, w = spikes.shape
+    if (h * w) % 8:
+        raise RvsmError(f".dat needs H*W divisible by 8 (8 pixels per byte), got {h}x{w}")
+    frames = spikes[:, ::-1] if flip else spikes
+    packed = np.packbits(frames.reshape(t, h * w).astype(bool), axis=1, bitorder="little")
+    with atomic_path(path) as tmp:
+        packed.tofile(tmp)
+
+
+def dat_steps(path: str | os.PathLike, height: int, width: int) -> np.ndarray:
+    """The steps of a camera ``.dat`` file, checked against ``height x width``, as a
+    read-only memory map ``(T, H*W/8) uint8`` (one row of packed bits per step)."""
+    path = Path(path)
+    if not path.is_file():
+        raise RvsmError(f".dat file {path} does not exist")
+    if height < 1 or width < 1 or (height * width) % 8:
+        raise RvsmError(
+            f".dat size {height}x{width} invalid: H*W must be positive and divisible by 8"
+        )
+    step_bytes = height * width // 8
+    size = path.stat().st_size
+    if size == 0 or size % step_bytes:
+        raise RvsmError(
+            f"{path} is truncated or not {height}x{width}: {size} bytes is not a whole "
+            f"number of steps of {step_bytes} bytes; check --size"
+        )
+    return np.memmap(path, dtype=np.uint8, mode="r").reshape(-1, step_bytes)
+
+
+def unpack_dat(rows: np.ndarray, height: int, width: int, flip: bool = False) -> np.ndarray:
+    """Spikes ``(T, 1, H, W) int8`` of ``.dat`` step rows ``(T, H*W/8) uint8``."""
+    bits = np.unpackbits(np.asarray(rows), axis=1, bitorder="little")
+    frames = bits.reshape(-1, height, width)
+    if flip:
+        frames = frames[:, ::-1]
+    return np.ascontiguousarray(frames[:, None]).astype(np.int8)
+
+
+def import_dat(
+    path: str | os.PathLike, height: int, width: int, flip: bool = False
+) -> np.ndarray:
+    """Read a camera ``.dat`` file into spikes ``(T, 1, H, W) int8``."""
+    raw = dat_steps(path, height, width)
+    require_memory(9 * raw.size, f"{path} (one int8 per pixel)",
+                   "split the .dat file into shorter recordings")
+    return unpack_dat(raw, height, width, flip)
+
+
+class DatWriter:
+    """A spike sink writing FSM spikes in the camera's ``.dat`` layout, chunk by chunk,
+    atomically (the layout of the module docstring)."""
+
+    def __init__(self, path: str | os.PathLike, flip: bool = False):
+        self.path = Path(path)
+        self.flip = flip
+        self._handle = None
+        self._tmp: Path | None = None
+
+    def begin(self, shape, meta) -> None:
+        t, s, h, w = shape
+        if s != 1:
+            raise RvsmError(f".dat (one bit per pixel) needs single-scale (FSM) spikes; these "
+                            f"have {s} scales")
+        if (h * w) % 8:
+            raise RvsmError(f".dat needs H*W divisible by 8 (8 pixels per byte), got {h}x{w}")
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.stem}.", suffix=".partial.dat",
+                                   dir=self.path.parent)
+        self._handle = os.fdopen(fd, "wb")
+        self._tmp = Path(tmp)
+
+    def write(self, t0, spikes) -> None:
+        arr = spikes[:, 0]
+        if arr.size and (arr.min() < 0 or arr.max() > 1):
+            raise RvsmError(".dat holds only 0/1 spikes; RVSM's -1 spikes cannot be exported")
+        if self.flip:
+            arr = arr[:, ::-1]
+        t, h, w = arr.shape
+        np.packbits(arr.reshape(t, h * w).astype(bool), axis=1,
+                    bitorder="little").tofile(self._handle)
+
+    def finish(self, meta) -> None:
+        self._handle.close()
+        self._handle = None
+        os.chmod(self._tmp, 0o666 & ~_UMASK)
+        os.replace(self._tmp, self.path)
+        self._tmp = None
+
+    def abort(self) -> None:
+        if self._handle is not None:
+            self._handle.close()
+            self._handle = None
+        if self._tmp is not None and self._tmp.exists():
+            self._tmp.unlink()
+        self._tmp = None
+
+
+def dat_source(path: str | os.PathLike, height: int, width: int,
+               flip: bool = False) -> SpikeSource:
+    """A camera ``.dat`` file as a :class:`SpikeSource` of ``(T, 1, H, W)`` spikes, read
+    step range by step range (memory-mapped)."""
+    raw = dat_steps(path, height, width)
+
+    def read(t0: int, t1: int) -> np.ndarray:
+        return unpack_dat(raw[t0:t1], height, width, flip)
+
+    return SpikeSource((raw.shape[0], 1, height, width), {}, read, None, str(path))
