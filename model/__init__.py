@@ -1,19 +1,27 @@
-"""Float and fixed-point models of the RVSM spike-camera pixel array.
+"""Float and fixed-point models of the RVSM spike-camera pixel array (``rvsm.model``).
 
-Submodules, one concept each:
+Sub-packages, one concern each (the layering is ``sim -> rtl -> model``; nothing here
+imports ``rtl`` or ``sim``):
 
-- :mod:`kernels` -- normalised DoG / Gauss receptive fields and the scale ladders.
-- :mod:`scene` -- a scene (frames + ``steps_per_frame``) and its per-step brightness.
-- :mod:`scene_library` / :mod:`scene_io` -- built-in synthetic scenes and file loaders.
-- :mod:`noise` -- dark current and fixed-pattern threshold noise (SPEC section 3).
-- :mod:`samplers` -- the float FSM / RVSM samplers (SPEC section 2).
-- :mod:`spike_files` -- ``.npz`` spike files and the spike camera's ``.dat`` layout.
-- :mod:`reconstruction`, :mod:`metrics` -- TFI/TFP, the RVSM adjoint, PSNR/SSIM, robustness.
-- :mod:`inverse` -- the least-squares inverse of the RVSM filter bank (CG).
-- :mod:`thresholds` -- per-scale threshold rules: equal, equal response time.
-- :mod:`noise_presets` / :mod:`noise_calibration` -- named noise regimes and the
-  calibration of the ``paper`` preset on FSM.
-- :mod:`fixed` -- the bit-accurate fixed-point twin (SPEC section 5).
+- :mod:`.scene` -- a scene (frames + ``steps_per_frame``), its per-step brightness, the
+  built-in synthetic scenes and the file loaders.
+- :mod:`.kernels` -- normalised DoG / Gauss receptive fields, the scale ladders, the orbit
+  order of the receptive sums.
+- :mod:`.noise` -- dark current and fixed-pattern threshold noise (SPEC section 3), its
+  counter-based streams and the named presets.
+- :mod:`.sampling` -- the float twin (SPEC section 2): configuration and results, the
+  numpy and fused numba engines, one chunked run pipeline (``sample``,
+  ``stream_float``), threshold rules and the literal SPEC oracle.
+- :mod:`.fixed` -- the bit-accurate fixed-point twin (SPEC section 5): design points, the
+  :class:`~.fixed.core.ArrayContract`, the numpy and fused engines and one run pipeline
+  (``simulate_fixed``, ``stream_fixed``), stimulus, profile and cost.
+- :mod:`.spikes` -- spike I/O: ``.npz``, the camera's ``.dat``, chunked HDF5, two-bit
+  packing, the sinks a chunked run writes to and one reader entry point
+  (``open_spikes``).
+- :mod:`.decode` -- reconstruction (TFI/TFP, the RVSM adjoint, the least-squares inverse),
+  metrics (PSNR/SSIM) and evaluation, whole-array or streamed.
+- :mod:`.infra` -- what the models run on: errors and exit statuses, atomic writes,
+  external tools, progress bars, versions, memory checks, text and ``.npy`` guards.
 """
 
 import os as _os
