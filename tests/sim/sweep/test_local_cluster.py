@@ -8,7 +8,7 @@ from urllib.parse import urlparse
 import psutil
 import pytest
 
-from rvsm.sim.sweep.run import LOCAL_HOST, local_cluster
+from rvsm.sim.sweep.executors import LOCAL_HOST, local_cluster
 
 
 def _listening(procs) -> list[tuple[int, str, int]]:

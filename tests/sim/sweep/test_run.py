@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.sim.sweep import run as sweep_run
+from rvsm.sim.sweep import work as sweep_work
 from rvsm.sim.sweep.run import run_sweep
 from rvsm.sim.sweep.spec import parse_sweep
 
@@ -18,13 +18,13 @@ SWEEP = (Path(__file__).parents[2] / "data" / "small-sweep.toml").read_text()
 def counter(monkeypatch):
     """Count calls of the task function (inline runs only)."""
     calls = []
-    real = sweep_run.evaluate_task
+    real = sweep_work.evaluate_task
 
     def counting(task, *args):
         calls.append(task.point_id)
         return real(task, *args)
 
-    monkeypatch.setattr(sweep_run, "evaluate_task", counting)
+    monkeypatch.setattr(sweep_work, "evaluate_task", counting)
     return calls
 
 
