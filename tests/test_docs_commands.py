@@ -34,11 +34,9 @@ from __future__ import annotations
 
 import contextlib
 import io
-import os
 import re
 import shlex
 import subprocess
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -221,11 +219,11 @@ def test_every_quoted_command_parses(quoted):
     assert failure is None, f"{quoted}\n{failure}"
 
 
-def _run(block: RunBlock, cwd: Path) -> None:
+def _run(block: RunBlock, cwd: Path, env: dict[str, str]) -> None:
+    """Run ``block``'s commands one by one in ``cwd`` (created, with a link to
+    ``sweeps/``) with the environment ``env``."""
     cwd.mkdir(parents=True, exist_ok=True)
     (cwd / "sweeps").symlink_to(ROOT / "sweeps")
-    env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}"
-               f"{os.environ.get('PATH', '')}")
     for quoted, errors in block.steps:
         done = subprocess.run(["bash", "-c", quoted.text], cwd=cwd, env=env, text=True,
                               capture_output=True, timeout=1800, check=False)
@@ -242,15 +240,15 @@ def _blocks_to_run(slow: bool) -> list[RunBlock]:
 
 @pytest.mark.parametrize("block", _blocks_to_run(slow=False),
                          ids=lambda b: f"{b.doc}:{b.line}")
-def test_quick_blocks_run_as_written(block, tmp_path):
-    _run(block, tmp_path)
+def test_quick_blocks_run_as_written(block, tmp_path, shell_env):
+    _run(block, tmp_path, shell_env)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("block", _blocks_to_run(slow=True),
                          ids=lambda b: f"{b.doc}:{b.line}")
-def test_slow_blocks_run_as_written(block, tmp_path):
-    _run(block, tmp_path)
+def test_slow_blocks_run_as_written(block, tmp_path, shell_env):
+    _run(block, tmp_path, shell_env)
 
 
 # --- the extraction, on a synthetic doc ------------------------------------------------
@@ -296,15 +294,15 @@ def test_parse_failures_are_reported():
     assert parse_failure(["no-such-command"], mention=True) is not None
 
 
-def test_a_run_block_checks_status_and_message(tmp_path):
+def test_a_run_block_checks_status_and_message(tmp_path, shell_env):
     def block(command: str, errors: list[str]) -> RunBlock:
         return RunBlock("x.md", 1, False, [(Quoted("x.md", 2, command), errors)])
 
-    _run(block("touch made; test -L sweeps", []), tmp_path / "ok")
+    _run(block("touch made; test -L sweeps", []), tmp_path / "ok", shell_env)
     assert (tmp_path / "ok" / "made").exists()
     refused = "echo 'rvsm: error: x.toml:  bad' >&2; exit 2"
-    _run(block(refused, ["rvsm: error: x.toml: bad"]), tmp_path / "refused")
+    _run(block(refused, ["rvsm: error: x.toml: bad"]), tmp_path / "refused", shell_env)
     with pytest.raises(AssertionError, match="expected: rvsm: error: not this"):
-        _run(block(refused, ["rvsm: error: not this"]), tmp_path / "other-message")
+        _run(block(refused, ["rvsm: error: not this"]), tmp_path / "other-message", shell_env)
     with pytest.raises(AssertionError, match="docs/x.md:2: exit 2"):
-        _run(block("exit 2", []), tmp_path / "status")
+        _run(block("exit 2", []), tmp_path / "status", shell_env)
