@@ -22,8 +22,10 @@ with their contents; alternatives ``a|b`` take the first one (``equal|response``
 File names such as ``point.toml`` are not placeholders: the parser does not open files,
 and a block that runs creates them (``rvsm config new -o point.toml``). Skipped, because
 they are a synopsis rather than a command: a span containing ``COMMAND`` or ``...``.
-A span naming a command without arguments (``rvsm sweep``, ``rvsm dat import``) names
-it: ``rvsm sweep --help`` must then exit 0.
+Prose also *mentions* a command and some of its options without their arguments
+(``rvsm sweep``, ``rvsm simulate --fixed``): an inline span that argparse refuses only for
+missing arguments passes when ``rvsm COMMAND --help`` exits 0 and lists every ``--option``
+of the span; a wrong option or value still fails. Lines of fenced blocks must parse whole.
 
 In a block that runs, a line starting with ``rvsm: error:`` is the expected output of
 the command before it: that command must exit 2 and print the quoted line on stderr
@@ -58,6 +60,8 @@ PLACEHOLDERS = {
 }
 PLACEHOLDER = re.compile(r"^[A-Z][A-Za-z0-9_]*(\.[a-z0-9]+)?$")
 SYNOPSIS = re.compile(r"\bCOMMAND\b|\.\.\.")
+#: argparse's complaints about a missing argument (what a mention in prose leaves out).
+MISSING = re.compile(r"arguments are required|expected (one|at least one) argument")
 FENCE = re.compile(r"^(\s*)(```|~~~)")
 RUN_MARK = re.compile(r"^<!--\s*run(?::\s*(slow))?\s*-->\s*$")
 
@@ -181,13 +185,12 @@ def _parse(argv: list[str]) -> tuple[int | None, str]:
 
 def parse_failure(argv: list[str], mention: bool = False) -> str | None:
     """None if ``rvsm argv`` parses, else what argparse printed. A ``mention`` (an inline
-    span) may also name a command and some of its options without their arguments
-    (``rvsm simulate --fixed``): then ``rvsm COMMAND --help`` must exit 0 and list every
-    ``--option`` of the span."""
+    span) refused only for missing arguments (``rvsm simulate --fixed``) passes if
+    ``rvsm COMMAND --help`` exits 0 and lists every ``--option`` of the span."""
     if argv == ["--version"]:
         return None
     status, said = _parse(argv)
-    if status is None or not mention:
+    if status is None or not mention or not MISSING.search(said):
         return None if status is None else said.strip() or "argparse exited"
     command = argv[:next((i for i, w in enumerate(argv) if w.startswith("-")), len(argv))]
     status, text = _parse([*command, "--help"])
@@ -292,6 +295,7 @@ def test_parse_failures_are_reported():
     assert parse_failure(["simulate", "--no-such"], mention=True) == \
         "rvsm simulate has no option --no-such"
     assert parse_failure(["no-such-command"], mention=True) is not None
+    assert "invalid choice" in parse_failure(["simulate", "--engine", "jit"], mention=True)
 
 
 def test_a_run_block_checks_status_and_message(tmp_path, shell_env):
