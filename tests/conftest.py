@@ -9,13 +9,16 @@
   cache shared by every pytest-xdist worker of the session.
 - :func:`fsm_point` / :func:`fake_tool`: the smallest design point for the FPGA flow, and
   stand-in tool scripts for its failure paths.
+- :func:`shell_env`: the environment in which documented shell lines run (README, docs).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import os
 import re
 import stat
+import sys
 from collections.abc import Awaitable, Callable
 from pathlib import Path
 
@@ -114,3 +117,11 @@ def fake_tool() -> Callable[[Path, str], Path]:
         return path
 
     return make
+
+
+@pytest.fixture
+def shell_env() -> dict[str, str]:
+    """``os.environ`` with this interpreter's folder first on ``PATH``, so that ``rvsm`` in
+    a shell line is this checkout's console script."""
+    return dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}"
+                f"{os.environ.get('PATH', '')}")

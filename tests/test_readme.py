@@ -9,12 +9,10 @@
 
 from __future__ import annotations
 
-import os
 import re
 import shlex
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -65,16 +63,14 @@ def test_every_readme_command_parses(command):
     assert callable(args.func)
 
 
-def _run_block(lines: list[str], cwd: Path) -> subprocess.CompletedProcess:
-    env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}"
-               f"{os.environ.get('PATH', '')}")
+def _run_block(lines: list[str], cwd: Path, env: dict[str, str]) -> subprocess.CompletedProcess:
     script = "set -e\n" + "\n".join(f"echo '$ {ln}'; {ln}" for ln in lines) + "\n"
     return subprocess.run(["bash", "-c", script], cwd=cwd, env=env, capture_output=True,
                           text=True, timeout=1800, check=False)
 
 
-def test_try_it_block_runs_as_written_without_rtl(tmp_path):
-    done = _run_block([ln for ln in try_it_block() if not RTL.match(ln)], tmp_path)
+def test_try_it_block_runs_as_written_without_rtl(tmp_path, shell_env):
+    done = _run_block([ln for ln in try_it_block() if not RTL.match(ln)], tmp_path, shell_env)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     assert {"spikes.npz", "fsm.dat", "back.npz", "point.toml", "stim.npz"} <= {
         p.name for p in tmp_path.iterdir()}
@@ -82,7 +78,7 @@ def test_try_it_block_runs_as_written_without_rtl(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("iverilog") is None, reason="Icarus Verilog not installed")
-def test_try_it_block_runs_as_written(tmp_path):
-    done = _run_block(try_it_block(), tmp_path)
+def test_try_it_block_runs_as_written(tmp_path, shell_env):
+    done = _run_block(try_it_block(), tmp_path, shell_env)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     assert done.stdout.count(", 0 mismatches") == 2
