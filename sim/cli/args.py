@@ -92,8 +92,9 @@ def parse_size_arg(text: str | None) -> tuple[int, int] | None:
 class SceneRequest:
     """``SCENE`` and how to shape it: the one rule of every command that takes a scene.
 
-    ``size`` (``--size``, ``(H, W)`` pixels), ``frames`` (``--frames``) and ``hold``
-    (``--hold``) are ``None`` when not given. The rule (docs/cli.md, "Scenes"):
+    ``source`` is a built-in scene name or a path; ``size`` (``--size``, ``(H, W)``
+    pixels) and ``frames`` (``--frames``) are ``None`` when not given. The rule
+    (docs/cli.md, "Scenes"):
 
     - ``--size HxW`` renders a built-in scene at that size and centre-crops a scene file to
       it (a file smaller than ``--size`` is refused, naming ``--size``);
@@ -124,21 +125,14 @@ class SceneRequest:
         try:
             if size is None and "height" in meta:
                 size = (int(meta["height"]), int(meta["width"]))
-            frames = args.frames if args.frames is not None else meta.get("num_frames")
-            spf = args.steps_per_frame
-            if spf is None:
-                spf = int(meta.get("steps_per_frame", DEFAULT_STEPS_PER_FRAME))
-            hold = args.hold if args.hold is not None else bool(meta.get("hold", False))
+            frames = positive_or_default(args.frames, "--frames", meta.get("num_frames"))
+            steps_per_frame = positive_or_default(
+                args.steps_per_frame, "--steps-per-frame",
+                int(meta.get("steps_per_frame", DEFAULT_STEPS_PER_FRAME)))
+            hold = bool(meta.get("hold", False)) if args.hold is None else args.hold
         except (KeyError, TypeError, ValueError) as exc:
             raise RvsmError(f"the spike file's meta is incomplete or malformed: {exc}") from None
-        return cls(
-            source=str(source),
-            size=size,
-            frames=None if frames is None else positive_or_default(frames, "--frames", 1),
-            steps_per_frame=positive_or_default(spf, "--steps-per-frame",
-                                                DEFAULT_STEPS_PER_FRAME),
-            hold=bool(hold),
-        )
+        return cls(str(source), size, frames, steps_per_frame, hold)
 
     def load(self, default_size: tuple[int, int] | None = None) -> Scene:
         """The scene by the rule; ``default_size`` (``(H, W)``) renders a built-in scene
@@ -160,7 +154,7 @@ class SceneRequest:
         return fit_point(scene, point), scene
 
 
-def positive_or_default(value: int | None, option: str, default: int) -> int:
+def positive_or_default(value: int | None, option: str, default: int | None) -> int | None:
     """``value`` when given (refused unless >= 1, never silently replaced), else
     ``default``."""
     if value is None:
