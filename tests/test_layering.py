@@ -21,22 +21,11 @@ import ast
 from dataclasses import dataclass
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parents[1]
 #: The layers, lowest first: a module may import its own layer and the ones before it.
 LAYERS = ("rvsm.model", "rvsm.rtl", "rvsm.sim")
 #: Package name -> its folder (``package-dir`` in ``pyproject.toml``).
 PACKAGES = {"rvsm.model": ROOT / "model", "rvsm.rtl": ROOT / "rtl", "rvsm.sim": ROOT / "sim"}
-
-#: Circles on the tree today, being removed by the restructuring (issue 16). While the tree
-#: has exactly these, the circle test is an expected failure; once they are gone it passes
-#: unexpectedly (a strict xfail fails): then delete this list and the xfail marker.
-KNOWN_CIRCLES = frozenset({
-    frozenset({"rvsm.model.sampling.samplers", "rvsm.model.sampling.stream"}),
-    frozenset({"rvsm.model.fixed.twin", "rvsm.model.fixed.fused"}),
-})
-
 
 @dataclass(frozen=True)
 class Arrow:
@@ -53,10 +42,6 @@ class Arrow:
         except ValueError:
             where = self.path
         return f"{where}:{self.line}: {self.source} -> {self.target}"
-
-
-class KnownCircles(AssertionError):
-    """The tree has exactly the circles of :data:`KNOWN_CIRCLES`."""
 
 
 def module_files(packages: dict[str, Path]) -> dict[str, Path]:
@@ -207,14 +192,9 @@ def test_no_import_against_the_layers():
     assert not bad, "imports against model <- rtl <- sim:\n" + "\n".join(map(str, bad))
 
 
-@pytest.mark.xfail(strict=True, raises=KnownCircles,
-                   reason="the two known circles of KNOWN_CIRCLES (issue 16, being removed)")
 def test_no_import_circles():
     found = circles(all_arrows(PACKAGES))
-    message = "import circles:\n" + "\n".join(describe(c) for c in found)
-    if found and {frozenset(a.source for a in c) for c in found} == KNOWN_CIRCLES:
-        raise KnownCircles(message)
-    assert not found, message
+    assert not found, "import circles:\n" + "\n".join(describe(c) for c in found)
 
 
 # --- the checker, on a synthetic tree --------------------------------------------------

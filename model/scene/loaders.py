@@ -40,6 +40,11 @@ def parse_size(text: str) -> tuple[int, int]:
     return int(m.group(1)), int(m.group(2))
 
 
+def is_builtin(arg: str | os.PathLike) -> bool:
+    """True if ``arg`` names a built-in scene (rendered at any size), not a file."""
+    return os.fspath(arg) in SCENE_NAMES
+
+
 def _to_grey(img: np.ndarray, source: str) -> np.ndarray:
     """One image (H, W) / (H, W, C) of any dtype as grey ``(H, W) float64`` in 0..255."""
     from skimage.color import rgb2gray
@@ -184,7 +189,8 @@ def _fit_size(frames: np.ndarray, size: tuple[int, int] | None, source: str) -> 
     if h > fh or w > fw:
         raise RvsmError(
             f"{source}: frames are {fh}x{fw}, smaller than the requested size {h}x{w}; "
-            f"ask for at most {fh}x{fw}"
+            f"ask for at most --size {fh}x{fw}, or leave --size out to use the file's own "
+            "size"
         )
     y0, x0 = (fh - h) // 2, (fw - w) // 2
     return frames[:, y0 : y0 + h, x0 : x0 + w]
@@ -208,7 +214,7 @@ def load_scene(
     ):
         raise RvsmError(f"number of frames must be an integer >= 1, got {num_frames!r}")
     text = os.fspath(arg)
-    if text in SCENE_NAMES:
+    if is_builtin(text):
         from rvsm.model.scene.library import DEFAULT_FRAMES, DEFAULT_SIZE
 
         return builtin_scene(
@@ -242,7 +248,8 @@ def load_scene(
     if num_frames is not None:
         if num_frames > frames.shape[0]:
             raise RvsmError(f"{path}: has {frames.shape[0]} frames, fewer than the "
-                            f"{int(num_frames)} asked for; ask for at most {frames.shape[0]}")
+                            f"{int(num_frames)} asked for; ask for at most --frames "
+                            f"{frames.shape[0]}")
         frames = frames[: int(num_frames)]
     frames = _fit_size(frames, size, str(path))
     name = path.stem if path.suffix else path.name

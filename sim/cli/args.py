@@ -3,11 +3,16 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.noise.presets import NOISE_PRESETS, preset_noise
 from rvsm.model.noise.sensor import NoiseParams
 from rvsm.model.scene.scene import DEFAULT_STEPS_PER_FRAME, Scene
+
+if TYPE_CHECKING:
+    from rvsm.model.fixed.design_point import DesignPoint
 
 
 def add_scene_arguments(parser: argparse.ArgumentParser, positional: bool = True) -> None:
@@ -18,8 +23,16 @@ def add_scene_arguments(parser: argparse.ArgumentParser, positional: bool = True
             help="built-in scene name (see `rvsm scenes`) or a path: .npy (F,H,W) array, "
             "image folder or video file",
         )
-    parser.add_argument("--size", metavar="HxW", help="array size, e.g. 250x400")
-    parser.add_argument("--frames", type=int, metavar="F", help="number of video frames")
+    parser.add_argument(
+        "--size", metavar="HxW",
+        help="scene (and array) size, e.g. 250x400: renders a built-in scene, centre-crops "
+        "a scene file (default: a file's own size; a built-in scene at the design point's "
+        "size, else 250x400)",
+    )
+    parser.add_argument(
+        "--frames", type=int, metavar="F",
+        help="number of video frames (default: all of a file's, 41 of a built-in scene)",
+    )
     parser.add_argument(
         "--steps-per-frame", type=int, default=None, metavar="M",
         help=f"sampling steps per video frame (default {DEFAULT_STEPS_PER_FRAME})",
@@ -75,25 +88,73 @@ def parse_size_arg(text: str | None) -> tuple[int, int] | None:
     return parse_size(text)
 
 
-def load_scene_from_args(
-    args: argparse.Namespace,
-    scene_arg: str | None = None,
-    size: tuple[int, int] | None = None,
-) -> Scene:
-    """Load the scene named on the command line with its stepping options."""
-    from rvsm.model.scene.loaders import load_scene
+@dataclass(frozen=True)
+class SceneRequest:
+    """``SCENE`` and how to shape it: the one rule of every command that takes a scene.
 
-    return load_scene(
-        scene_arg if scene_arg is not None else args.scene,
-        size=size if size is not None else parse_size_arg(args.size),
-        num_frames=args.frames,
-        steps_per_frame=positive_or_default(args.steps_per_frame, "--steps-per-frame",
-                                            DEFAULT_STEPS_PER_FRAME),
-        hold=bool(args.hold),
-    )
+    ``source`` is a built-in scene name or a path; ``size`` (``--size``, ``(H, W)``
+    pixels) and ``frames`` (``--frames``) are ``None`` when not given. The rule
+    (docs/cli.md, "Scenes"):
+
+    - ``--size HxW`` renders a built-in scene at that size and centre-crops a scene file to
+      it (a file smaller than ``--size`` is refused, naming ``--size``);
+    - without ``--size`` a scene file is used at its own size, and a built-in scene is
+      rendered at the command's default size: the design point's with ``--fixed``, else
+      250x400;
+    - with a design point, the point's size follows the scene (:meth:`load_for_point`);
+    - ``rvsm evaluate`` takes every option not given from the spike file's meta
+      (:meth:`from_args` with ``meta``): the scene as the spikes were made.
+    """
+
+    source: str
+    size: tuple[int, int] | None = None
+    frames: int | None = None
+    steps_per_frame: int = DEFAULT_STEPS_PER_FRAME
+    hold: bool = False
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace, meta: dict | None = None) -> SceneRequest:
+        """From ``args.scene`` and the options of :func:`add_scene_arguments`; with a spike
+        file's ``meta``, ``SCENE`` and every option not given default to the meta's."""
+        meta = {} if meta is None else meta
+        source = args.scene if args.scene is not None else meta.get("scene_arg")
+        if source is None:
+            raise RvsmError("the spike file's meta does not name its scene; pass SCENE "
+                            "explicitly")
+        size = parse_size_arg(args.size)
+        try:
+            if size is None and "height" in meta:
+                size = (int(meta["height"]), int(meta["width"]))
+            frames = positive_or_default(args.frames, "--frames", meta.get("num_frames"))
+            steps_per_frame = positive_or_default(
+                args.steps_per_frame, "--steps-per-frame",
+                int(meta.get("steps_per_frame", DEFAULT_STEPS_PER_FRAME)))
+            hold = bool(meta.get("hold", False)) if args.hold is None else args.hold
+        except (KeyError, TypeError, ValueError) as exc:
+            raise RvsmError(f"the spike file's meta is incomplete or malformed: {exc}") from None
+        return cls(str(source), size, frames, steps_per_frame, hold)
+
+    def load(self, default_size: tuple[int, int] | None = None) -> Scene:
+        """The scene by the rule; ``default_size`` (``(H, W)``) renders a built-in scene
+        when ``--size`` is not given (``None``: 250x400)."""
+        from rvsm.model.scene.loaders import is_builtin, load_scene
+
+        size = self.size
+        if size is None and is_builtin(self.source):
+            size = default_size
+        return load_scene(self.source, size=size, num_frames=self.frames,
+                          steps_per_frame=self.steps_per_frame, hold=self.hold)
+
+    def load_for_point(self, point: DesignPoint) -> tuple[DesignPoint, Scene]:
+        """``(point, scene)``: the scene by the rule (a built-in one at the point's size),
+        and the point sized to the scene (:func:`~rvsm.model.fixed.twin.fit_point`)."""
+        from rvsm.model.fixed.twin import fit_point
+
+        scene = self.load(default_size=point.shape)
+        return fit_point(scene, point), scene
 
 
-def positive_or_default(value: int | None, option: str, default: int) -> int:
+def positive_or_default(value: int | None, option: str, default: int | None) -> int | None:
     """``value`` when given (refused unless >= 1, never silently replaced), else
     ``default``."""
     if value is None:
@@ -101,21 +162,3 @@ def positive_or_default(value: int | None, option: str, default: int) -> int:
     if value < 1:
         raise RvsmError(f"{option} must be an integer >= 1, got {value}")
     return value
-
-
-def scene_from_meta(meta: dict, override: str | None = None) -> Scene:
-    """Reload the scene a spike file was made from (``override`` replaces its source)."""
-    from rvsm.model.scene.loaders import load_scene
-
-    source = override if override is not None else meta.get("scene_arg")
-    if source is None:
-        raise RvsmError("the spike file's meta does not name its scene; pass SCENE explicitly")
-    try:
-        size = (int(meta["height"]), int(meta["width"]))
-        return load_scene(
-            source, size=size, num_frames=meta.get("num_frames"),
-            steps_per_frame=int(meta.get("steps_per_frame", DEFAULT_STEPS_PER_FRAME)),
-            hold=bool(meta.get("hold", False)),
-        )
-    except (KeyError, TypeError, ValueError) as exc:
-        raise RvsmError(f"the spike file's meta is incomplete or malformed: {exc}") from None

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from rvsm.sim.cli.args import add_force_argument, load_scene_from_args
+from rvsm.sim.cli.args import SceneRequest, add_force_argument
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.cosim import SIMULATORS
 from rvsm.sim.studies.demo import (
@@ -45,7 +45,7 @@ def run_demo(args: argparse.Namespace) -> int:
                   for ext, kind in ((".npz", "spike file"), (".png", None)))
     files += (("metrics.md", PLAIN), ("metrics.csv", PLAIN), ("rtl", FOLDER))
     check_outputs([Output(args.output, "-o", FOLDER, files)], [args.scene], args.force)
-    scene = load_scene_from_args(args)
+    scene = SceneRequest.from_args(args).load()
     out = Path(args.output)
     h, w = scene.shape
     print(f"demo: {scene.name} {h}x{w}, {scene.num_steps} steps, models "

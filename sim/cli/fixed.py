@@ -8,12 +8,11 @@ import sys
 from pathlib import Path
 
 from rvsm.model.decode.reconstruction import MATCH_MODES, METHODS
-from rvsm.model.infra.errors import RvsmError
 from rvsm.model.sampling.thresholds import THRESHOLD_RULES
 from rvsm.sim.cli.args import (
+    SceneRequest,
     add_force_argument,
     add_scene_arguments,
-    load_scene_from_args,
     parse_size_arg,
 )
 from rvsm.sim.cli.outputs import PLAIN, Output, check_outputs
@@ -73,19 +72,11 @@ def _common(p: argparse.ArgumentParser) -> None:
 
 
 def _point_and_scene(args: argparse.Namespace):
+    """The design point of ``--fixed`` and the scene by :class:`SceneRequest`'s rule; the
+    point's size follows the scene."""
     from rvsm.model.fixed.point_toml import load_design_point
 
-    point = load_design_point(args.fixed)
-    size = parse_size_arg(args.size)
-    if size is not None:
-        point = point.with_size(*size)
-    scene = load_scene_from_args(args, size=point.shape)
-    if scene.shape != point.shape:
-        raise RvsmError(
-            f"scene {scene.name!r} is {scene.shape[0]}x{scene.shape[1]} but the design point "
-            f"is {point.height}x{point.width}; pass --size {scene.shape[0]}x{scene.shape[1]}"
-        )
-    return point, scene
+    return SceneRequest.from_args(args).load_for_point(load_design_point(args.fixed))
 
 
 def run_config_new(args: argparse.Namespace) -> int:

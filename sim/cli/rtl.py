@@ -7,7 +7,12 @@ import json
 import shlex
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.sim.cli.args import add_force_argument, parse_size_arg
+from rvsm.sim.cli.args import (
+    SceneRequest,
+    add_force_argument,
+    add_scene_arguments,
+    parse_size_arg,
+)
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.cosim import SIMULATORS
 
@@ -53,7 +58,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "mid-stream) instead of a scene; needs --fixed, --size, --steps")
     p.add_argument("--sim", choices=SIMULATORS, default="icarus")
     p.add_argument("--steps", type=int, help="simulate only the first N steps")
-    p.add_argument("--size", metavar="HxW", help="override the array size")
+    add_scene_arguments(p, positional=False)
     p.add_argument("--waves", action="store_true", help="keep an FST waveform")
     p.add_argument("--work", default="build/verify",
                    help="work folder: shared build cache (builds/) and one new folder per "
@@ -116,6 +121,12 @@ def _top_arg(text: str) -> str:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _scene_shaping(args: argparse.Namespace) -> tuple[tuple[str, object], ...]:
+    """The options that shape a SCENE (beyond --size), with their values."""
+    return (("--frames", args.frames), ("--steps-per-frame", args.steps_per_frame),
+            ("--hold", args.hold))
+
+
 def _verify(args: argparse.Namespace) -> int:
     from rvsm.sim.cosim.verify import random_verify, replay, verify
 
@@ -126,17 +137,18 @@ def _verify(args: argparse.Namespace) -> int:
     lanes = args.lanes if args.arch == "stream" else None
     if args.stimulus:
         given = [n for n, v in (("SCENE", args.scene), ("--fixed", args.fixed),
-                                ("--size", args.size), ("--random", args.random))
-                 if v is not None]
+                                ("--size", args.size), ("--random", args.random),
+                                *_scene_shaping(args)) if v is not None]
         if given:
             raise RvsmError(f"{', '.join(given)} cannot be combined with --stimulus: the "
                             "stimulus file holds the scene's codes and the contract")
         r = replay(args.stimulus, args.sim, steps=args.steps, waves=args.waves,
                    work_dir=args.work, lanes=lanes)
     elif args.random is not None:
-        if args.scene is not None:
-            raise RvsmError("SCENE cannot be combined with --random (the stimulus is "
-                            "generated)")
+        given = [n for n, v in (("SCENE", args.scene), *_scene_shaping(args)) if v is not None]
+        if given:
+            raise RvsmError(f"{', '.join(given)} cannot be combined with --random (the "
+                            "stimulus is generated)")
         missing = [n for n, v in (("--fixed", args.fixed), ("--size", args.size),
                                   ("--steps", args.steps)) if v is None]
         if missing:
@@ -148,8 +160,12 @@ def _verify(args: argparse.Namespace) -> int:
         if args.scene is None or args.fixed is None:
             raise RvsmError("rvsm verify needs SCENE --fixed POINT.toml, --stimulus FILE, "
                             "or --random SEED --fixed POINT.toml")
-        r = verify(args.scene, args.fixed, args.sim, steps=args.steps, waves=args.waves,
-                   size=parse_size_arg(args.size), work_dir=args.work, lanes=lanes)
+        from rvsm.model.fixed.point_toml import load_design_point
+
+        point, scene = SceneRequest.from_args(args).load_for_point(
+            load_design_point(args.fixed))
+        r = verify(scene, args.fixed, args.sim, steps=args.steps, waves=args.waves,
+                   size=point.shape, work_dir=args.work, lanes=lanes)
     if args.json:
         r = dict(r)
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]

@@ -18,19 +18,19 @@ from rvsm.model.sampling.config import (
 )
 from rvsm.model.sampling.thresholds import THRESHOLD_RULES, rule_thresholds
 from rvsm.model.sampling.twin import stream_float
+from rvsm.model.scene.scene import Scene
 from rvsm.model.spikes.dat import DatWriter, dat_source
 from rvsm.model.spikes.files import copy_source, open_spikes
 from rvsm.model.spikes.h5 import H5SpikeWriter, is_h5_path
 from rvsm.model.spikes.npz import save_spikes
 from rvsm.model.spikes.sinks import ArraySink, CountSink, TeeSink
 from rvsm.sim.cli.args import (
+    SceneRequest,
     add_force_argument,
     add_noise_arguments,
     add_scene_arguments,
-    load_scene_from_args,
     noise_from_args,
     parse_size_arg,
-    scene_from_meta,
 )
 from rvsm.sim.cli.outputs import PLAIN, Output, check_outputs
 
@@ -65,10 +65,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("evaluate", help="reconstruct a spike file and score it",
                        description="Reconstruct spikes (TFI for FSM, the paper's RVSM "
                        "adjoint otherwise; --method inverse for the least-squares inverse), "
-                       "match brightness and print MSE, PSNR and SSIM.")
+                       "match brightness and print MSE, PSNR and SSIM over the frames after "
+                       "the warm-up. The scene is shaped as the file's meta says it was made; "
+                       "--size, --frames, --steps-per-frame and --hold override that.")
     p.add_argument("spikes", help="spike file (.h5 streams chunk by chunk, or .npz)")
     p.add_argument("scene", nargs="?", default=None,
                    help="scene to score against (default: the one in the file's meta)")
+    add_scene_arguments(p, positional=False)
     p.add_argument("--method", default="auto", choices=METHODS)
     p.add_argument("--match", default="gain", choices=MATCH_MODES,
                    help="brightness matching before scoring")
@@ -167,16 +170,13 @@ def run_simulate(args: argparse.Namespace) -> int:
         from rvsm.model.fixed.point_toml import load_design_point
         from rvsm.model.fixed.twin import stream_fixed
 
-        point = load_design_point(args.fixed)
-        size = parse_size_arg(args.size)
-        if size is not None:
-            point = point.with_size(*size)
-        scene = load_scene_from_args(args, size=(point.height, point.width))
+        point, scene = SceneRequest.from_args(args).load_for_point(
+            load_design_point(args.fixed))
         run_fn = lambda sink: stream_fixed(  # noqa: E731
             scene, point, sink, chunk_steps=args.chunk_steps, engine=args.engine,
             progress=True, ranges=False)
     else:
-        scene = load_scene_from_args(args)
+        scene = SceneRequest.from_args(args).load()
         config = _float_config(args, scene)
         run_fn = lambda sink: stream_float(  # noqa: E731
             scene, config, sink, chunk_steps=args.chunk_steps, engine=args.engine,
@@ -203,7 +203,8 @@ def run_evaluate(args: argparse.Namespace) -> int:
 
     with open_spikes(args.spikes) as source:
         meta = source.meta
-        scene = scene_from_meta(meta, override=args.scene)
+        scene = SceneRequest.from_args(args, meta).load()
+        _check_scene_fits(scene, source.shape)
         model = meta.get("model")
         phis = meta.get("phis")
         if model is None or phis is None:
@@ -220,9 +221,23 @@ def run_evaluate(args: argparse.Namespace) -> int:
         print(json.dumps({**result, "model": model, "scene": scene.name}, default=float))
     else:
         print(f"{scene.name} {model}: MSE {result['mse']:.2f}  PSNR {result['psnr']:.2f} dB  "
-              f"SSIM {result['ssim']:.3f}  ({result['num_scored']} steps scored after "
+              f"SSIM {result['ssim']:.3f}  ({result['num_scored']} frames scored after "
               f"{result['warmup']} warm-up steps, {result['method']})")
     return 0
+
+
+def _check_scene_fits(scene: Scene, spikes_shape: tuple[int, int, int, int]) -> None:
+    """Refuse, naming the options that fix it, a scene shaped unlike the spikes
+    ``(T, S, H, W)``."""
+    t, _, h, w = spikes_shape
+    if scene.shape == (h, w) and scene.num_steps == t:
+        return
+    fix = (f"pass --size {h}x{w}" if scene.shape != (h, w) else
+           "pass the --frames, --steps-per-frame and --hold the spikes were made with")
+    raise RvsmError(f"spikes {tuple(spikes_shape)} do not match scene {scene.name!r} "
+                    f"({scene.num_steps} steps of {scene.shape[0]}x{scene.shape[1]}: "
+                    f"{scene.num_frames} frames, {scene.steps_per_frame} steps per frame"
+                    f"{', held' if scene.hold else ''}); {fix}")
 
 
 def run_dat_export(args: argparse.Namespace) -> int:

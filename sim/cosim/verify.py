@@ -23,6 +23,7 @@ from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.stimulus import Stimulus, load_stimulus, save_stimulus
 from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.scene.scene import Scene
 from rvsm.sim.cosim.runner import SimBuild, build, check_simulator, new_run_dir, run_testbench
 
 __all__ = ["MAX_PARALLEL_SIDE", "check_stimulus", "random_verify", "replay", "run_rtl",
@@ -184,7 +185,7 @@ def replay(
 
 
 def verify(
-    scene: str,
+    scene: str | Scene,
     fixed: str | os.PathLike,
     sim: str = "icarus",
     steps: int | None = None,
@@ -197,8 +198,9 @@ def verify(
 
     ``lanes`` verifies the streaming array with that many lanes (any array size).
 
-    ``size = (H, W)`` overrides the point's array size (the scene is rendered or cropped
-    to it); ``steps`` keeps the first steps. Returns :func:`check_stimulus`'s result plus
+    ``size = (H, W)`` overrides the point's array size (a scene name or path is rendered
+    or cropped to it; a :class:`Scene`, shaped by the caller, must have it); ``steps``
+    keeps the first steps. Returns :func:`check_stimulus`'s result plus
     ``scene`` and ``point``. Raises :class:`RvsmError` on user errors (not on
     mismatches: check ``result["mismatches"]``).
     """
@@ -212,10 +214,12 @@ def verify(
         point = point.with_size(*size)
     h, w = point.height, point.width
     _check_size(point.contract(), lanes)
-    stim = make_stimulus(load_scene(scene, size=(h, w)), point, num_steps=steps)
+    if not isinstance(scene, Scene):
+        scene = load_scene(scene, size=(h, w))
+    stim = make_stimulus(scene, point, num_steps=steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
-                            name=Path(str(scene)).stem or "scene", lanes=lanes)
-    result.update(scene=str(scene), point=str(fixed), height=h, width=w,
+                            name=scene.name or "scene", lanes=lanes)
+    result.update(scene=scene.source or scene.name, point=str(fixed), height=h, width=w,
                   coverage=_coverage(stim))
     return result
 
