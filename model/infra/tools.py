@@ -65,7 +65,7 @@ class ToolFailure(ToolError):
             extra = f": {detail}" if detail else ""
             super().__init__(f"{tool} {describe_status(status)}{extra}{where}")
         else:
-            short = f"exit {status}" if status >= 0 else describe_status(status)[4:]
+            short = f"exit {status}" if status >= 0 else f"killed by {_signal_name(-status)}"
             extra = f"; {detail}" if detail else ""
             super().__init__(f"{tool} failed ({short}) after {seconds:.0f} s{extra}{where}")
 
@@ -73,12 +73,15 @@ class ToolFailure(ToolError):
 def describe_status(status: int) -> str:
     """``"exited with status 2"`` or ``"was killed by SIGKILL (status -9)"``."""
     if status < 0:
-        try:
-            name = signal.Signals(-status).name
-        except ValueError:
-            name = f"signal {-status}"
-        return f"was killed by {name} (status {status})"
+        return f"was killed by {_signal_name(-status)} (status {status})"
     return f"exited with status {status}"
+
+
+def _signal_name(number: int) -> str:
+    try:
+        return signal.Signals(number).name
+    except ValueError:
+        return f"signal {number}"
 
 
 def live_groups() -> list[int]:

@@ -185,7 +185,8 @@ def build(
         paths, gen = (_reuse_verilog(base, digest, top, stage)
                       or design.write(stage, top))
         t0 = time.perf_counter()
-        cocotb_build(sim, paths["verilog"], top, stage / "sim_build", traced, log)
+        ports = [p["name"] for p in json.loads(paths["ports_json"].read_text())["ports"]]
+        cocotb_build(sim, paths["verilog"], top, ports, stage / "sim_build", traced, log)
         build_seconds = time.perf_counter() - t0
         files = _checksums(stage, _build_files(sim, top))
         if files is None:

@@ -4,15 +4,16 @@ parent's environment untouched, a safe PYTHONPATH, Verilator's top-level-only VP
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 
-from rvsm.model.infra.errors import ToolError
+from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.model.infra.tools import ToolFailure
-from rvsm.sim.cosim.cocotb_adapter import VERILATOR_PUBLIC_ARGS, build_args, cocotb_build
+from rvsm.sim.cosim.cocotb_adapter import build_args, cocotb_build, public_ports_control
 from rvsm.sim.cosim.cocotb_job import safe_path
 
 TWO_LEVELS = """
@@ -24,6 +25,7 @@ module top(input clk, input [3:0] a, output [3:0] q);
   sub u(.clk(clk), .a(a), .q(q));
 endmodule
 """
+PORTS = ("clk", "a", "q")
 
 
 def test_safe_path_drops_relative_and_current_folder_entries(tmp_path: Path,
@@ -40,7 +42,7 @@ def test_icarus_build_and_its_failure(tmp_path: Path) -> None:
     environ = dict(os.environ)
     good = tmp_path / "top.v"
     good.write_text(TWO_LEVELS)
-    cocotb_build("icarus", good, "top", tmp_path / "ok" / "sim_build", True,
+    cocotb_build("icarus", good, "top", PORTS, tmp_path / "ok" / "sim_build", True,
                  tmp_path / "ok.log")
     assert (tmp_path / "ok" / "sim_build" / "sim.vvp").is_file()
     bad = tmp_path / "bad.v"
@@ -48,7 +50,8 @@ def test_icarus_build_and_its_failure(tmp_path: Path) -> None:
     log = tmp_path / "bad.log"
     with pytest.raises(ToolFailure, match=r"^icarus build \(iverilog\) exited with status "
                        r"\d+; log: ") as info:
-        cocotb_build("icarus", bad, "top", tmp_path / "bad" / "sim_build", True, log)
+        cocotb_build("icarus", bad, "top", ["clk"], tmp_path / "bad" / "sim_build", True,
+                     log)
     assert info.value.log == log and "syntax error" in log.read_text()
     assert dict(os.environ) == environ
 
@@ -57,28 +60,32 @@ def test_a_missing_simulator_is_a_tool_error(tmp_path: Path, monkeypatch) -> Non
     (tmp_path / "top.v").write_text(TWO_LEVELS)
     monkeypatch.setenv("PATH", str(tmp_path / "empty"))
     with pytest.raises(ToolError, match="icarus build failed: .*iverilog"):
-        cocotb_build("icarus", tmp_path / "top.v", "top", tmp_path / "b" / "sim_build",
-                     True, tmp_path / "b.log")
+        cocotb_build("icarus", tmp_path / "top.v", "top", PORTS,
+                     tmp_path / "b" / "sim_build", True, tmp_path / "b.log")
 
 
 def test_verilator_exposes_only_the_top_level_ports(tmp_path: Path) -> None:
-    """Verilator takes the last of cocotb's ``--public-flat-rw`` and our build arguments:
-    no signal below the top is registered for VPI."""
+    """cocotb's ``--public-flat-rw``, then our build arguments and control file (cocotb's
+    order): the named top-level ports, and nothing else, are registered for VPI."""
     from rvsm.rtl.verilog import verilator_env
 
     try:
         env = verilator_env()
     except ToolError:
         pytest.skip("Verilator not installed")
-    assert build_args("verilator", False)[-len(VERILATOR_PUBLIC_ARGS):] \
-        == list(VERILATOR_PUBLIC_ARGS)
-    (tmp_path / "t.v").write_text(TWO_LEVELS)
+    (tmp_path / "t.v").write_text(TWO_LEVELS.replace("output [3:0] q);",
+                                                     "output [3:0] q);\n  wire [3:0] w = a;"))
+    (tmp_path / "public.vlt").write_text(public_ports_control("top", PORTS))
     inserted = {}
-    for name, flags in (("flat", []), ("ours", build_args("verilator", False))):
+    for name, flags in (("flat", []), ("ours", [*build_args("verilator", False),
+                                                str(tmp_path / "public.vlt")])):
         out = tmp_path / name
         subprocess.run(["verilator", "--cc", "--vpi", "-Mdir", str(out), "--top-module",
                         "top", "--public-flat-rw", *flags, str(tmp_path / "t.v")],
                        env=env, check=True, capture_output=True)
-        inserted[name] = "".join(p.read_text() for p in out.glob("*.cpp")).count(
-            "varInsert(")
-    assert inserted["flat"] > inserted["ours"] == 6  # top ports a, clk, q (two scopes)
+        inserted[name] = sorted(set(re.findall(
+            r'varInsert\("(\w+)"', "".join(p.read_text() for p in out.glob("*.cpp")))))
+    assert inserted["flat"] == ["a", "clk", "inner", "q", "w"]
+    assert inserted["ours"] == sorted(PORTS)
+    with pytest.raises(RvsmError, match="Verilog identifier"):
+        public_ports_control("top", ['a" -var "*'])
