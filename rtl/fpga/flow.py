@@ -36,11 +36,12 @@ from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.tools import Progress, find_tool, run_tool
 from rvsm.rtl.fpga.devices import Device, get_device
 from rvsm.rtl.fpga.harness import IoHarness
 from rvsm.rtl.fpga.report import FpgaReport, Usage, parse_nextpnr_report, parse_yosys_stat
 from rvsm.rtl.fpga.sensor import state_memory
-from rvsm.rtl.fpga.tools import Progress, find_tool, run_tool
+from rvsm.rtl.fpga.tools import follower
 
 __all__ = [
     "ARCHES",
@@ -176,9 +177,10 @@ def synthesise(
     for stale in ("synth.json", "stat.json", "report.json"):
         (work / stale).unlink(missing_ok=True)
     seconds["synthesis"] = run_tool(
-        [yosys, "-q", "-l", "yosys.log", "-s", "synth.ys"], work, work / "yosys.out",
-        "synthesis (yosys)", on_progress, expected_synthesis_seconds(len(text), netlist),
-        timeout, follow="yosys.log")
+        [yosys, "-q", "-l", "yosys.log", "-s", "synth.ys"], cwd=work, log=work / "yosys.out",
+        follow=follower(yosys, "synthesis (yosys)", on_progress,
+                        expected_synthesis_seconds(len(text), netlist), "yosys.log"),
+        timeout=timeout).seconds
     stat = parse_yosys_stat(_read_json(work / "stat.json", "yosys statistics"))
     return Synthesis(work, stat, harness, len(text), seconds)
 
@@ -205,9 +207,10 @@ def place_and_route(
             "--lpf-allow-unconstrained", "--timing-allow-fail", "--seed", str(seed),
             "--report", "report.json", "-q", "--log", "nextpnr.log"]
     st = synthesis.stat
-    seconds = run_tool(argv, work, work / "nextpnr.out", "place & route (nextpnr)",
-                       on_progress, expected_pnr_seconds(st["lut4"] + st["ff"]), timeout,
-                       follow="nextpnr.log")
+    seconds = run_tool(argv, cwd=work, log=work / "nextpnr.out", timeout=timeout,
+                       follow=follower(nextpnr, "place & route (nextpnr)", on_progress,
+                                       expected_pnr_seconds(st["lut4"] + st["ff"]),
+                                       "nextpnr.log")).seconds
     return parse_nextpnr_report(_read_json(work / "report.json", "nextpnr report")), seconds
 
 

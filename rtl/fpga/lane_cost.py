@@ -28,10 +28,10 @@ from typing import Any
 
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.tools import Progress
 from rvsm.rtl.fpga.devices import get_device
 from rvsm.rtl.fpga.flow import build_component, place_and_route, synthesise
 from rvsm.rtl.fpga.sensor import state_memory
-from rvsm.rtl.fpga.tools import Progress
 
 __all__ = ["DEFAULT_LANES", "DEFAULT_SIZE", "LaneCost", "LaneSynthesis", "combine_lanes",
            "lane_cost", "lane_synthesis", "logic_lut4"]

@@ -24,7 +24,9 @@ from rvsm.model.fixed.stimulus import Stimulus, load_stimulus, save_stimulus
 from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.scene import Scene
-from rvsm.sim.cosim.runner import SimBuild, build, check_simulator, new_run_dir, run_testbench
+from rvsm.sim.cosim.build_cache import SimBuild, build, new_run_dir
+from rvsm.sim.cosim.cocotb_adapter import check_simulator
+from rvsm.sim.cosim.simulation import run_testbench
 
 __all__ = ["MAX_PARALLEL_SIDE", "check_stimulus", "random_verify", "replay", "run_rtl",
            "verify"]
@@ -79,7 +81,7 @@ def check_stimulus(
     lanes instead of the fully parallel one.
 
     Each call gets its own run folder ``work_dir/runs/<name>-<sim>-<time>-<pid>-<random>``
-    (:func:`~.runner.new_run_dir`) holding ``stimulus.npz`` (the testbench's input), the
+    (:func:`~.build_cache.new_run_dir`) holding ``stimulus.npz`` (the testbench's input), the
     result, the log and waves; builds are shared in ``build_root`` (default
     ``work_dir/builds``). Returns the testbench result: ``compared``, ``mismatches``,
     ``first_mismatch``, ``first_mismatch_time_ns``, ``simulator``, ``waves`` (path or

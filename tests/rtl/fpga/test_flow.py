@@ -11,8 +11,9 @@ import pytest
 
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.infra.errors import ToolError
+from rvsm.model.infra.tools import run_tool
 from rvsm.rtl.fpga.flow import run_fpga, synthesis_script
-from rvsm.rtl.fpga.tools import run_tool
+from rvsm.rtl.fpga.tools import follower
 
 TINY = (2, 2)
 
@@ -55,7 +56,7 @@ def test_timeout_kills_the_whole_process_group(tmp_path: Path, fake_tool) -> Non
                    f"sleep 60 &\necho $! > '{pidfile}'\necho started\nwait\n")
     t0 = time.monotonic()
     with pytest.raises(ToolError, match="time limit"):
-        run_tool([str(tool)], tmp_path, tmp_path / "log", "test", timeout=1.0)
+        run_tool([str(tool)], cwd=tmp_path, log=tmp_path / "log", timeout=1.0)
     assert time.monotonic() - t0 < 15
     child = int(pidfile.read_text())
     for _ in range(50):
@@ -75,8 +76,8 @@ def test_progress_reports_phases_and_end(tmp_path: Path, fake_tool) -> None:
                    "echo 'Info:      24000 |     3857      19752 |  110   670 |     15736|'\n"
                    "sleep 1.5\necho 'Info: Packing again'\n")
     seen = []
-    run_tool([str(tool)], tmp_path, tmp_path / "log", "pnr", seen.append, expected=60.0,
-             heartbeat=0.5)
+    run_tool([str(tool)], cwd=tmp_path, log=tmp_path / "log",
+             follow=follower(tool, "pnr", seen.append, expected=60.0, heartbeat=0.5))
     phases = list(dict.fromkeys(p.phase for p in seen))
     assert phases[0] == "starting" and phases[-1] == "done" and seen[-1].done
     # phases never go back; heartbeats show the router's arcs left
@@ -89,8 +90,8 @@ def test_progress_follows_the_tools_own_log(tmp_path: Path, fake_tool) -> None:
                    "echo 'Info: Packing IOs..' >> own.log\nsleep 1\n"
                    "echo 'Info: Routing..' >> own.log\nsleep 1\necho 'console only'\n")
     seen = []
-    run_tool([str(tool)], tmp_path, tmp_path / "console", "pnr", seen.append,
-             follow="own.log")
+    run_tool([str(tool)], cwd=tmp_path, log=tmp_path / "console",
+             follow=follower(tool, "pnr", seen.append, log_file="own.log"))
     assert [p.phase for p in seen] == ["starting", "packing", "routing", "done"]
     assert (tmp_path / "console").read_text() == "console only\n"
 

@@ -1,7 +1,7 @@
 """cocotb regressions: generated Verilog vs the fixed twin, on Icarus and Verilator.
 
 One build per (contract, simulator) is shared by many stimuli (the build cache of
-:mod:`rvsm.sim.cosim.runner`). Default: a border-heavy dog4 3x5 array and a 4x4 FSM array on
+:mod:`rvsm.sim.cosim.build_cache`). Default: a border-heavy dog4 3x5 array and a 4x4 FSM array on
 both simulators, every model on Icarus, the checker-can-fail proof and tool errors.
 ``-m slow`` (``make regress``): every model on both shapes and simulators, longer streams.
 """
@@ -16,7 +16,7 @@ import pytest
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
-from rvsm.sim.cosim.runner import check_simulator
+from rvsm.sim.cosim.cocotb_adapter import check_simulator
 from rvsm.sim.cosim.verify import run_rtl
 
 SIMS = ["icarus", "verilator"]

@@ -1,0 +1,305 @@
+"""The verified co-simulation build cache: one build per key, checked before each use.
+
+One build per :func:`build_key` (RTL, simulator, top, tracing, flags, C++ optimisation,
+tool versions) is cached under ``build_root/<sim>-<digest>-<top>[-trace]-<key>/``,
+checked by checksum before each use and reused by every stimulus
+(:func:`rvsm.sim.cosim.simulation.run_testbench`), so a Verilator compile is paid once.
+Icarus builds always include the FST dump module; Verilator builds get ``--trace-fst``
+only when waves are asked for (a second cached build), since tracing doubles the C++. A
+build happens in a private folder renamed into place when done; the Verilog of a
+contract already generated for another build is reused; each run gets a fresh folder
+(:func:`new_run_dir`). The simulators are driven through
+:mod:`rvsm.sim.cosim.cocotb_adapter`.
+
+What is built for a contract (architecture, default top, Verilog writer, testbench) comes
+from one function, :func:`cosim_design`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import hashlib
+import json
+import os
+import re
+import secrets
+import shutil
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.infra.errors import ToolError
+from rvsm.model.infra.tools import ToolFailure, run_tool
+from rvsm.rtl.digest import rtl_digest
+from rvsm.rtl.stream_verilog import STREAM_TOP, write_stream_outputs
+from rvsm.rtl.verilog import DEFAULT_TOP, GeneratedVerilog, write_outputs
+from rvsm.sim.cosim.cocotb_adapter import build_args, check_simulator, cocotb_build, cxx_opt
+
+__all__ = ["CosimDesign", "SimBuild", "build", "build_key", "cosim_design", "new_run_dir",
+           "tool_versions"]
+
+#: The fully parallel array's testbench.
+TB_MODULE = "rvsm.sim.cosim.tb_array"
+#: The streaming array's testbench.
+TB_STREAM_MODULE = "rvsm.sim.cosim.tb_stream"
+_BUILD_VERSION = "6"  # bump when the build recipe changes
+#: Paths GNU make builds in (Verilator's C++); others are staged in a temporary folder.
+_MAKE_SAFE = re.compile(r"[A-Za-z0-9_./+,@=-]+")
+
+#: Writes ``<top>.v``, ``<top>.ports.json`` and ``<top>.ports.md`` into a folder.
+VerilogWriter = Callable[[Path, str], tuple[dict[str, Path], GeneratedVerilog]]
+
+
+@dataclass(frozen=True)
+class CosimDesign:
+    """What co-simulation builds: architecture name and options, default top, Verilog
+    writer (folder, top -> paths and :class:`~rvsm.rtl.verilog.GeneratedVerilog`) and
+    the cocotb testbench module."""
+
+    arch: str
+    lanes: int | None
+    top: str
+    write: VerilogWriter
+    testbench: str
+
+
+def cosim_design(contract: ArrayContract, lanes: int | None = None) -> CosimDesign:
+    """The design co-simulated for ``contract``: the streaming array with ``lanes`` lanes,
+    or the fully parallel array when ``lanes`` is None. The one place co-simulation
+    chooses an architecture."""
+    if lanes is None:
+        return CosimDesign("parallel", None, DEFAULT_TOP,
+                           lambda out, top: write_outputs(contract, out, top), TB_MODULE)
+    return CosimDesign("stream", lanes, STREAM_TOP,
+                       lambda out, top: write_stream_outputs(contract, lanes, out, top),
+                       TB_STREAM_MODULE)
+
+
+@dataclass(frozen=True)
+class SimBuild:
+    """A finished build: simulator, build directory, top name, Verilog, timings (s), its
+    testbench module."""
+
+    sim: str
+    build_dir: Path
+    top: str
+    verilog: Path
+    generate_seconds: float
+    build_seconds: float
+    cached: bool
+    test_module: str
+    waves: bool = False
+    lanes: int | None = None  # the streaming array's lanes; None: fully parallel
+
+
+@functools.cache
+def tool_versions(sim: str) -> dict[str, str]:
+    """Versions of everything that makes a ``sim`` build: cocotb, the simulator (and g++
+    for Verilator). Part of :func:`build_key`."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    versions = {"cocotb": version("cocotb")}
+    if sim == "icarus":
+        out = run_tool(["iverilog", "-V"], capture=True, check=False)
+        lines = (out.stdout or "").strip().splitlines()
+        versions["iverilog"] = lines[0] if lines else f"unknown (status {out.returncode})"
+    else:
+        try:
+            versions["verilator"] = version("verilator")
+        except PackageNotFoundError:
+            versions["verilator"] = "unknown"
+        out = run_tool(["g++", "-dumpfullversion"], capture=True, check=False)
+        versions["g++"] = (out.stdout or "").strip() or "unknown"
+    return versions
+
+
+def build_key(contract: ArrayContract, sim: str, top: str, traced: bool,
+              extra: Sequence[str] = (), lanes: int | None = None) -> tuple[str, dict]:
+    """Digest (16 hex digits) and fields of everything that changes a build's binary:
+    the RTL (:func:`rvsm.rtl.digest.rtl_digest` of the design :func:`cosim_design` picks
+    for ``lanes``), the build recipe, simulator, top, tracing, build flags, the C++
+    optimisation, the tool versions (:func:`tool_versions`) and ``extra`` (e.g. an
+    architecture's parameters). Two builds with equal keys are interchangeable."""
+    design = cosim_design(contract, lanes)
+    fields = {
+        "recipe": _BUILD_VERSION, "rtl": rtl_digest(contract, design.arch, design.lanes),
+        "sim": sim, "top": top,
+        "traced": traced, "build_args": build_args(sim, traced),
+        "cxx_opt": cxx_opt() if sim == "verilator" else "",
+        "versions": tool_versions(sim), "extra": list(extra),
+    }
+    text = json.dumps(fields, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16], fields
+
+
+def build(
+    contract: ArrayContract, sim: str, build_root: str | os.PathLike,
+    top: str | None = None, waves: bool = False, lanes: int | None = None,
+) -> SimBuild:
+    """Generate (or reuse) the Verilog and build it for ``sim``; cached per :func:`build_key`.
+
+    Icarus builds always carry the FST dump module (cheap); Verilator builds carry
+    ``--trace-fst`` only when ``waves`` (a separate cached build: tracing doubles the
+    C++). A build happens in a private folder ``<name>.tmp<pid>`` renamed into place
+    when done, so concurrent processes share ``build_root`` safely; it is removed when
+    the build fails or is interrupted (a failed build's log is kept as
+    ``<name>.failed.log``). A cached build is used only when its recorded checksums
+    still match (:func:`_cached`); a damaged one is rebuilt. The Verilog of a contract
+    already generated for another build is reused, not regenerated. What is built for
+    ``lanes`` (and the default ``top``) is :func:`cosim_design`'s choice.
+    """
+    check_simulator(sim)
+    design = cosim_design(contract, lanes)
+    top = top or design.top
+    traced = waves or sim == "icarus"
+    digest = rtl_digest(contract, design.arch, design.lanes)
+    key, key_fields = build_key(contract, sim, top, traced, lanes=lanes)
+    suffix = "-trace" if (traced and sim == "verilator") else ""
+    base = Path(build_root).resolve()
+    final = base / f"{sim}-{digest}-{top}{suffix}-{key[:8]}"
+    cached = _cached(final, sim, top, traced, key, design)
+    if cached is not None:
+        return cached
+    root = final.with_name(f"{final.name}.tmp{os.getpid()}")
+    shutil.rmtree(root, ignore_errors=True)
+    # GNU make (Verilator's C++ build) refuses folders with spaces, and a vvp file cannot
+    # name a source whose path holds a double quote: stage such builds in a private
+    # temporary folder, then copy the finished build into the cache.
+    staged = (not _MAKE_SAFE.fullmatch(str(root)) if sim == "verilator"
+              else any(ch in str(root) for ch in '"\\\n'))
+    stage = Path(tempfile.mkdtemp(prefix="rvsm-build-")) / "b" if staged else root
+    log = stage / "build.log"
+
+    def clean() -> None:
+        shutil.rmtree(root, ignore_errors=True)
+        if staged:
+            shutil.rmtree(stage.parent, ignore_errors=True)
+
+    try:
+        stage.mkdir(parents=True, exist_ok=True)
+        paths, gen = (_reuse_verilog(base, digest, top, stage)
+                      or design.write(stage, top))
+        t0 = time.perf_counter()
+        ports = [p["name"] for p in json.loads(paths["ports_json"].read_text())["ports"]]
+        cocotb_build(sim, paths["verilog"], top, ports, stage / "sim_build", traced, log)
+        build_seconds = time.perf_counter() - t0
+        files = _checksums(stage, _build_files(sim, top))
+        if files is None:
+            raise ToolFailure(f"{sim} build", 0, log, "finished without its outputs "
+                              f"{', '.join(_build_files(sim, top))}")
+        (stage / "build.json").write_text(json.dumps({
+            "generate_seconds": gen.seconds, "build_seconds": build_seconds,
+            "key": key, "key_fields": key_fields, "files": files}, indent=1))
+        if staged:
+            shutil.copytree(stage, root, symlinks=True)
+            shutil.rmtree(stage.parent, ignore_errors=True)
+    except ToolFailure as exc:
+        kept = base / f"{final.name}.failed.log"
+        with contextlib.suppress(OSError):
+            shutil.move(log, kept)
+        clean()
+        raise ToolFailure(exc.tool, exc.status, kept if kept.exists() else None,
+                          exc.detail) from exc
+    except BaseException:  # interrupted, disk full...: no half build left behind
+        clean()
+        raise
+    try:
+        os.rename(root, final)
+    except OSError:  # another process finished the same build first
+        shutil.rmtree(root, ignore_errors=True)
+    (base / f"{final.name}.failed.log").unlink(missing_ok=True)  # an older failure's log
+    done = _cached(final, sim, top, traced, key, design)
+    if done is None:
+        raise ToolError(f"{sim} build folder {final} vanished or is damaged")
+    return SimBuild(sim, done.build_dir, top, done.verilog, gen.seconds, build_seconds,
+                    False, design.testbench, traced, design.lanes)
+
+
+def _build_files(sim: str, top: str) -> list[str]:
+    """Files (relative to a build folder) whose checksums a cached build records: the
+    Verilog it was built from and the binary the simulation runs."""
+    binary = "sim_build/sim.vvp" if sim == "icarus" else f"sim_build/{top}"
+    return [f"{top}.v", binary]
+
+
+def _checksums(root: Path, names: Sequence[str]) -> dict[str, str] | None:
+    """SHA-256 of each file ``root/name``; None when one is missing or not a file."""
+    sums = {}
+    for name in names:
+        path = root / name
+        if not path.is_file():
+            return None
+        h = hashlib.sha256()
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+        sums[name] = h.hexdigest()
+    return sums
+
+
+def _cached(root: Path, sim: str, top: str, traced: bool, key: str,
+            design: CosimDesign) -> SimBuild | None:
+    """The finished build in ``root`` if its ``build.json`` records ``key`` and the
+    checksums of its files still match; a damaged build is moved away (and rebuilt)."""
+    if not root.exists():
+        return None
+    problem = None
+    try:
+        meta = json.loads((root / "build.json").read_text())
+        if meta.get("key") != key:
+            problem = "its recorded key differs"
+        elif _checksums(root, list(meta["files"])) != meta["files"]:
+            problem = "a file is missing or changed"
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        problem = "build.json is missing or unreadable"
+    if problem is not None:
+        print(f"rvsm: note: cached {sim} build {root} is damaged ({problem}); rebuilding",
+              file=sys.stderr)
+        stale = root.with_name(f"{root.name}.stale{os.getpid()}")
+        with contextlib.suppress(OSError):
+            os.rename(root, stale)
+        shutil.rmtree(stale, ignore_errors=True)
+        return None
+    return SimBuild(sim, root / "sim_build", top, root / f"{top}.v",
+                    meta["generate_seconds"], meta["build_seconds"], True, design.testbench,
+                    traced, design.lanes)
+
+
+def _reuse_verilog(
+    base: Path, digest: str, top: str, root: Path
+) -> tuple[dict[str, Path], GeneratedVerilog] | None:
+    """Copy an already generated Verilog of the same contract digest into ``root``."""
+    for other in sorted(base.glob(f"*-{digest}-{top}*")):
+        meta_path = other / f"{top}.ports.json"
+        if other == root or not (other / f"{top}.v").exists() or not meta_path.exists():
+            continue
+        paths = {}
+        for key, name in (("verilog", f"{top}.v"), ("ports_json", f"{top}.ports.json"),
+                          ("ports_md", f"{top}.ports.md")):
+            paths[key] = root / name
+            shutil.copyfile(other / name, paths[key])
+        meta = json.loads(meta_path.read_text())
+        return paths, GeneratedVerilog("", top, meta["latency"], meta["generation_seconds"])
+    return None
+
+
+def new_run_dir(work_dir: str | os.PathLike, name: str) -> Path:
+    """A new, empty folder ``<work_dir>/runs/<name>-<date>-<time>-<pid>-<random>`` for
+    one run: concurrent runs sharing ``work_dir`` never see each other's files, and the
+    testbench (whose current folder it is) finds nothing there it did not write."""
+    safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._")[:40] or "run"
+    runs = Path(work_dir).resolve() / "runs"
+    runs.mkdir(parents=True, exist_ok=True)
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    while True:
+        path = runs / f"{safe}-{stamp}-{os.getpid()}-{secrets.token_hex(3)}"
+        try:
+            path.mkdir()
+            return path
+        except FileExistsError:
+            continue

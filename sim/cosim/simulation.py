@@ -1,0 +1,75 @@
+"""One testbench run on a cached build: a stimulus in, the checked result out.
+
+The testbench (:mod:`.tb_array`, :mod:`.tb_stream`) reads the stimulus ``.npz`` named by
+``RVSM_STIMULUS`` and the port map ``RVSM_PORTS``, drives the build, and writes its JSON
+result to ``RVSM_RESULT``; cocotb's verdict (``results.xml``) must agree with it.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from pathlib import Path
+
+from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.sim.cosim.build_cache import SimBuild
+from rvsm.sim.cosim.cocotb_adapter import cocotb_test
+
+__all__ = ["run_testbench"]
+
+
+def run_testbench(
+    sb: SimBuild, stimulus: str | os.PathLike, test_dir: str | os.PathLike,
+    waves: bool = False, test_module: str | None = None,
+) -> dict:
+    """Run the testbench ``test_module`` (default: the build's, ``sb.test_module``) on one
+    stimulus ``.npz``; return its JSON result.
+
+    ``test_dir`` (the simulator's current folder) should be a fresh folder
+    (:func:`~rvsm.sim.cosim.build_cache.new_run_dir`). The result has ``compared``,
+    ``mismatches``, ``first_mismatch`` (or None), ``stream_seconds`` and ``simulator``;
+    ``waves`` the FST path when kept. Raises :class:`~rvsm.model.infra.tools.ToolFailure`
+    when the simulator fails or is killed, :class:`ToolError` when the testbench ends
+    without a result or its cocotb verdict contradicts the result (both: exit status 3).
+    """
+    from cocotb_tools.check_results import get_results
+
+    if waves and not sb.waves:
+        raise RvsmError("this build has no wave support; build it with waves=True")
+    test_dir = Path(test_dir).resolve()
+    test_dir.mkdir(parents=True, exist_ok=True)
+    result_path = test_dir / "result.json"
+    result_path.unlink(missing_ok=True)
+    wave_path = test_dir / ("waves.fst" if sb.sim == "icarus" else "dump.fst")
+    plusargs = [f"+dumpfile_path={wave_path}"] if (waves and sb.sim == "icarus") else []
+    log = test_dir / "sim.log"
+    results_xml = test_dir / "results.xml"
+    extra = {"RVSM_STIMULUS": str(Path(stimulus).resolve()), "RVSM_RESULT": str(result_path),
+             "RVSM_PORTS": str((sb.verilog.parent / f"{sb.top}.ports.json").resolve())}
+    test_module = test_module or sb.test_module
+    t0 = time.perf_counter()
+    cocotb_test(sb.sim, sb.build_dir, sb.top, test_module, test_dir, extra, waves, plusargs,
+                results_xml, log)
+    wall = time.perf_counter() - t0
+    tb = test_module.rsplit(".", 1)[-1]
+    try:
+        tests, failed = get_results(results_xml)
+    except (RuntimeError, OSError):
+        raise ToolError(f"testbench {tb} on {sb.sim} wrote no cocotb results "
+                        f"({results_xml.name}); log: {log}") from None
+    try:
+        result = json.loads(result_path.read_text())
+        mismatches = int(result["mismatches"])
+    except (OSError, ValueError, KeyError, TypeError):
+        raise ToolError(f"testbench {tb} on {sb.sim} crashed before writing its result "
+                        f"({failed} of {tests} cocotb test(s) failed); log: {log}") from None
+    if tests < 1 or bool(failed) != bool(mismatches):
+        raise ToolError(f"testbench {tb} on {sb.sim}: cocotb reports {failed} of {tests} "
+                        f"test(s) failed but the result has {mismatches} mismatches; "
+                        f"log: {log}")
+    result["simulator"] = sb.sim
+    result["sim_wall_seconds"] = wall
+    result["waves"] = str(wave_path) if waves and wave_path.exists() else None
+    result["cocotb_tests"], result["cocotb_failed"] = tests, failed
+    return result
