@@ -32,14 +32,9 @@ from typing import TYPE_CHECKING
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.model.infra.tools import ToolFailure, run_tool
-from rvsm.rtl.stream_verilog import STREAM_TOP, write_stream_outputs
-from rvsm.rtl.verilog import (
-    DEFAULT_TOP,
-    GeneratedVerilog,
-    rtl_digest,
-    verilator_env,
-    write_outputs,
-)
+from rvsm.rtl.architecture import Architecture
+from rvsm.rtl.architectures import get_architecture
+from rvsm.rtl.verilog import GeneratedVerilog, rtl_digest, verilator_env, write_outputs
 from rvsm.sim.cosim import SIMULATORS
 
 if TYPE_CHECKING:
@@ -48,9 +43,15 @@ if TYPE_CHECKING:
 __all__ = ["SIMULATORS", "SimBuild", "build", "build_key", "check_simulator", "new_run_dir",
            "run_testbench", "tool_versions"]
 
-TB_MODULE = "rvsm.sim.cosim.tb_array"
-#: The streaming array's testbench (builds with ``lanes``).
-TB_STREAM_MODULE = "rvsm.sim.cosim.tb_stream"
+
+
+def _architecture(lanes: int | None) -> tuple[Architecture, dict[str, int]]:
+    """The registered architecture of a build and its options: the streaming array with
+    ``lanes``, the fully parallel array without."""
+    if lanes is None:
+        return get_architecture("parallel"), {}
+    return get_architecture("stream"), {"lanes": lanes}
+
 #: Verilator flags for Amaranth's netlist (warnings are the lint's job, not the build's).
 VERILATOR_BUILD_ARGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style", "-O2")
 _BUILD_VERSION = "5"  # bump when the build recipe changes
@@ -240,7 +241,7 @@ def _runner_class(sim: str) -> type:
 
 def build(
     contract: ArrayContract, sim: str, build_root: str | os.PathLike,
-    top: str = DEFAULT_TOP, waves: bool = False, lanes: int | None = None,
+    top: str | None = None, waves: bool = False, lanes: int | None = None,
 ) -> SimBuild:
     """Generate (or reuse) the Verilog and build it for ``sim``; cached per :func:`build_key`.
 
@@ -252,11 +253,11 @@ def build(
     ``<name>.failed.log``). A cached build is used only when its recorded checksums
     still match (:func:`_cached`); a damaged one is rebuilt. The Verilog of a contract
     already generated for another build is reused, not regenerated. ``lanes`` builds the
-    streaming array (:mod:`rvsm.rtl.stream_array`) instead.
+    streaming array (:mod:`rvsm.rtl.stream`) instead.
     """
     check_simulator(sim)
-    if lanes is not None and top == DEFAULT_TOP:
-        top = STREAM_TOP
+    arch, options = _architecture(lanes)
+    top = top or arch.default_top
     traced = waves or sim == "icarus"
     digest = contract_digest(contract, lanes)
     key, key_fields = build_key(contract, sim, top, traced, lanes=lanes)
@@ -284,8 +285,7 @@ def build(
     try:
         stage.mkdir(parents=True, exist_ok=True)
         paths, gen = _reuse_verilog(base, digest, top, stage) or (
-            write_outputs(contract, stage, top) if lanes is None
-            else write_stream_outputs(contract, lanes, stage, top))
+            write_outputs(contract, stage, arch, top, **options))
         runner = _runner(sim)
         t0 = time.perf_counter()
         with _environ(_sim_env(sim)):
@@ -418,9 +418,9 @@ def run_testbench(
     sb: SimBuild, stimulus: str | os.PathLike, test_dir: str | os.PathLike,
     waves: bool = False, test_module: str | None = None,
 ) -> dict:
-    """Run the testbench ``test_module`` (default: :data:`TB_MODULE`, or
-    :data:`TB_STREAM_MODULE` for a streaming build) on one stimulus ``.npz``; return its
-    JSON result.
+    """Run the testbench ``test_module`` (default: the build's architecture's,
+    :attr:`~rvsm.rtl.architecture.Architecture.testbench`) on one stimulus ``.npz``;
+    return its JSON result.
 
     ``test_dir`` (the simulator's current folder) should be a fresh folder
     (:func:`new_run_dir`). The result has ``compared``, ``mismatches``,
@@ -443,7 +443,7 @@ def run_testbench(
     extra = {"RVSM_STIMULUS": str(Path(stimulus).resolve()), "RVSM_RESULT": str(result_path),
              "RVSM_PORTS": str((sb.verilog.parent / f"{sb.top}.ports.json").resolve())}
     if test_module is None:
-        test_module = TB_MODULE if sb.lanes is None else TB_STREAM_MODULE
+        test_module = _architecture(sb.lanes)[0].testbench
     t0 = time.perf_counter()
     # Under pytest, cocotb's runner judges the results itself and exits on a failed test;
     # hide pytest from it, so it behaves as on the command line and the verdict is ours.

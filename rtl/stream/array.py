@@ -1,6 +1,6 @@
 """The lane-parallel streaming RVSM pixel array, built from one :class:`ArrayContract`.
 
-Where :class:`~rvsm.rtl.array.RvsmArray` builds an adder network and an accumulator per
+Where :class:`~rvsm.rtl.parallel.array.RvsmArray` builds an adder network and an accumulator per
 (scale, pixel), this array streams the frame through ``P`` lanes: the datapath is
 O(P), and only the state memories grow with the sensor. One clock domain ``sync``
 (synchronous reset ``rst``)::
@@ -18,7 +18,7 @@ O(P), and only the state memories grow with the sensor. One clock domain ``sync`
       -> fire / reset -> write back to the accumulator memory;
          spikes + position registered on the output stream           [Q+3]
 
-L is the kernel radius (:func:`~rvsm.rtl.pipelined_sum.kernel_radius`), E =
+L is the kernel radius (:func:`~rvsm.model.kernels.geometry.kernel_radius`), E =
 ``ceil(L / P)`` the column groups a window reaches either side, G = ``W / P``.
 
 **State.** Per scale one accumulator memory (word = P signed W-bit accumulators) and one
@@ -69,234 +69,26 @@ of this schedule.
 The bit-accurate model is :meth:`ArrayContract.run`, rearranged into beats by
 :class:`~rvsm.rtl.stream_schedule.StreamSchedule`.
 """
-
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-
-import numpy as np
-from amaranth.hdl import Cat, Const, Module, Mux, Signal, Value, signed, unsigned
-from amaranth.lib import data, stream, wiring
+from amaranth.hdl import Cat, Const, Module, Mux, Signal, signed, unsigned
+from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.interfaces import ThresholdWriteSignature
-from rvsm.rtl.pipelined_sum import Pipeline, Timed, kernel_orbits, kernel_radius, orbit_terms
-from rvsm.rtl.receptive_sum import sum_width
-from rvsm.rtl.stream_schedule import OutputBeats, StreamSchedule, pack_lanes
+from rvsm.rtl.stream.banked_memory import BankedMemory
+from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.pipelined_sum import Pipeline
+from rvsm.rtl.stream.schedule import StreamSchedule
+from rvsm.rtl.stream.signatures import (
+    code_beat_signature,
+    spike_beat_signature,
+    threshold_word_bits,
+    threshold_write_signature,
+)
 
-__all__ = [
-    "RvsmStreamArray",
-    "StreamGeometry",
-    "code_beat_signature",
-    "simulate",
-    "spike_beat_layout",
-    "spike_beat_signature",
-    "threshold_word_bits",
-    "threshold_write_signature",
-]
-
-
-def _bits(max_value: int) -> int:
-    """Bits of an unsigned field holding ``0 .. max_value`` (at least 1)."""
-    return max(1, int(max_value).bit_length())
-
-
-def code_beat_signature(adc_bits: int, lanes: int) -> stream.Signature:
-    """Input stream: ``payload`` = ``lanes`` unsigned ADC codes, ``valid``, ``ready``."""
-    return stream.Signature(data.ArrayLayout(unsigned(adc_bits), lanes))
-
-
-def spike_beat_layout(num_scales: int, lanes: int, height: int,
-                      groups: int) -> data.StructLayout:
-    """Output payload: ``row``, ``group``, ``last``, ``pos`` and ``neg`` (``S*P`` bits)."""
-    return data.StructLayout({
-        "row": unsigned(_bits(height - 1)),
-        "group": unsigned(_bits(groups - 1)),
-        "last": unsigned(1),
-        "pos": unsigned(num_scales * lanes),
-        "neg": unsigned(num_scales * lanes),
-    })
-
-
-def spike_beat_signature(num_scales: int, lanes: int, height: int,
-                         groups: int) -> wiring.Signature:
-    """Output stream of :func:`spike_beat_layout` beats: ``payload`` and ``valid``, no
-    ``ready`` (a sensor cannot be stopped: there is no back-pressure)."""
-    return wiring.Signature({
-        "payload": Out(spike_beat_layout(num_scales, lanes, height, groups)),
-        "valid": Out(1),
-    })
-
-
-def threshold_word_bits(words: int) -> int:
-    """Bits of the word part (``y*G + g``) of a threshold write address."""
-    return _bits(words - 1)
-
-
-def threshold_write_signature(num_scales: int, words: int, lanes: int,
-                              threshold_bits: int) -> ThresholdWriteSignature:
-    """The shared threshold-write bus with one memory word (P thresholds) per write:
-    ``data`` lane ``i`` at ``[i*(W-1) +: W-1]``, ``addr = (s << word_bits) | (y*G + g)``
-    (:func:`threshold_word_bits`)."""
-    return ThresholdWriteSignature(lanes * threshold_bits,
-                                   _bits(num_scales - 1) + threshold_word_bits(words))
-
-
-class StreamGeometry:
-    """Sizes and timing of a stream array: pure Python, nothing to elaborate.
-
-    ``RvsmStreamArray(contract, lanes).geometry``, or build one directly when only the
-    schedule or the named timing properties are needed (e.g. by a testbench).
-    """
-
-    #: Adder levels between pipeline registers in the receptive-sum trees.
-    LEVELS_PER_STAGE = 2
-    #: Default largest number of words in one bank of a state memory (one ECP5 DP16KD
-    #: holds 1024 words of up to 18 bits; wider words use several in parallel).
-    BANK_WORDS = 1024
-    #: Stages from the sums' register to the output register: add, compare, reset.
-    TAIL_STAGES = 3
-    #: Registers between the input ports and the datapath (accepted beat, clear).
-    INPUT_STAGES = 1
-
-    def __init__(self, contract: ArrayContract, lanes: int = 1,
-                 bank_words: int = BANK_WORDS):
-        c = contract
-        if bank_words < 1 or bank_words & (bank_words - 1):
-            raise RvsmError(f"bank_words must be a power of two, got {bank_words}")
-        self.bank_words = int(bank_words)
-        if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) \
-                or lanes < 1 or c.width % lanes:
-            raise RvsmError(f"lanes must be a positive divisor of the width {c.width}, "
-                            f"got {lanes}")
-        self.contract = c
-        self.lanes = int(lanes)
-        self.groups = c.width // self.lanes
-        self.radius = kernel_radius(c.weights)
-        self.edge_groups = -(-self.radius // self.lanes)
-        self.orbits = kernel_orbits(c.weights)
-        self.beats_per_frame = c.height * self.groups
-        self.sum_stage = self.build_sums(Pipeline(None), None)[1]
-        if self.beats_per_frame <= self.rmw_depth:
-            raise RvsmError(
-                f"the stream array needs more than {self.rmw_depth} beats per frame (its "
-                f"read-modify-write depth); {c.height}x{c.width} at {lanes} lane(s) has "
-                f"{self.beats_per_frame}: use fewer lanes")
-
-    @property
-    def window_lag(self) -> int:
-        """Input beats after position ``p`` until its window is complete: ``L*G + E``."""
-        return self.radius * self.groups + self.edge_groups
-
-    @property
-    def pipeline_depth(self) -> int:
-        """Registered stages from the window register to the output register."""
-        return self.sum_stage + self.TAIL_STAGES
-
-    @property
-    def latency(self) -> int:
-        """Clock cycles from the edge accepting beat ``p + window_lag`` to the edge
-        presenting ``p``'s output, when beats are back to back."""
-        return self.INPUT_STAGES + self.pipeline_depth
-
-    @property
-    def lag(self) -> int:
-        """Output ``p`` is released by input beat ``p + lag`` (presented in the second
-        cycle after that beat's acceptance)."""
-        return self.window_lag + self.pipeline_depth
-
-    @property
-    def rmw_depth(self) -> int:
-        """Beats from an accumulator read (address sampled) to its write-back."""
-        return self.TAIL_STAGES + 1
-
-    @property
-    def rmw_guard_bits(self) -> int:
-        """Low address bits that tell an accumulator read from the write at its edge.
-
-        The read of position ``p`` meets the write-back of ``p - rmw_depth``, so the
-        addresses differ by ``rmw_depth`` or ``rmw_depth - beats_per_frame``: the
-        smallest ``k`` for which ``2**k`` divides neither (all address bits at most).
-        """
-        def twos(v: int) -> int:
-            return (v & -v).bit_length() - 1
-
-        d, n = self.rmw_depth, self.beats_per_frame
-        return min(1 + max(twos(d), twos(n - d)), max(1, (n - 1).bit_length()))
-
-    @property
-    def threshold_lag(self) -> int:
-        """Position ``p`` reads its thresholds at the edge after the one accepting input
-        beat ``p + threshold_lag``."""
-        return self.window_lag + self.sum_stage - 1
-
-    @property
-    def bank_sizes(self) -> list[int]:
-        """Words per bank of each state memory (every bank but the last is full)."""
-        n, b = self.beats_per_frame, self.bank_words
-        return [min(b, n - i) for i in range(0, n, b)]
-
-    @property
-    def state_bits(self) -> dict[str, int]:
-        """Memory bits: ``accumulators``, ``thresholds``, ``line_buffer``."""
-        c = self.contract
-        acc = c.num_scales * c.height * c.width * c.accumulator_bits
-        thr = c.num_scales * c.height * c.width * c.threshold_bits
-        return {"accumulators": acc, "thresholds": thr,
-                "line_buffer": 2 * self.radius * c.width * c.adc_bits}
-
-    @property
-    def schedule(self) -> StreamSchedule:
-        """The numpy model of this array's beat schedule."""
-        c = self.contract
-        return StreamSchedule(c.height, c.width, self.lanes, self.lag, self.threshold_lag)
-
-    @property
-    def spike_layout(self) -> data.StructLayout:
-        """Layout of the output payload (:func:`spike_beat_layout`)."""
-        c = self.contract
-        return spike_beat_layout(c.num_scales, self.lanes, c.height, self.groups)
-
-    def timing(self) -> dict[str, int]:
-        """The named timing properties, as a dict (for port maps and reports)."""
-        return {k: getattr(self, k) for k in (
-            "lanes", "groups", "radius", "window_lag", "pipeline_depth", "latency", "lag",
-            "rmw_depth", "threshold_lag", "beats_per_frame")}
-
-    def sum_bits(self, scale: int) -> int:
-        """Signed width of scale ``scale``'s exact weighted sum."""
-        return sum_width(*self.contract.sum_range(scale))
-
-    def window_cells(self) -> list[tuple[int, int]]:
-        """Window cells ``(d, j)`` (row 0..2L, column 0..P+2L-1) some tap reads."""
-        r = self.radius
-        return sorted({(r + dy, r + i + dx) for i in range(self.lanes)
-                       for o in self.orbits for dy, dx in o.offsets})
-
-    def build_sums(self, pipe: Pipeline, window: Mapping[tuple[int, int], Timed] | None
-                   ) -> tuple[list[list[Timed]], int]:
-        """Per lane, per scale the weighted sum; and the stage they are all registered at.
-
-        ``window`` maps cells to stage-1 values; ``None`` plans (stage numbers only).
-        """
-        c, r, n = self.contract, self.radius, self.contract.adc_bits
-        if window is None:
-            window = {cell: pipe.timed(None, 1) for cell in self.window_cells()}
-        sums = []
-        for i in range(self.lanes):
-            orbit_sums = []
-            for o in self.orbits:
-                terms = [(1, window[(r + dy, r + i + dx)], 0) for dy, dx in o.offsets]
-                width = n + (len(terms) - 1).bit_length()
-                orbit_sums.append(pipe.settle(pipe.sum(terms, width)))
-            sums.append([pipe.settle(pipe.sum(orbit_terms(orbit_sums, self.orbits, s),
-                                              self.sum_bits(s)))
-                         for s in range(c.num_scales)])
-        stage = max([2] + [t.stage for lane in sums for t in lane])
-        return sums, stage
+__all__ = ["RvsmStreamArray"]
 
 
 class RvsmStreamArray(wiring.Component):
@@ -373,66 +165,6 @@ class RvsmStreamArray(wiring.Component):
     def schedule(self) -> StreamSchedule:
         """:attr:`StreamGeometry.schedule`."""
         return self.geometry.schedule
-
-    def _banked(self, m: Module, name: str, width: int, advance: Value,
-                read_addr: Value, read_bank: Value,
-                writes: Sequence[tuple[Value, Value, Value]],
-                forward: tuple[Value, Value] | None = None,
-                guard: tuple[Value, int] | None = None) -> Value:
-        """A banked memory of ``width``-bit words; returns the registered read data.
-
-        The read address is sampled at an ``advance`` edge; the data is registered per
-        bank at the next ``advance`` edge and multiplexed by ``read_bank`` (which must be
-        the bank of that address, delayed alike). ``writes`` is one ``(en, addr, data)``
-        port description per write port. A bank's read is disabled at an edge where a
-        write port writes its address: the read data is then undefined (yosys needs no
-        read-first bypass multiplexer after the block RAM), so either such collisions
-        never meet a valid read, or ``forward = (hit, data)`` replaces the read data by
-        ``data`` after the bank registers where ``hit`` was set (``hit`` is sampled with
-        the read address; ``data`` must be the forwarded word delayed alike, two
-        ``advance`` edges). ``guard = (may_write, k)`` (one write port whose enable is
-        ``advance & may_write``) gates the read where ``may_write`` holds and the low
-        ``k`` address bits match: a cheaper superset of the collisions, for a memory
-        whose valid reads and writes never match in those bits.
-        """
-        sizes = self.geometry.bank_sizes
-        banked = len(sizes) > 1
-        offset_bits = (self.geometry.bank_words - 1).bit_length()
-        outs = []
-        for b, depth in enumerate(sizes):
-            mem = Memory(shape=unsigned(width), depth=depth, init=[])
-            m.submodules[f"{name}_b{b}"] = mem
-            for en, addr, wdata in writes:
-                wp = mem.write_port()
-                hit = (addr >> offset_bits) == b if banked else Const(1)
-                m.d.comb += [wp.addr.eq(addr[:offset_bits] if banked else addr),
-                             wp.data.eq(wdata), wp.en.eq(en & hit)]
-            rp = mem.read_port()
-            m.d.comb += rp.addr.eq(read_addr[:offset_bits] if banked else read_addr)
-            collide = Const(0)
-            for (_, addr, _), wp in zip(writes, mem.write_ports, strict=True):
-                if guard is None:
-                    collide = collide | (wp.en & (wp.addr == rp.addr))
-                else:
-                    hit = (addr >> offset_bits) == b if banked else Const(1)
-                    k = min(guard[1], len(rp.addr))
-                    collide = collide | (guard[0] & hit & (wp.addr[:k] == rp.addr[:k]))
-            m.d.comb += rp.en.eq(advance & ~collide)
-            reg = Signal(unsigned(width), name=f"{name}_b{b}_q", reset_less=True)
-            with m.If(advance):
-                m.d.sync += reg.eq(rp.data)
-            outs.append(reg)
-        out = outs[-1]
-        for b in range(len(outs) - 2, -1, -1):
-            out = Mux(read_bank == b, outs[b], out)
-        if forward is not None:
-            hit, data = forward
-            hit1 = Signal(name=f"{name}_fwd1", reset_less=True)
-            hit2 = Signal(name=f"{name}_fwd2", reset_less=True)
-            with m.If(advance):
-                m.d.sync += [hit1.eq(hit), hit2.eq(hit1)]
-            out = Mux(hit2, data, out)
-        return out
 
     def elaborate(self, platform: object) -> Module:
         """Line buffer, window, masks, sums, state memories, output register."""
@@ -594,14 +326,25 @@ class RvsmStreamArray(wiring.Component):
         pos_bits, neg_bits = [], []
         for s in range(c.num_scales):
             after_lanes = []
-            thr_q = self._banked(
-                m, f"thr_s{s}", p * tw, advance, rd_addr, bank_q,
-                [(bus_we & (bus_scale == s), bus_word, bus_data)],
-                forward=(bus_we & (bus_scale == s) & (bus_word == rd_addr), fwd_data[1]))
+            thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True)
+            m.submodules[f"thr_s{s}"] = thr_mem
+            m.d.comb += [thr_mem.advance.eq(advance), thr_mem.read_addr.eq(rd_addr),
+                         thr_mem.read_bank.eq(bank_q),
+                         thr_mem.write_en.eq(bus_we & (bus_scale == s)),
+                         thr_mem.write_addr.eq(bus_word), thr_mem.write_data.eq(bus_data),
+                         thr_mem.forward_hit.eq(bus_we & (bus_scale == s)
+                                                & (bus_word == rd_addr)),
+                         thr_mem.forward_data.eq(fwd_data[1])]
+            thr_q = thr_mem.data
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
-            acc_q = self._banked(m, f"acc_s{s}", p * wa, advance, rd_addr, bank_q,
-                                 [(wr_en, wr_addr, after_flat)],
-                                 guard=(valid[tail], geo.rmw_guard_bits))
+            acc_mem = BankedMemory(p * wa, words, geo.bank_words,
+                                   guard_bits=geo.rmw_guard_bits)
+            m.submodules[f"acc_s{s}"] = acc_mem
+            m.d.comb += [acc_mem.advance.eq(advance), acc_mem.read_addr.eq(rd_addr),
+                         acc_mem.read_bank.eq(bank_q), acc_mem.write_en.eq(wr_en),
+                         acc_mem.write_addr.eq(wr_addr), acc_mem.write_data.eq(after_flat),
+                         acc_mem.may_write.eq(valid[tail])]
+            acc_q = acc_mem.data
             for i in range(p):
                 acc = Mux(fresh_q, 0, acc_q[i * wa:(i + 1) * wa].as_signed())
                 shifted = sums[i][s].value.as_signed() >> c.shift
@@ -637,102 +380,3 @@ class RvsmStreamArray(wiring.Component):
         m.d.sync += self.spikes.valid.eq(wr_en)
         pipe.emit()
         return m
-
-
-def simulate(
-    contract: ArrayContract,
-    codes: np.ndarray,
-    thresholds: np.ndarray,
-    lanes: int = 1,
-    clear_before: Sequence[int] = (),
-    threshold_updates: Mapping[int, np.ndarray] | None = None,
-    idle_every: int = 0,
-    bank_words: int = StreamGeometry.BANK_WORDS,
-) -> OutputBeats:
-    """Run :class:`RvsmStreamArray` in ``amaranth.sim``; return every output beat.
-
-    Thresholds ``(S, H, W)`` are written through ``thr``; each segment between
-    ``clear_before`` steps is streamed back to back, flushed with ``lag`` beats and
-    followed by a one-cycle ``clear``. ``threshold_updates`` maps a frame ``t`` (of the
-    first segment) to thresholds written while the stream is paused at
-    :meth:`StreamSchedule.threshold_pause_beat` ``(t)``. ``idle_every = k > 0`` drops
-    ``valid`` for one cycle after every ``k``-th beat (a paused stream). Compare the
-    result with :func:`~rvsm.rtl.stream_schedule.check_beats`; its ``accepted`` holds,
-    per output beat, the index (within its segment) of the input beat accepted two
-    cycles before it was presented, the beat that released it.
-    """
-    from amaranth.sim import Simulator
-
-    c = contract
-    codes = np.asarray(codes, dtype=np.int64)
-    StreamGeometry(c, lanes, bank_words)  # validate before building a component
-    dut = RvsmStreamArray(c, lanes, bank_words)
-    sched = dut.schedule
-    layout = dut.geometry.spike_layout
-    word_bits = threshold_word_bits(sched.beats_per_frame)
-    fields = {name: (layout[name].offset, layout[name].width)
-              for name in ("row", "group", "last", "pos", "neg")}
-    updates = dict(threshold_updates or {})
-    got: dict[str, list[int]] = {k: [] for k in (*fields, "accepted")}
-
-    def thr_words(thr: np.ndarray) -> list[tuple[int, int, int]]:
-        w = sched.threshold_words(np.asarray(thr, dtype=np.int64))
-        packed = pack_lanes(w.reshape(-1, lanes), c.threshold_bits)
-        return [(s, a, packed[s * sched.beats_per_frame + a])
-                for s in range(c.num_scales) for a in range(sched.beats_per_frame)]
-
-    async def write_thresholds(ctx, thr: np.ndarray) -> None:  # noqa: ANN001
-        for s, a, word in thr_words(thr):
-            ctx.set(dut.thr.we, 1)
-            ctx.set(dut.thr.addr, (s << word_bits) | a)
-            ctx.set(dut.thr.data, word)
-            await ctx.tick()
-        ctx.set(dut.thr.we, 0)
-
-    accepted = [-1, -1]  # beats accepted at the previous and at the latest edge
-
-    def collect(ctx, beat: int) -> None:  # noqa: ANN001
-        """After an edge that accepted ``beat`` (-1: none), record a presented output."""
-        accepted[:] = [accepted[1], beat]
-        if ctx.get(dut.spikes.valid):
-            word = ctx.get(dut.spikes.payload.as_value())
-            for k, (off, width) in fields.items():
-                got[k].append((word >> off) & ((1 << width) - 1))
-            got["accepted"].append(accepted[0])
-
-    async def bench(ctx) -> None:  # noqa: ANN001
-        await write_thresholds(ctx, thresholds)
-        for seg, (a, b) in enumerate(sched.segments(len(codes), clear_before)):
-            if seg:
-                ctx.set(dut.clear, 1)
-                await ctx.tick()
-                collect(ctx, -1)
-                ctx.set(dut.clear, 0)
-            beats = pack_lanes(sched.input_beats(codes[a:b]), c.adc_bits)
-            pauses = {sched.threshold_pause_beat(t): thr for t, thr in updates.items()} \
-                if seg == 0 else {}
-            for k, word in enumerate(beats):
-                if k in pauses:
-                    ctx.set(dut.codes.valid, 0)
-                    await ctx.tick()
-                    collect(ctx, -1)
-                    await write_thresholds(ctx, pauses[k])
-                ctx.set(dut.codes.payload.as_value(), word)
-                ctx.set(dut.codes.valid, 1)
-                await ctx.tick()
-                collect(ctx, k)
-                if idle_every and (k + 1) % idle_every == 0:
-                    ctx.set(dut.codes.valid, 0)
-                    await ctx.tick()
-                    collect(ctx, -1)
-            ctx.set(dut.codes.valid, 0)
-            for _ in range(2):
-                await ctx.tick()
-                collect(ctx, -1)
-
-    sim = Simulator(dut)
-    sim.add_clock(1e-6)
-    sim.add_testbench(bench)
-    sim.run()
-    return OutputBeats.from_words(got["row"], got["group"], got["last"], got["pos"],
-                                  got["neg"], c.num_scales, lanes, got["accepted"])

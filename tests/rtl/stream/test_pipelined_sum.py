@@ -5,18 +5,19 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from amaranth.hdl import Module, Signal, unsigned
-from amaranth.sim import Simulator
 
 from rvsm.model.fixed.weights import quantise_model
+from rvsm.model.kernels.geometry import kernel_radius
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
-from rvsm.rtl.pipelined_sum import Pipeline, kernel_orbits, kernel_radius
 from rvsm.rtl.receptive_sum import sum_width
+from rvsm.rtl.simulation import run_simulation
+from rvsm.rtl.stream.pipelined_sum import Pipeline, weighted_orbits
 
 
 @pytest.mark.parametrize("model", MODEL_NAMES)
 def test_orbits_rebuild_every_kernel(model: str) -> None:
     ks = quantise_model(model, 9, "round-half-up")
-    orbits = kernel_orbits(ks)
+    orbits = weighted_orbits(ks)
     radius = kernel_radius(ks)
     for s, k in enumerate(ks):
         half = k.shape[0] // 2
@@ -82,9 +83,6 @@ def test_retimed_sum_is_exact_and_planned(levels: int) -> None:
             raw = ctx.get(out)
             got.append(raw - (1 << width) if raw >> (width - 1) else raw)
 
-    sim = Simulator(m)
-    sim.add_clock(1e-6)
-    sim.add_testbench(bench)
-    sim.run()
+    run_simulation(m, bench)
     want = [sum(s * int(vec[i]) << sh for s, i, sh in terms_spec) for vec in vectors]
     assert got == want
