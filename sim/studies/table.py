@@ -20,8 +20,8 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES, model_spec
 from rvsm.model.noise.sensor import NoiseParams
 from rvsm.model.sampling.samplers import DEFAULT_PHI, SamplerConfig, sample
-from rvsm.model.scene import library as scene_library
 from rvsm.model.scene.scene import Scene
+from rvsm.model.scene import library as scene_library
 from rvsm.sim.studies.labels import column_label, method_label
 
 TABLE_MODELS: tuple[str, ...] = MODEL_NAMES
