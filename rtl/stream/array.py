@@ -23,29 +23,29 @@ L is the kernel radius (:func:`~rvsm.model.kernels.geometry.kernel_radius`), E =
 
 **State.** Per scale one accumulator memory (word = P signed W-bit accumulators) and one
 threshold memory (word = P thresholds of W-1 bits), depth ``H*G``, address ``y*G + g``,
-split into banks of at most :attr:`StreamGeometry.bank_words` words (a power of two,
-1024 by default) whose read data is registered before the bank multiplexer (ECP5
-block-RAM timing). Each address is read and written once per frame,
-:attr:`StreamGeometry.rmw_depth` beats apart, so the
+each a :class:`~rvsm.rtl.stream.banked_memory.BankedMemory` split into banks of at most
+:attr:`StreamGeometry.bank_words` words (a power of two, 1024 by default) whose read
+data is registered before the bank multiplexer (ECP5 block-RAM timing). Each address is
+read and written once per frame, :attr:`StreamGeometry.rmw_depth` beats apart, so the
 read-modify-write needs no forwarding as long as ``H*G > rmw_depth`` (checked). A bank's
 read is disabled when its write port writes the same address at that edge (no read-first
 bypass multiplexer after the block RAM); threshold writes are registered and forwarded
 after the bank registers to a read meeting them, so the rule below holds.
 
-**Streams.** ``codes`` (:func:`code_beat_signature`): ``payload`` lane ``i`` = pixel
-``(y, g*P + i)``; a beat is accepted at a rising edge with ``valid & ready``; ``ready``
-is low only while ``clear`` is high. Accepted beats and ``clear`` pass an input
-register (no combinational path from the ports into the datapath), and the whole
-pipeline advances once per accepted beat, at the edge after its acceptance (a clock
-enable), so a paused input holds everything in flight. ``spikes``
+**Streams.** ``codes`` (:func:`~rvsm.rtl.stream.signatures.code_beat_signature`):
+``payload`` lane ``i`` = pixel ``(y, g*P + i)``; a beat is accepted at a rising edge
+with ``valid & ready``; ``ready`` is low only while ``clear`` is high. Accepted beats
+and ``clear`` pass an input register (no combinational path from the ports into the
+datapath), and the whole pipeline advances once per accepted beat, at the edge after its
+acceptance (a clock enable), so a paused input holds everything in flight. ``spikes``
 (:func:`spike_beat_signature`, no back-pressure): ``valid`` is high for the one cycle
 after the edge that releases a position; ``payload.row``/``group`` is the position,
-``last`` marks the frame's last beat, bit ``s*P + i`` of ``pos``/``neg`` the +1/-1
-spike of accumulator ``(s, y, g*P + i)``. The output of position ``p`` (beats counted
-from the last clear) is released by input beat ``p + lag``: it is presented in the
-second cycle after that beat's acceptance. To drain a stream, send ``lag`` more beats
-(any codes) and wait one more cycle. :mod:`rvsm.rtl.stream_schedule` is the numpy model
-of this schedule.
+``last`` marks the frame's last beat, bit ``s*P + i`` of ``pos``/``neg`` the +1/-1 spike
+of accumulator ``(s, y, g*P + i)``. The output of position ``p`` (beats counted from the
+last clear) is released by input beat ``p + lag``: it is presented in the second cycle
+after that beat's acceptance. To drain a stream, send ``lag`` more beats (any codes) and
+wait one more cycle. :mod:`rvsm.rtl.stream.schedule` is the numpy model of this
+schedule.
 
 **Frame-boundary meaning of the controls.**
 
@@ -67,8 +67,10 @@ of this schedule.
   memories are not initialised: load every threshold before streaming.
 
 The bit-accurate model is :meth:`ArrayContract.run`, rearranged into beats by
-:class:`~rvsm.rtl.stream_schedule.StreamSchedule`.
+:class:`~rvsm.rtl.stream.schedule.StreamSchedule`; the component is driven in
+``amaranth.sim`` by :mod:`rvsm.rtl.stream.drive`.
 """
+
 from __future__ import annotations
 
 from amaranth.hdl import Cat, Const, Module, Mux, Signal, signed, unsigned

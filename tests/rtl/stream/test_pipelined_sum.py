@@ -1,4 +1,4 @@
-"""Orbit decomposition and retimed adder trees of :mod:`rvsm.rtl.pipelined_sum`."""
+"""Orbit decomposition and retimed adder trees of :mod:`rvsm.rtl.stream.pipelined_sum`."""
 
 from __future__ import annotations
 
