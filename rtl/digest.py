@@ -15,14 +15,13 @@ __all__ = ["rtl_digest"]
 _RTL_ROOT = Path(__file__).parent
 
 
-def rtl_digest(contract: ArrayContract, arch: str, lanes: int | None = None,
-               extra: Mapping[str, object] | None = None) -> str:
-    """16 hex digits of ``contract``, the architecture ``arch`` and its options (``lanes``,
-    ``extra``: JSON values such as a flow's settings) and every Python source under
-    ``rtl/`` (architectures, shared pieces, the FPGA flow): equal digests build the same
-    RTL the same way."""
-    options = json.dumps({"arch": arch, "lanes": lanes, "extra": dict(extra or {})},
-                         sort_keys=True)
+def rtl_digest(contract: ArrayContract, arch: str,
+               options: Mapping[str, object] | None = None) -> str:
+    """16 hex digits of ``contract``, the architecture ``arch`` and its ``options`` (JSON
+    values: the architecture's options such as ``lanes``, a flow's settings) and every
+    Python source under ``rtl/`` (architectures, shared pieces, the FPGA flow): equal
+    digests build the same RTL the same way."""
+    options = json.dumps({"arch": arch, "options": dict(options or {})}, sort_keys=True)
     h = hashlib.sha256(f"{contract!r}|{options}".encode())
     for src in sorted(_RTL_ROOT.rglob("*.py")):
         h.update(src.relative_to(_RTL_ROOT).as_posix().encode())

@@ -2,8 +2,9 @@
 
 :class:`ThresholdWriteSignature` is the threshold-write bus: a host drives ``we``, the
 ``data`` to write and, on an array, the accumulator ``addr``; a component takes it as
-``In(ThresholdWriteSignature(...))``. :class:`~rvsm.rtl.pixel_cell.PixelCell` takes the
-address-less form (``thr``), :class:`~rvsm.rtl.array.RvsmArray` the addressed one (``cfg``).
+``In(ThresholdWriteSignature(...))``. :class:`~rvsm.rtl.parallel.pixel_cell.PixelCell`
+takes the address-less form (``thr``), :class:`~rvsm.rtl.parallel.array.RvsmArray` the
+addressed one (``cfg``), the streaming array one memory word per write.
 """
 
 from __future__ import annotations

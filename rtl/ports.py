@@ -12,7 +12,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from amaranth.hdl import Shape, Value, ValueCastable
-from amaranth.hdl._ir import PortDirection
 from amaranth.lib import wiring
 
 __all__ = ["port_map", "verilog_ports"]
@@ -21,24 +20,25 @@ __all__ = ["port_map", "verilog_ports"]
 SYNC_PORTS = ("clk", "rst")
 
 
-def _flat(component: wiring.Component, sep: str) -> list[tuple[str, str, Value]]:
+def _flat(component: wiring.Component, sep: str) -> list[tuple[str, Value]]:
     out = []
-    for path, member, value in component.signature.flatten(component):
+    for path, _, value in component.signature.flatten(component):
         if isinstance(value, ValueCastable):
             value = value.as_value()
-        direction = "in" if member.flow == wiring.In else "out"
-        out.append((sep.join(map(str, path)), direction, value))
+        out.append((sep.join(map(str, path)), value))
     return out
 
 
 def verilog_ports(
     component: wiring.Component, sep: str = "_"
-) -> dict[str, tuple[Value, PortDirection]]:
-    """``{name: (value, direction)}`` for ``amaranth.back.verilog.convert(ports=...)``."""
-    return {
-        name: (value, PortDirection.Input if d == "in" else PortDirection.Output)
-        for name, d, value in _flat(component, sep)
-    }
+) -> dict[str, tuple[Value, None]]:
+    """``{name: (value, None)}`` for ``amaranth.back.verilog.convert(ports=...)``.
+
+    The direction is left to Amaranth (``None``: a port the design drives is an output,
+    any other an input), which agrees with the signature because every ``Out`` member
+    of the arrays is driven; :func:`port_map` states the signature's direction.
+    """
+    return {name: (value, None) for name, value in _flat(component, sep)}
 
 
 def port_map(

@@ -1,9 +1,16 @@
-"""Verilog generation, port map, Verilator lint and yosys synthesis statistics.
+"""Verilog generation, port map, Verilator lint and yosys synthesis statistics, for every
+registered architecture (:mod:`rvsm.rtl.architectures`).
 
-* :func:`generate_verilog` converts :class:`~rvsm.rtl.array.RvsmArray` with Amaranth's
-  bundled (WebAssembly) yosys, ``emit_src=False`` (no source-location attributes).
-* :func:`write_outputs` writes ``<name>.v``, ``<name>.ports.json`` and
-  ``<name>.ports.md`` (the port map, with flat-vector bit ordering).
+* :func:`generate_verilog` converts an architecture's component with Amaranth's bundled
+  (WebAssembly) yosys, ``emit_src=False`` (no source-location attributes), and leaves
+  out all-zero memory initialisers (:func:`strip_zero_memory_init`: no array relies on
+  memory contents at power-up; the streaming array's accumulators read as zero in the
+  first frame after reset or ``clear``, line-buffer rows outside the frame are masked
+  and thresholds must be loaded; at sensor size those ``initial`` blocks were most of
+  the file).
+* :func:`write_outputs` writes ``<top>.v``, ``<top>.ports.json`` (architecture, top,
+  latency, the architecture's timing and memories, ports) and ``<top>.ports.md`` (the
+  port map, with flat-vector bit ordering and payload fields).
 * :func:`verilator_lint` runs ``verilator --lint-only`` with :data:`LINT_WAIVERS`.
 * :func:`yosys_stats` reads the Verilog into the system ``yosys`` (Debian's 0.23),
   runs ``synth -flatten`` and ``stat -json``; returns cells and flip-flops.
@@ -21,30 +28,30 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from amaranth.back import verilog as amaranth_verilog
+from amaranth.lib import wiring
 
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.model.infra.tools import ToolFailure, run_tool
-from rvsm.rtl.array import RvsmArray
-from rvsm.rtl.ports import port_map as signature_port_map
+from rvsm.rtl.architecture import Architecture
+from rvsm.rtl.architectures import get_architecture
 from rvsm.rtl.ports import verilog_ports
 
 __all__ = [
     "LINT_WAIVERS",
-    "DEFAULT_TOP",
     "GeneratedVerilog",
-    "generate_verilog",
-    "port_map",
-    "port_map_markdown",
     "check_top",
+    "generate_verilog",
+    "port_map_markdown",
+    "ports_meta",
+    "strip_zero_memory_init",
     "verilator_env",
     "verilator_lint",
     "write_outputs",
     "yosys_stats",
 ]
 
-DEFAULT_TOP = "rvsm_array"
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,127}")
 
 
@@ -82,59 +89,94 @@ class GeneratedVerilog:
     seconds: float
 
 
-def generate_verilog(contract: ArrayContract, top: str = DEFAULT_TOP) -> GeneratedVerilog:
-    """Convert the array built from ``contract`` to Verilog (no ``src`` attributes)."""
+_ZERO_INIT = re.compile(
+    r"^[ \t]*initial begin\n(?:[ \t]*\\?[\w$.]+ ?\[\d+\] = \d+'h0+;\n)+[ \t]*end\n",
+    re.MULTILINE)
+
+
+def strip_zero_memory_init(text: str) -> tuple[str, int]:
+    """Remove ``initial begin mem[i] = N'h0; ... end`` blocks; return text and count.
+
+    The documented rule for leaving out all-zero memory initialisers (no array relies on
+    power-up memory contents): only blocks made entirely of all-zero memory-word
+    assignments are removed, so any non-zero initial contents stay.
+    """
+    return _ZERO_INIT.subn("", text)
+
+
+def generate_verilog(
+    contract: ArrayContract,
+    arch: str | Architecture,
+    top: str | None = None,
+    component: wiring.Component | None = None,
+    **options: int,
+) -> GeneratedVerilog:
+    """Verilog of architecture ``arch`` built from ``contract`` and ``options`` (or of
+    ``component``, built from them): no ``src`` attributes, no all-zero memory
+    initialisers; ``top`` defaults to the architecture's."""
+    a = get_architecture(arch)
+    top = check_top(top or a.default_top)
     t0 = time.perf_counter()
-    dut = RvsmArray(contract)
+    dut = a.component(contract, **a.resolve(options)) if component is None else component
     text = amaranth_verilog.convert(dut, name=top, emit_src=False, ports=verilog_ports(dut))
+    text, _ = strip_zero_memory_init(text)
     return GeneratedVerilog(text, top, dut.latency, time.perf_counter() - t0)
 
 
-def port_map(contract: ArrayContract) -> list[dict]:
-    """Top-level ports: name, direction, width and meaning (with bit ordering).
+def ports_meta(arch: str | Architecture, component: wiring.Component, top: str) -> dict:
+    """The ``ports.json`` content (without timings): ``top``, ``arch``, ``latency``, the
+    architecture's own entries (:attr:`Architecture.describe`) and ``ports``."""
+    a = get_architecture(arch)
+    options = {o.name: getattr(component, o.name) for o in a.options}
+    return {"top": top, "arch": a.name, "latency": component.latency,
+            **a.describe(component), "ports": a.port_map(component.contract, **options)}
 
-    Names, directions and widths come from :class:`RvsmArray`'s signature
-    (:func:`rvsm.rtl.ports.port_map`), meanings from :meth:`RvsmArray.port_docs`.
-    """
-    return signature_port_map(RvsmArray.interface(contract), RvsmArray.port_docs(contract))
 
-
-def port_map_markdown(contract: ArrayContract, top: str = DEFAULT_TOP) -> str:
-    """The port map as a Markdown table, with the design point and latency."""
-    c = contract
-    lines = [
-        f"# `{top}` port map",
-        "",
-        f"Array {c.height}x{c.width}, {c.num_scales} scale(s), ADC {c.adc_bits} bits, "
-        f"accumulator {c.accumulator_bits} bits ({'signed' if c.signed else 'unsigned'}"
-        f" model, reset {c.reset}), shift {c.shift}; latency "
-        f"{RvsmArray.LATENCY} cycle(s).",
-        "",
-        "| port | dir | width | meaning |",
-        "|---|---|---|---|",
-    ]
+def port_map_markdown(arch: str | Architecture, component: wiring.Component,
+                      top: str) -> str:
+    """The port map as Markdown: design point and timing, ports, payload fields."""
+    a = get_architecture(arch)
+    meta = ports_meta(a, component, top)
+    lines = [f"# `{top}` port map ({a.title})", "", *a.summary(component), "",
+             "| port | dir | width | meaning |", "|---|---|---|---|"]
     lines += [f"| `{p['name']}` | {p['dir']} | {p['width']} | {p['desc']} |"
-              for p in port_map(c)]
+              for p in meta["ports"]]
+    for p in meta["ports"]:
+        if "fields" in p:
+            lines += ["", f"Fields of `{p['name']}`:", "",
+                      "| field | bits | meaning |", "|---|---|---|"]
+            lines += [f"| `{f['name']}` | [{f['offset'] + f['width'] - 1}:{f['offset']}] "
+                      f"| {f['desc']} |" for f in p["fields"]]
+    notes = a.notes(component)
+    if notes:
+        lines += ["", *notes]
     return "\n".join(lines) + "\n"
 
 
 def write_outputs(
-    contract: ArrayContract, out_dir: str | os.PathLike, top: str = DEFAULT_TOP
+    contract: ArrayContract,
+    out_dir: str | os.PathLike,
+    arch: str | Architecture,
+    top: str | None = None,
+    **options: int,
 ) -> tuple[dict[str, Path], GeneratedVerilog]:
-    """Write ``<top>.v``, ``<top>.ports.json`` and ``<top>.ports.md`` into ``out_dir``."""
-    check_top(top)
+    """Write ``<top>.v``, ``<top>.ports.json`` and ``<top>.ports.md`` of architecture
+    ``arch`` (``options`` as :meth:`Architecture.resolve`) into ``out_dir``."""
+    a = get_architecture(arch)
+    top = check_top(top or a.default_top)
     out = Path(out_dir)
-    gen = generate_verilog(contract, top)
+    dut = a.component(contract, **a.resolve(options))
+    gen = generate_verilog(contract, a, top, component=dut)
     paths = {
         "verilog": out / f"{top}.v",
         "ports_json": out / f"{top}.ports.json",
         "ports_md": out / f"{top}.ports.md",
     }
+    meta = ports_meta(a, dut, top)
+    meta["generation_seconds"] = round(gen.seconds, 3)
     write_text_atomic(paths["verilog"], gen.text)
-    meta = {"top": top, "latency": gen.latency, "ports": port_map(contract),
-            "generation_seconds": round(gen.seconds, 3)}
     write_text_atomic(paths["ports_json"], json.dumps(meta, indent=2) + "\n")
-    write_text_atomic(paths["ports_md"], port_map_markdown(contract, top))
+    write_text_atomic(paths["ports_md"], port_map_markdown(a, dut, top))
     return paths, gen
 
 
@@ -157,15 +199,17 @@ def verilator_env() -> dict[str, str]:
     return env
 
 
-def verilator_lint(verilog_path: str | os.PathLike, top: str = DEFAULT_TOP) -> str:
+def verilator_lint(verilog_path: str | os.PathLike, top: str | None = None) -> str:
     """``verilator --lint-only -Wall`` with :data:`LINT_WAIVERS`; returns its output.
+
+    ``top`` defaults to the file's name without ``.v`` (as :func:`write_outputs` names it).
 
     Raises :class:`RvsmError` (with the output) if Verilator reports anything, a
     :class:`~rvsm.model.infra.tools.ToolFailure` if it crashes or is killed.
     """
     env = verilator_env()
-    cmd = ["verilator", "--lint-only", "-Wall", *LINT_WAIVERS, "--top-module", check_top(top),
-           str(verilog_path)]
+    cmd = ["verilator", "--lint-only", "-Wall", *LINT_WAIVERS, "--top-module",
+           check_top(top or Path(verilog_path).stem), str(verilog_path)]
     proc = run_tool(cmd, tool="verilator --lint-only", env=env, capture=True, check=False)
     out = (proc.stdout + proc.stderr).strip()
     if proc.returncode < 0 or proc.returncode > 1:  # crashed or killed, not a finding
@@ -179,8 +223,10 @@ def verilator_lint(verilog_path: str | os.PathLike, top: str = DEFAULT_TOP) -> s
 _FF_RE = re.compile(r"^\$_(S?DFF|DFFE|SDFFE|SDFFCE|DFFSR|DFFSRE|ALDFF|ALDFFE|DLATCH)")
 
 
-def yosys_stats(verilog_path: str | os.PathLike, top: str = DEFAULT_TOP) -> dict:
+def yosys_stats(verilog_path: str | os.PathLike, top: str | None = None) -> dict:
     """Synthesise with the system ``yosys`` (``synth -flatten``); cells and flip-flops.
+
+    ``top`` defaults to the file's name without ``.v``.
 
     The Verilog path reaches yosys as its own argument (never inside the script text), so
     any path works and none is interpreted. Returns ``{"cells", "flip_flops",
@@ -194,7 +240,8 @@ def yosys_stats(verilog_path: str | os.PathLike, top: str = DEFAULT_TOP) -> dict
     if path.suffix != ".v" or not path.is_file():
         raise RvsmError(f"yosys_stats needs an existing .v file, got {path}")
     t0 = time.perf_counter()
-    script = f"synth -flatten -top {check_top(top)}; tee -q -o /dev/stdout stat -json"
+    script = (f"synth -flatten -top {check_top(top or path.stem)}; "
+              "tee -q -o /dev/stdout stat -json")
     proc = run_tool([exe, "-q", "-p", script, str(path.resolve())], tool="yosys",
                     capture=True)
     text = proc.stdout

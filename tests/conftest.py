@@ -49,7 +49,7 @@ def small_contract() -> Callable[..., ArrayContract]:
 
 
 class AmaranthSim:
-    """Runs test benches in ``amaranth.sim`` (1 MHz clock on ``sync``)."""
+    """Runs test benches through :func:`rvsm.rtl.simulation.run_simulation`."""
 
     def __init__(self, waves_dir: Path | None, test_name: str) -> None:
         self.waves_dir = waves_dir
@@ -66,17 +66,9 @@ class AmaranthSim:
 
     def run(self, dut: object, bench: Callable[[object], Awaitable[None]]) -> None:
         """Simulate ``dut`` with ``bench(ctx)`` as its test bench until the bench returns."""
-        from amaranth.sim import Simulator
+        from rvsm.rtl.simulation import run_simulation
 
-        sim = Simulator(dut)
-        sim.add_clock(1e-6)
-        sim.add_testbench(bench)
-        vcd = self.vcd_path()
-        if vcd is None:
-            sim.run()
-        else:
-            with sim.write_vcd(str(vcd)):
-                sim.run()
+        run_simulation(dut, bench, self.vcd_path())
 
 
 @pytest.fixture

@@ -25,6 +25,7 @@ import numpy as np
 
 from rvsm.model.fixed.widths import signed_range, unsigned_max
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kernels.geometry import is_symmetric, symmetric_orbits
 from rvsm.model.sampling.config import RESET_MODES
 
 
@@ -38,7 +39,7 @@ def integer_receptive_sums(codes: np.ndarray, weights: Sequence[np.ndarray]) -> 
     :func:`integer_receptive_sums_direct`.
     """
     kernels = [np.asarray(k, dtype=np.int64) for k in weights]
-    if all(_is_symmetric(k) for k in kernels):
+    if all(is_symmetric(k) for k in kernels):
         return _symmetric_sums(np.asarray(codes, dtype=np.int64), kernels)
     return integer_receptive_sums_direct(codes, kernels)
 
@@ -64,13 +65,6 @@ def integer_receptive_sums_direct(
     return out
 
 
-def _is_symmetric(k: np.ndarray) -> bool:
-    return (
-        k.ndim == 2 and k.shape[0] == k.shape[1] and k.shape[0] % 2 == 1
-        and np.array_equal(k, k.T) and np.array_equal(k, k[::-1]) and np.array_equal(k, k[:, ::-1])
-    )
-
-
 def _symmetric_sums(codes: np.ndarray, kernels: list[np.ndarray]) -> np.ndarray:
     """Sum codes per orbit ``{(+-a, +-b), (+-b, +-a)}`` once, then weight per scale."""
     bsz, h, w = codes.shape
@@ -94,21 +88,20 @@ def _symmetric_sums(codes: np.ndarray, kernels: list[np.ndarray]) -> np.ndarray:
 
     out = np.zeros((bsz, len(kernels), h, w), dtype=np.int64)
     tmp = np.empty((bsz, h, w), dtype=np.int64)
-    for a in range(big + 1):
-        for b in range(a + 1):
-            users = [
-                (s, int(k[halves[s] + a, halves[s] + b]))
-                for s, k in enumerate(kernels) if halves[s] >= a
-            ]
-            users = [(s, wt) for s, wt in users if wt]
-            if not users:
-                continue
-            orbit = cols(rows[b], a)
-            if a != b:
-                orbit += cols(rows[a], b)
-            for s, wt in users:
-                np.multiply(orbit, wt, out=tmp)
-                out[:, s] += tmp
+    for a, b in symmetric_orbits(big):
+        users = [
+            (s, int(k[halves[s] + a, halves[s] + b]))
+            for s, k in enumerate(kernels) if halves[s] >= a
+        ]
+        users = [(s, wt) for s, wt in users if wt]
+        if not users:
+            continue
+        orbit = cols(rows[b], a)
+        if a != b:
+            orbit += cols(rows[a], b)
+        for s, wt in users:
+            np.multiply(orbit, wt, out=tmp)
+            out[:, s] += tmp
     return out
 
 

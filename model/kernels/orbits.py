@@ -27,16 +27,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from rvsm.model.infra.errors import RvsmError
-
-
-def is_symmetric(kernel: np.ndarray) -> bool:
-    """True when ``kernel`` is odd, square and invariant under the square's symmetries."""
-    k = np.asarray(kernel)
-    return (
-        k.ndim == 2 and k.shape[0] == k.shape[1] and k.shape[0] % 2 == 1
-        and np.array_equal(k, k.T) and np.array_equal(k, k[::-1])
-        and np.array_equal(k, k[:, ::-1])
-    )
+from rvsm.model.kernels.geometry import is_symmetric, symmetric_orbits
 
 
 def kernel_orbits(
@@ -52,7 +43,7 @@ def kernel_orbits(
         raise RvsmError("orbit sums need kernels with the square's 8-fold symmetry")
     halves = [k.shape[0] // 2 for k in ks]
     big = max(halves)
-    orbits = [(a, b) for a in range(big + 1) for b in range(a + 1)]
+    orbits = symmetric_orbits(big)
     dtype = np.result_type(*[k.dtype for k in ks])
     weights = np.zeros((len(ks), len(orbits)), dtype=dtype)
     for s, (k, half) in enumerate(zip(ks, halves, strict=True)):

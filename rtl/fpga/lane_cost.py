@@ -120,9 +120,9 @@ def lane_synthesis(
     contract = point.with_size(*size).contract()
     with tempfile.TemporaryDirectory(prefix="rvsm-lane-cost-") as tmp:
         root = Path(work_dir) if work_dir is not None else Path(tmp)
-        component, _ = build_component(contract, "stream", lanes)
+        component, _ = build_component(contract, "stream", lanes=lanes)
         syn = synthesise(component, root / f"p{lanes}", netlist="verilog",
-                         zero_memory_init=False, on_progress=on_progress, timeout=timeout)
+                         on_progress=on_progress, timeout=timeout)
         fmax_mhz = None
         if fmax:
             pnr, _ = place_and_route(syn, get_device(device), on_progress=on_progress,

@@ -24,6 +24,7 @@ import math
 from dataclasses import asdict, dataclass
 
 from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.kernels.geometry import kernel_radius
 from rvsm.rtl.fpga.devices import DEVICES
 
 __all__ = [
@@ -69,14 +70,9 @@ def lanes_needed(height: int, width: int, clock_hz: float,
 
 
 def window_radius(contract: ArrayContract) -> int:
-    """``L``: the largest Chebyshev radius of a non-zero weight over all scales."""
-    radius = 0
-    for kernel in contract.weight_arrays:
-        half = kernel.shape[0] // 2
-        rows, cols = kernel.nonzero()
-        if len(rows):
-            radius = max(radius, int(max(abs(rows - half).max(), abs(cols - half).max())))
-    return radius
+    """``L``: the largest Chebyshev radius of a non-zero weight over all scales
+    (:func:`~rvsm.model.kernels.geometry.kernel_radius`)."""
+    return kernel_radius(contract.weight_arrays)
 
 
 def bram_blocks(depth: int, width: int) -> int:

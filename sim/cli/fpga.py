@@ -18,6 +18,7 @@ def _size(text: str) -> tuple[int, int]:
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``fpga`` sub-command."""
     from rvsm.rtl.fpga.devices import DEVICES
+    from rvsm.sim.cli.rtl import add_arch_arguments
 
     p = sub.add_parser(
         "fpga", help="synthesise, place and route the array on an ECP5; Fmax and area",
@@ -28,13 +29,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "the full sensor's state memory. Place and route takes minutes (about 8 at 4 "
         "lanes); use --synth-only for wide arrays. Exit 3 when a tool fails.")
     p.add_argument("point", help="design point TOML (its size is the sensor's)")
-    p.add_argument("--lanes", type=int, default=1, metavar="P",
-                   help="pixels per clock of the streaming array (default 1)")
     p.add_argument("--size", type=_size, metavar="HxW",
                    help="size of the array built (default: the design point's)")
-    p.add_argument("--arch", choices=("stream", "parallel"), default="stream",
-                   help="array architecture: the lane-parallel streaming array (default) "
-                   "or the fully parallel array (small sizes only)")
+    add_arch_arguments(p)
     p.add_argument("--device", choices=tuple(DEVICES), default="ecp5-85",
                    help="ECP5 part (default ecp5-85)")
     p.add_argument("--speed", type=int, choices=(6, 7, 8), default=6,
@@ -58,24 +55,24 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
+    from rvsm.rtl.architectures import ARCHITECTURES
     from rvsm.rtl.fpga.flow import run_fpga
+    from rvsm.sim.cli.rtl import arch_options
 
-    if args.lanes < 1:
-        raise RvsmError(f"--lanes must be >= 1, got {args.lanes}")
+    arch = ARCHITECTURES[args.arch]
+    options = arch_options(args)
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be > 0 seconds, got {args.timeout}")
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
     point = load_design_point(args.point)
-    h, w = args.size or (point.height, point.width)
-    if args.arch == "parallel" and h * w > 64:
-        print(f"rvsm: note: a {h}x{w} fully parallel array is large for synthesis; "
-              "consider --size 4x4 or --arch stream", file=sys.stderr)
+    arch.check((point.with_size(*args.size) if args.size else point).contract(), **options)
 
     def progress(p) -> None:  # noqa: ANN001 - rvsm.rtl.fpga.tools.Progress
         if not args.quiet:
             print(f"rvsm fpga: {p.line()}", file=sys.stderr, flush=True)
 
-    report = run_fpga(point, args.out, arch=args.arch, lanes=args.lanes, size=args.size,
+    report = run_fpga(point, args.out, arch=args.arch, lanes=options.get("lanes"),
+                      size=args.size,
                       device=args.device, speed=args.speed, target_mhz=args.freq,
                       synth_only=args.synth_only, seed=args.seed,
                       netlist="rtlil" if args.rtlil else "verilog", on_progress=progress,

@@ -7,6 +7,7 @@ import json
 import shlex
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.architectures import ARCHITECTURES, DEFAULT_ARCHITECTURE
 from rvsm.sim.cli.args import (
     SceneRequest,
     add_force_argument,
@@ -26,13 +27,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--out", default="build", help="output folder (default: build)")
     p.add_argument("--size", metavar="HxW", help="override the array size")
     p.add_argument("--top", type=_top_arg,
-                   help="top module name, a Verilog identifier (default: rvsm_array, or "
-                   "rvsm_stream_array with --arch stream)")
-    p.add_argument("--arch", choices=("parallel", "stream"), default="parallel",
-                   help="fully parallel array (small in-pixel designs) or the "
-                   "lane-parallel streaming array (sensor size)")
-    p.add_argument("--lanes", type=int, default=1,
-                   help="pixels per beat of the streaming array (divides the width)")
+                   help="top module name, a Verilog identifier (default: the "
+                   "architecture's, " + ", ".join(
+                       f"{a.default_top} for {a.name}" for a in ARCHITECTURES.values())
+                   + ")")
+    add_arch_arguments(p)
     p.add_argument("--lint", action="store_true", help="run verilator --lint-only")
     p.add_argument("--stats", action="store_true",
                    help="synthesise with yosys (synth; stat) and print cells/flip-flops")
@@ -64,42 +63,54 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="work folder: shared build cache (builds/) and one new folder per "
                    "run (runs/)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--arch", choices=("parallel", "stream"), default="parallel",
-                   help="verify the fully parallel or the streaming array")
-    p.add_argument("--lanes", type=int, default=1, help="lanes of the streaming array")
+    add_arch_arguments(p)
     p.set_defaults(func=_verify)
+
+
+def add_arch_arguments(p: argparse.ArgumentParser) -> None:
+    """``--arch`` (the registered architectures, default the streaming array) and one
+    ``--<option>`` per architecture option (default: not given)."""
+    p.add_argument("--arch", choices=tuple(ARCHITECTURES), default=DEFAULT_ARCHITECTURE,
+                   help="array architecture: " + "; ".join(
+                       f"{a.name}: the {a.title}" for a in ARCHITECTURES.values())
+                   + f" (default {DEFAULT_ARCHITECTURE})")
+    seen = set()
+    for a in ARCHITECTURES.values():
+        for o in a.options:
+            if o.name not in seen:
+                seen.add(o.name)
+                p.add_argument(f"--{o.name}", type=int, metavar=o.name[0].upper(),
+                               help=f"{o.help}; --arch {a.name} only (default {o.default})")
+
+
+def arch_options(args: argparse.Namespace) -> dict[str, int]:
+    """The options of ``args.arch`` from the command line (defaults filled in); an option
+    the architecture does not take is refused (:class:`RvsmError`, exit 2)."""
+    a = ARCHITECTURES[args.arch]
+    given = {o.name: getattr(args, o.name) for arch in ARCHITECTURES.values()
+             for o in arch.options}
+    return a.resolve(given)
 
 
 def _verilog(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.verilog import verilator_lint, write_outputs, yosys_stats
-    from rvsm.sim.cosim.verify import MAX_PARALLEL_SIDE
 
+    arch = ARCHITECTURES[args.arch]
+    options = arch_options(args)
     size = parse_size_arg(args.size)
     point = load_design_point(args.point)
     if size is not None:
         point = point.with_size(*size)
     contract = point.contract()
-    if args.arch == "stream":
-        from rvsm.rtl.stream_verilog import STREAM_TOP, write_stream_outputs
-
-        args.top = args.top or STREAM_TOP
-    else:
-        args.top = args.top or "rvsm_array"
-        if max(contract.height, contract.width) > MAX_PARALLEL_SIDE:  # as verify refuses
-            raise RvsmError(
-                f"the fully parallel RTL array is limited to {MAX_PARALLEL_SIDE}x"
-                f"{MAX_PARALLEL_SIDE} pixels (larger ones take hours to generate), the "
-                f"design point is {contract.height}x{contract.width}; pass --size, e.g. "
-                "--size 16x16, or --arch stream")
+    arch.check(contract, **options)
+    args.top = args.top or arch.default_top
     files = tuple((f"{args.top}{ext}", PLAIN) for ext in (".v", ".ports.json", ".ports.md"))
     check_outputs([Output(args.out, "-o", FOLDER, files)], [args.point], args.force)
-    if args.arch == "stream":
-        paths, gen = write_stream_outputs(contract, args.lanes, args.out, args.top)
-    else:
-        paths, gen = write_outputs(contract, args.out, args.top)
+    paths, gen = write_outputs(contract, args.out, arch, args.top, **options)
     print(f"wrote {paths['verilog']} ({gen.seconds:.1f} s), {paths['ports_json']}, "
-          f"{paths['ports_md']}; latency {gen.latency} cycle(s)")
+          f"{paths['ports_md']}; {_arch_text(args.arch, options)}, latency {gen.latency} "
+          "cycle(s)")
     if args.lint:
         verilator_lint(paths["verilog"], args.top)
         print("verilator --lint-only: clean (documented waivers only)")
@@ -110,6 +121,12 @@ def _verilog(args: argparse.Namespace) -> int:
               f"({st['cells'] / pixels:.1f} cells, {st['flip_flops'] / pixels:.1f} FFs "
               f"per pixel; {st['seconds']:.1f} s)")
     return 0
+
+
+def _arch_text(name: str, options: dict[str, int]) -> str:
+    """``architecture stream (lanes 8)``: how results name what they built."""
+    opts = ", ".join(f"{k} {v}" for k, v in options.items())
+    return f"architecture {name}" + (f" ({opts})" if opts else "")
 
 
 def _top_arg(text: str) -> str:
@@ -134,7 +151,7 @@ def _verify(args: argparse.Namespace) -> int:
                   [args.scene, args.fixed, args.stimulus])
     if args.steps is not None and args.steps < 1:
         raise RvsmError(f"--steps must be >= 1, got {args.steps}")
-    lanes = args.lanes if args.arch == "stream" else None
+    arch, options = args.arch, arch_options(args)
     if args.stimulus:
         given = [n for n, v in (("SCENE", args.scene), ("--fixed", args.fixed),
                                 ("--size", args.size), ("--random", args.random),
@@ -143,7 +160,7 @@ def _verify(args: argparse.Namespace) -> int:
             raise RvsmError(f"{', '.join(given)} cannot be combined with --stimulus: the "
                             "stimulus file holds the scene's codes and the contract")
         r = replay(args.stimulus, args.sim, steps=args.steps, waves=args.waves,
-                   work_dir=args.work, lanes=lanes)
+                   work_dir=args.work, arch=arch, **options)
     elif args.random is not None:
         given = [n for n, v in (("SCENE", args.scene), *_scene_shaping(args)) if v is not None]
         if given:
@@ -155,7 +172,8 @@ def _verify(args: argparse.Namespace) -> int:
             raise RvsmError(f"rvsm verify --random SEED also needs {', '.join(missing)}, "
                             "e.g. --random 1 --fixed point.toml --size 4x4 --steps 200")
         r = random_verify(args.fixed, args.random, args.steps, args.sim, waves=args.waves,
-                          size=parse_size_arg(args.size), work_dir=args.work, lanes=lanes)
+                          size=parse_size_arg(args.size), work_dir=args.work, arch=arch,
+                          **options)
     else:
         if args.scene is None or args.fixed is None:
             raise RvsmError("rvsm verify needs SCENE --fixed POINT.toml, --stimulus FILE, "
@@ -165,13 +183,14 @@ def _verify(args: argparse.Namespace) -> int:
         point, scene = SceneRequest.from_args(args).load_for_point(
             load_design_point(args.fixed))
         r = verify(scene, args.fixed, args.sim, steps=args.steps, waves=args.waves,
-                   size=point.shape, work_dir=args.work, lanes=lanes)
+                   size=point.shape, work_dir=args.work, arch=arch, **options)
     if args.json:
         r = dict(r)
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]
         print(json.dumps(r))
     else:
-        print(f"{args.sim}: compared {r['compared']} spikes ({r['steps']} steps x "
+        print(f"{args.sim}, {_arch_text(r['arch'], r['options'])}: compared "
+              f"{r['compared']} spikes ({r['steps']} steps x "
               f"{r['accumulators']} accumulators, {r['expected_spikes']} non-zero), "
               f"{r['mismatches']} mismatches")
         if r.get("coverage"):

@@ -12,7 +12,8 @@ contract already generated for another build is reused; each run gets a fresh fo
 :mod:`rvsm.sim.cosim.cocotb_adapter`.
 
 What is built for a contract (architecture, default top, Verilog writer, testbench) comes
-from one function, :func:`cosim_design`.
+from the architecture registry (:mod:`rvsm.rtl.architectures`) through one function,
+:func:`cosim_design`.
 """
 
 from __future__ import annotations
@@ -28,56 +29,57 @@ import shutil
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.infra.errors import ToolError
 from rvsm.model.infra.tools import ToolFailure, run_tool
+from rvsm.rtl.architecture import Architecture
+from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.digest import rtl_digest
-from rvsm.rtl.stream_verilog import STREAM_TOP, write_stream_outputs
-from rvsm.rtl.verilog import DEFAULT_TOP, GeneratedVerilog, write_outputs
+from rvsm.rtl.verilog import GeneratedVerilog, write_outputs
 from rvsm.sim.cosim.cocotb_adapter import build_args, check_simulator, cocotb_build, cxx_opt
 
 __all__ = ["CosimDesign", "SimBuild", "build", "build_key", "cosim_design", "new_run_dir",
            "tool_versions"]
 
-#: The fully parallel array's testbench.
-TB_MODULE = "rvsm.sim.cosim.tb_array"
-#: The streaming array's testbench.
-TB_STREAM_MODULE = "rvsm.sim.cosim.tb_stream"
 _BUILD_VERSION = "6"  # bump when the build recipe changes
 #: Paths GNU make builds in (Verilator's C++); others are staged in a temporary folder.
 _MAKE_SAFE = re.compile(r"[A-Za-z0-9_./+,@=-]+")
 
-#: Writes ``<top>.v``, ``<top>.ports.json`` and ``<top>.ports.md`` into a folder.
-VerilogWriter = Callable[[Path, str], tuple[dict[str, Path], GeneratedVerilog]]
-
-
 @dataclass(frozen=True)
 class CosimDesign:
-    """What co-simulation builds: architecture name and options, default top, Verilog
-    writer (folder, top -> paths and :class:`~rvsm.rtl.verilog.GeneratedVerilog`) and
-    the cocotb testbench module."""
+    """What co-simulation builds: the registered architecture, its resolved options
+    (e.g. ``{"lanes": 8}``), the top name and the cocotb testbench module."""
 
-    arch: str
-    lanes: int | None
+    arch: Architecture
+    options: dict[str, int]
     top: str
-    write: VerilogWriter
-    testbench: str
+
+    @property
+    def testbench(self) -> str:
+        """The architecture's cocotb testbench module."""
+        return self.arch.testbench
+
+    def write(self, contract: ArrayContract, out: Path
+              ) -> tuple[dict[str, Path], GeneratedVerilog]:
+        """Write ``<top>.v``, ``<top>.ports.json`` and ``<top>.ports.md`` into ``out``."""
+        return write_outputs(contract, out, self.arch, self.top, **self.options)
+
+    def digest(self, contract: ArrayContract) -> str:
+        """:func:`rvsm.rtl.digest.rtl_digest` of this design of ``contract``."""
+        return rtl_digest(contract, self.arch.name, self.options)
 
 
-def cosim_design(contract: ArrayContract, lanes: int | None = None) -> CosimDesign:
-    """The design co-simulated for ``contract``: the streaming array with ``lanes`` lanes,
-    or the fully parallel array when ``lanes`` is None. The one place co-simulation
-    chooses an architecture."""
-    if lanes is None:
-        return CosimDesign("parallel", None, DEFAULT_TOP,
-                           lambda out, top: write_outputs(contract, out, top), TB_MODULE)
-    return CosimDesign("stream", lanes, STREAM_TOP,
-                       lambda out, top: write_stream_outputs(contract, lanes, out, top),
-                       TB_STREAM_MODULE)
+def cosim_design(arch: str | Architecture = DEFAULT_ARCHITECTURE, top: str | None = None,
+                 **options: int | None) -> CosimDesign:
+    """The design co-simulated: architecture ``arch`` of the registry with ``options``
+    (defaults filled in; an option it does not take is an :class:`RvsmError`) and its
+    default top unless ``top``. The one place co-simulation chooses what to build."""
+    a = get_architecture(arch)
+    return CosimDesign(a, a.resolve(options), top or a.default_top)
 
 
 @dataclass(frozen=True)
@@ -94,7 +96,8 @@ class SimBuild:
     cached: bool
     test_module: str
     waves: bool = False
-    lanes: int | None = None  # the streaming array's lanes; None: fully parallel
+    arch: str = DEFAULT_ARCHITECTURE
+    options: dict[str, int] = field(default_factory=dict)  # the architecture's options
 
 
 @functools.cache
@@ -119,15 +122,16 @@ def tool_versions(sim: str) -> dict[str, str]:
 
 
 def build_key(contract: ArrayContract, sim: str, top: str, traced: bool,
-              extra: Sequence[str] = (), lanes: int | None = None) -> tuple[str, dict]:
+              extra: Sequence[str] = (), design: CosimDesign | None = None
+              ) -> tuple[str, dict]:
     """Digest (16 hex digits) and fields of everything that changes a build's binary:
-    the RTL (:func:`rvsm.rtl.digest.rtl_digest` of the design :func:`cosim_design` picks
-    for ``lanes``), the build recipe, simulator, top, tracing, build flags, the C++
-    optimisation, the tool versions (:func:`tool_versions`) and ``extra`` (e.g. an
-    architecture's parameters). Two builds with equal keys are interchangeable."""
-    design = cosim_design(contract, lanes)
+    the RTL (:meth:`CosimDesign.digest` of ``design``, default :func:`cosim_design`'s),
+    the build recipe, simulator, top, tracing, build flags, the C++ optimisation, the tool
+    versions (:func:`tool_versions`) and ``extra``. Two builds with equal keys are
+    interchangeable."""
+    design = design or cosim_design()
     fields = {
-        "recipe": _BUILD_VERSION, "rtl": rtl_digest(contract, design.arch, design.lanes),
+        "recipe": _BUILD_VERSION, "rtl": design.digest(contract),
         "sim": sim, "top": top,
         "traced": traced, "build_args": build_args(sim, traced),
         "cxx_opt": cxx_opt() if sim == "verilator" else "",
@@ -139,7 +143,8 @@ def build_key(contract: ArrayContract, sim: str, top: str, traced: bool,
 
 def build(
     contract: ArrayContract, sim: str, build_root: str | os.PathLike,
-    top: str | None = None, waves: bool = False, lanes: int | None = None,
+    top: str | None = None, waves: bool = False,
+    arch: str | Architecture = DEFAULT_ARCHITECTURE, **options: int | None,
 ) -> SimBuild:
     """Generate (or reuse) the Verilog and build it for ``sim``; cached per :func:`build_key`.
 
@@ -150,15 +155,15 @@ def build(
     the build fails or is interrupted (a failed build's log is kept as
     ``<name>.failed.log``). A cached build is used only when its recorded checksums
     still match (:func:`_cached`); a damaged one is rebuilt. The Verilog of a contract
-    already generated for another build is reused, not regenerated. What is built for
-    ``lanes`` (and the default ``top``) is :func:`cosim_design`'s choice.
+    already generated for another build is reused, not regenerated. ``arch`` and
+    ``options`` (e.g. ``lanes=8``) name the architecture (:func:`cosim_design`).
     """
     check_simulator(sim)
-    design = cosim_design(contract, lanes)
-    top = top or design.top
+    design = cosim_design(arch, top, **options)
+    top = design.top
     traced = waves or sim == "icarus"
-    digest = rtl_digest(contract, design.arch, design.lanes)
-    key, key_fields = build_key(contract, sim, top, traced, lanes=lanes)
+    digest = design.digest(contract)
+    key, key_fields = build_key(contract, sim, top, traced, design=design)
     suffix = "-trace" if (traced and sim == "verilator") else ""
     base = Path(build_root).resolve()
     final = base / f"{sim}-{digest}-{top}{suffix}-{key[:8]}"
@@ -183,7 +188,7 @@ def build(
     try:
         stage.mkdir(parents=True, exist_ok=True)
         paths, gen = (_reuse_verilog(base, digest, top, stage)
-                      or design.write(stage, top))
+                      or design.write(contract, stage))
         t0 = time.perf_counter()
         ports = [p["name"] for p in json.loads(paths["ports_json"].read_text())["ports"]]
         cocotb_build(sim, paths["verilog"], top, ports, stage / "sim_build", traced, log)
@@ -217,7 +222,7 @@ def build(
     if done is None:
         raise ToolError(f"{sim} build folder {final} vanished or is damaged")
     return SimBuild(sim, done.build_dir, top, done.verilog, gen.seconds, build_seconds,
-                    False, design.testbench, traced, design.lanes)
+                    False, design.testbench, traced, design.arch.name, design.options)
 
 
 def _build_files(sim: str, top: str) -> list[str]:
@@ -267,7 +272,7 @@ def _cached(root: Path, sim: str, top: str, traced: bool, key: str,
         return None
     return SimBuild(sim, root / "sim_build", top, root / f"{top}.v",
                     meta["generate_seconds"], meta["build_seconds"], True, design.testbench,
-                    traced, design.lanes)
+                    traced, design.arch.name, design.options)
 
 
 def _reuse_verilog(

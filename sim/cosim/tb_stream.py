@@ -10,7 +10,7 @@ cocotb runs everything from Python, one clock cycle at a time (inputs driven on 
 falling edge): reset; every threshold word through ``thr``; then per segment between
 clears (:meth:`StreamSchedule.segments`) the frames as back-to-back beats, the ``lag``
 flush beats, one idle cycle and one ``clear`` cycle. Every cycle with ``spikes_valid``
-high records one output beat; at the end :func:`~rvsm.rtl.stream_schedule.check_beats`
+high records one output beat; at the end :func:`~rvsm.rtl.stream.schedule.check_beats`
 (the schedule model's checker) compares positions and spikes with the expectation. The
 per-cycle Python is a few handle accesses on vectors of a few hundred bits; the result
 reports ``cycles_per_second`` to show whether it or the simulator dominates.
@@ -27,8 +27,9 @@ from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
 from rvsm.model.fixed.stimulus import load_stimulus
-from rvsm.rtl.stream_array import StreamGeometry, threshold_word_bits
-from rvsm.rtl.stream_schedule import OutputBeats, check_beats, pack_lanes
+from rvsm.rtl.stream.drive import threshold_writes
+from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.schedule import OutputBeats, check_beats, pack_lanes
 from rvsm.sim.cosim.tb_common import clock_and_reset, logic_bits, testbench_arg
 
 
@@ -52,7 +53,6 @@ async def stream_matches_fixed_twin(dut: object) -> None:
     by_name = {p["name"]: p for p in ports["ports"]}
     fields = {f["name"]: (f["offset"], f["width"])
               for f in by_name["spikes_payload"]["fields"]}
-    word_bits = threshold_word_bits(sched.beats_per_frame)
 
     clk = dut.clk  # type: ignore[attr-defined]
     d = {name: getattr(dut, name) for name in (
@@ -63,15 +63,12 @@ async def stream_matches_fixed_twin(dut: object) -> None:
 
     t0 = time.perf_counter()
     cycles = 0
-    words = sched.threshold_words(stim.thresholds)
-    packed = pack_lanes(words.reshape(-1, lanes), c.threshold_bits)
     d["thr_we"].value = 1
-    for s in range(scales):
-        for a in range(sched.beats_per_frame):
-            d["thr_addr"].value = (s << word_bits) | a
-            d["thr_data"].value = packed[s * sched.beats_per_frame + a]
-            await FallingEdge(clk)
-            cycles += 1
+    for addr, word in threshold_writes(geo, stim.thresholds):
+        d["thr_addr"].value = addr
+        d["thr_data"].value = word
+        await FallingEdge(clk)
+        cycles += 1
     d["thr_we"].value = 0
 
     got: dict[str, list[int]] = {k: [] for k in fields}

@@ -24,16 +24,14 @@ from rvsm.model.fixed.stimulus import Stimulus, load_stimulus, save_stimulus
 from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.scene import Scene
+from rvsm.rtl.architecture import Architecture
+from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.sim.cosim.build_cache import SimBuild, build, new_run_dir
 from rvsm.sim.cosim.cocotb_adapter import check_simulator
 from rvsm.sim.cosim.simulation import run_testbench
 
-__all__ = ["MAX_PARALLEL_SIDE", "check_stimulus", "random_verify", "replay", "run_rtl",
-           "verify"]
+__all__ = ["check_stimulus", "random_verify", "replay", "run_rtl", "verify"]
 
-#: Largest side of a fully parallel array ``verify`` will build (generation time grows
-#: with pixels x taps; a full-resolution sensor needs the streaming array).
-MAX_PARALLEL_SIDE = 64
 DEFAULT_WORK = Path("build") / "verify"
 
 
@@ -48,22 +46,13 @@ def _check_inputs(contract: ArrayContract, codes: np.ndarray, thresholds: np.nda
                         f"got {thresholds.shape}")
 
 
-def _check_parallel_size(height: int, width: int) -> None:
-    if max(height, width) > MAX_PARALLEL_SIDE:
-        raise RvsmError(
-            f"the fully parallel RTL array is limited to {MAX_PARALLEL_SIDE}x"
-            f"{MAX_PARALLEL_SIDE} pixels, the design point is {height}x{width}; pass "
-            "--size, e.g. --size 16x16")
-
-
-def _check_size(contract: ArrayContract, lanes: int | None) -> None:
-    """The parallel array's size limit, or that ``lanes`` suit the streaming array."""
-    if lanes is None:
-        _check_parallel_size(contract.height, contract.width)
-    else:
-        from rvsm.rtl.stream_array import StreamGeometry
-
-        StreamGeometry(contract, lanes)
+def _resolve(arch: str | Architecture, options: dict[str, int | None],
+             contract: ArrayContract) -> tuple[Architecture, dict[str, int]]:
+    """The architecture, its options (defaults filled in) and its size rule applied."""
+    a = get_architecture(arch)
+    resolved = a.resolve(options)
+    a.check(contract, **resolved)
+    return a, resolved
 
 
 def check_stimulus(
@@ -73,12 +62,13 @@ def check_stimulus(
     work_dir: str | os.PathLike = DEFAULT_WORK,
     name: str = "run",
     build_root: str | os.PathLike | None = None,
-    lanes: int | None = None,
+    arch: str | Architecture = DEFAULT_ARCHITECTURE,
+    **options: int | None,
 ) -> dict:
     """Drive the RTL of ``stim.contract`` with ``stim`` and compare every spike.
 
-    ``lanes`` drives the streaming array (:mod:`rvsm.rtl.stream_array`) with that many
-    lanes instead of the fully parallel one.
+    ``arch`` names the architecture (:mod:`rvsm.rtl.architectures`, default the
+    streaming array), ``options`` its options (e.g. ``lanes``).
 
     Each call gets its own run folder ``work_dir/runs/<name>-<sim>-<time>-<pid>-<random>``
     (:func:`~.build_cache.new_run_dir`) holding ``stimulus.npz`` (the testbench's input), the
@@ -88,13 +78,14 @@ def check_stimulus(
     None), ``build_seconds``, ``stream_seconds``, ``run_dir``...
     """
     contract = stim.contract
+    a, resolved = _resolve(arch, options, contract)
     _check_inputs(contract, stim.codes, stim.thresholds)
     want = (stim.num_steps, contract.num_scales, contract.height, contract.width)
     if stim.spikes.shape != want:
         raise RvsmError(f"expected spikes must be {want}, got {stim.spikes.shape}")
     work = Path(work_dir)
     root = work / "builds" if build_root is None else Path(build_root)
-    sb = build(contract, sim, root, waves=waves, lanes=lanes)
+    sb = build(contract, sim, root, waves=waves, arch=a, **resolved)
     run_dir = new_run_dir(work, f"{name}-{sim}")
     try:
         result = _run_and_keep_waves(stim, sb, run_dir, root, waves)
@@ -104,7 +95,7 @@ def check_stimulus(
     result.update(
         build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
         build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),
-        arch="parallel" if lanes is None else "stream", lanes=lanes,
+        arch=a.name, options=resolved, lanes=resolved.get("lanes"),
     )
     return result
 
@@ -122,7 +113,8 @@ def _run_and_keep_waves(stim: Stimulus, sb: SimBuild, run_dir: Path, root: Path,
         again_dir = run_dir / "failure"
         again = again_dir / "stimulus.npz"
         save_stimulus(again, stim.first_steps(upto))
-        sbw = build(stim.contract, sb.sim, root, waves=True, lanes=sb.lanes)
+        sbw = build(stim.contract, sb.sim, root, top=sb.top, waves=True, arch=sb.arch,
+                    **sb.options)
         result["waves"] = run_testbench(sbw, again, again_dir, waves=True)["waves"]
     return result
 
@@ -138,12 +130,13 @@ def run_rtl(
     work_dir: str | os.PathLike = DEFAULT_WORK,
     name: str = "run",
     build_root: str | os.PathLike | None = None,
-    lanes: int | None = None,
+    arch: str | Architecture = DEFAULT_ARCHITECTURE,
+    **options: int | None,
 ) -> dict:
     """Simulate the RTL on ``codes``/``thresholds`` and compare with the expectation.
 
     ``expected`` defaults to ``contract.run(codes, thresholds, clear_before)`` (pass one
-    to test the checker); ``lanes`` selects the streaming array. Returns
+    to test the checker); ``arch`` and ``options`` as :func:`check_stimulus`. Returns
     :func:`check_stimulus`'s result.
     """
     codes = np.asarray(codes, dtype=np.int64)
@@ -154,7 +147,7 @@ def run_rtl(
     stim = Stimulus(codes, thresholds, np.asarray(expected, dtype=np.int8), contract,
                     clear_before=tuple(clear_before))
     return check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=name,
-                          build_root=build_root, lanes=lanes)
+                          build_root=build_root, arch=arch, **options)
 
 
 def replay(
@@ -163,7 +156,8 @@ def replay(
     steps: int | None = None,
     waves: bool = False,
     work_dir: str | os.PathLike = DEFAULT_WORK,
-    lanes: int | None = None,
+    arch: str | Architecture = DEFAULT_ARCHITECTURE,
+    **options: int | None,
 ) -> dict:
     """Replay a stimulus file (``rvsm stimulus -o FILE``) on the RTL, spike for spike.
 
@@ -173,14 +167,14 @@ def replay(
     check_simulator(sim)
     stim = load_stimulus(stimulus)
     c = stim.contract
-    _check_size(c, lanes)
+    _resolve(arch, options, c)
     if steps is not None and steps > stim.num_steps:
         raise RvsmError(f"--steps {steps}: {stimulus} holds {stim.num_steps} steps; ask for "
                         f"at most {stim.num_steps}")
     if steps is not None and steps < stim.num_steps:
         stim = stim.first_steps(steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
-                            name=Path(stimulus).stem or "stimulus", lanes=lanes)
+                            name=Path(stimulus).stem or "stimulus", arch=arch, **options)
     result.update(stimulus=str(stimulus), height=c.height, width=c.width,
                   coverage=_coverage(stim))
     return result
@@ -194,11 +188,13 @@ def verify(
     waves: bool = False,
     size: tuple[int, int] | None = None,
     work_dir: str | os.PathLike = DEFAULT_WORK,
-    lanes: int | None = None,
+    arch: str | Architecture = DEFAULT_ARCHITECTURE,
+    **options: int | None,
 ) -> dict:
     """Verify the RTL of design point ``fixed`` (TOML) on ``scene``, spike for spike.
 
-    ``lanes`` verifies the streaming array with that many lanes (any array size).
+    ``arch`` and ``options`` as :func:`check_stimulus` (the streaming array takes any
+    array size).
 
     ``size = (H, W)`` overrides the point's array size (a scene name or path is rendered
     or cropped to it; a :class:`Scene`, shaped by the caller, must have it); ``steps``
@@ -215,12 +211,12 @@ def verify(
     if size is not None:
         point = point.with_size(*size)
     h, w = point.height, point.width
-    _check_size(point.contract(), lanes)
+    _resolve(arch, options, point.contract())
     if not isinstance(scene, Scene):
         scene = load_scene(scene, size=(h, w))
     stim = make_stimulus(scene, point, num_steps=steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
-                            name=scene.name or "scene", lanes=lanes)
+                            name=scene.name or "scene", arch=arch, **options)
     result.update(scene=scene.source or scene.name, point=str(fixed), height=h, width=w,
                   coverage=_coverage(stim))
     return result
@@ -234,11 +230,12 @@ def random_verify(
     waves: bool = False,
     size: tuple[int, int] | None = None,
     work_dir: str | os.PathLike = DEFAULT_WORK,
-    lanes: int | None = None,
+    arch: str | Architecture = DEFAULT_ARCHITECTURE,
+    **options: int | None,
 ) -> dict:
     """Verify the RTL of design point ``fixed`` on a seeded random and corner stimulus
     (:func:`~rvsm.model.fixed.corner_stimulus.corner_stimulus`, ``steps`` steps);
-    ``lanes`` verifies the streaming array.
+    ``arch`` and ``options`` as :func:`check_stimulus`.
 
     Returns :func:`check_stimulus`'s result plus ``seed``, ``point``, ``height``,
     ``width`` and ``coverage`` (per scale, accumulator-steps per bin).
@@ -250,11 +247,11 @@ def random_verify(
     point = load_design_point(fixed)
     if size is not None:
         point = point.with_size(*size)
-    _check_size(point.contract(), lanes)
+    _resolve(arch, options, point.contract())
     stim = corner_stimulus(point.contract(), seed, steps)
     stim.point = point
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=f"random{seed}",
-                            lanes=lanes)
+                            arch=arch, **options)
     result.update(seed=seed, point=str(fixed), height=point.height, width=point.width,
                   coverage=coverage(stim))
     return result

@@ -26,7 +26,7 @@ from rvsm.model.spikes.npz import save_spikes
 DEMO_SCENE = "flyball"
 DEMO_MODELS = ("fsm", "dog4", "gauss4")
 # The flat RTL array is verified on a small window: Verilator builds grow with the array.
-#: The RTL check of the demo: the streaming array (rvsm.rtl.stream_array) at this size,
+#: The RTL check of the demo: the streaming array (rvsm.rtl.stream) at this size,
 #: lanes and steps, spike for spike against the fixed twin.
 DEMO_RTL_SIZE = (64, 96)
 DEMO_RTL_LANES = 8
@@ -137,14 +137,14 @@ def run_rtl_demo(
     """
     from rvsm.model.fixed.design_point import default_design_point
     from rvsm.model.fixed.point_toml import save_design_point
-    from rvsm.rtl.stream_verilog import write_stream_outputs
+    from rvsm.rtl.verilog import write_outputs
     from rvsm.sim.cosim.verify import verify
 
     point = default_design_point().with_size(*size)
     point_path = out_dir / "point.toml"
     save_design_point(point_path, point)
-    paths, generated = write_stream_outputs(point.contract(), lanes, out_dir)
+    paths, generated = write_outputs(point.contract(), out_dir, "stream", lanes=lanes)
     result = verify(scene_arg, point_path, sim=sim, steps=steps, work_dir=out_dir / "verify",
-                    lanes=lanes)
+                    arch="stream", lanes=lanes)
     result.update(verilog=str(paths["verilog"]), generate_seconds=generated.seconds)
     return result

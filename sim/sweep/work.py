@@ -59,7 +59,7 @@ def hw_digest(point: DesignPoint, hardware: HardwareSettings) -> str:
     from rvsm.rtl.digest import rtl_digest
 
     return rtl_digest(hw_point(point, hardware.size).contract(), "stream",
-                      extra={"lane_counts": list(hardware.lanes), "fmax": hardware.fmax})
+                      {"lane_counts": list(hardware.lanes), "fmax": hardware.fmax})
 
 
 def synthesise_task(point: DesignPoint, hardware: HardwareSettings, lanes: int

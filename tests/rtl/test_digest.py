@@ -12,12 +12,13 @@ def test_digest_keys_contract_architecture_and_options(small_contract) -> None:
     other = small_contract("fsm", 2, 3, frac_bits=0, acc_bits=6, shift=0, reset="zero")
     d = rtl_digest(c, "parallel")
     assert re.fullmatch(r"[0-9a-f]{16}", d) and d == rtl_digest(c, "parallel")
-    variants = {d, rtl_digest(other, "parallel"), rtl_digest(c, "stream", 1),
-                rtl_digest(c, "stream", 2), rtl_digest(c, "stream", 2, {"fmax": True}),
-                rtl_digest(c, "stream", 2, {"fmax": False})}
+    variants = {d, rtl_digest(other, "parallel"), rtl_digest(c, "stream", {"lanes": 1}),
+                rtl_digest(c, "stream", {"lanes": 2}),
+                rtl_digest(c, "stream", {"lanes": 2, "fmax": True}),
+                rtl_digest(c, "stream", {"lanes": 2, "fmax": False})}
     assert len(variants) == 6
-    assert rtl_digest(c, "stream", 2, {"a": 1, "b": [1, 2]}) \
-        == rtl_digest(c, "stream", 2, {"b": [1, 2], "a": 1})
+    assert rtl_digest(c, "stream", {"lanes": 2, "a": 1, "b": [1, 2]}) \
+        == rtl_digest(c, "stream", {"b": [1, 2], "a": 1, "lanes": 2})
 
 
 def test_digest_covers_every_rtl_source(small_contract, tmp_path, monkeypatch) -> None:

@@ -6,11 +6,11 @@ import pytest
 from amaranth.hdl import Fragment
 from amaranth.lib import wiring
 
-from rvsm.rtl.array import RvsmArray
 from rvsm.rtl.interfaces import ThresholdWriteSignature
-from rvsm.rtl.pixel_cell import PixelCell
+from rvsm.rtl.parallel.architecture import PARALLEL
+from rvsm.rtl.parallel.array import RvsmArray
+from rvsm.rtl.parallel.pixel_cell import PixelCell
 from rvsm.rtl.ports import port_map, verilog_ports
-from rvsm.rtl.verilog import port_map as array_port_map
 
 
 def test_cell_and_array_share_the_threshold_bus(small_contract) -> None:
@@ -35,7 +35,7 @@ def test_verilog_ports_follow_the_signature(small_contract) -> None:
     Fragment.get(dut, None)
     assert list(ports) == ["codes", "strobe", "clear", "cfg_we", "cfg_addr", "cfg_data",
                            "spike_pos", "spike_neg", "valid"]
-    rows = array_port_map(c)
+    rows = PARALLEL.port_map(c)
     widths = {r["name"]: r["width"] for r in rows}
     assert [r["name"] for r in rows][:2] == ["clk", "rst"]
     assert widths["cfg_addr"] == dut.addr_bits == 5 and widths["cfg_data"] == 11

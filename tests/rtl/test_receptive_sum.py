@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from amaranth.sim import Simulator
 
 from rvsm.rtl.receptive_sum import ReceptiveSum, csd_digits
+from rvsm.rtl.simulation import run_simulation
 
 
 @pytest.mark.parametrize("value", [0, 1, 3, 7, 11, 236, 1023, 4095, 12345])
@@ -32,6 +32,4 @@ def test_weighted_sum_exact(seed: int) -> None:
             ctx.set(dut.inputs, sum(int(v) << (8 * i) for i, v in enumerate(x)))
             assert ctx.get(dut.sum) == int(np.dot(weights, x))
 
-    sim = Simulator(dut)
-    sim.add_testbench(bench)
-    sim.run()
+    run_simulation(dut, bench)

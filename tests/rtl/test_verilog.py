@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from rvsm.model.fixed.design_point import default_design_point
-from rvsm.rtl.array import RvsmArray
+from rvsm.rtl.parallel.array import RvsmArray
 from rvsm.rtl.verilog import write_outputs
 
 
@@ -21,7 +21,7 @@ def generated(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, object]:
     from dataclasses import replace
 
     point = replace(point, model="fsm")
-    write_outputs(point.contract(), tmp / "out")
+    write_outputs(point.contract(), tmp / "out", "parallel")
     return tmp / "out", point
 
 

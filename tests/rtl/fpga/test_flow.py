@@ -34,7 +34,7 @@ def test_synthesis_only_on_a_tiny_array(tmp_path: Path, fsm_point) -> None:
 
 
 def test_synthesis_only_keeps_the_stream_arrays_state_memories(tmp_path: Path) -> None:
-    from rvsm.rtl.stream_array import StreamGeometry
+    from rvsm.rtl.stream.geometry import StreamGeometry
 
     point = dataclasses.replace(default_design_point(), model="dog1")
     r = run_fpga(point, tmp_path, arch="stream", lanes=2, size=(6, 6), synth_only=True,

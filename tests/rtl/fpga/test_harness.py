@@ -6,10 +6,10 @@ import pytest
 from amaranth.hdl import Module, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
-from amaranth.sim import Simulator
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.harness import LFSR_TAPS, XOR_GROUP, IoHarness, component_ports
+from rvsm.rtl.simulation import run_simulation
 
 
 class Echo(wiring.Component):
@@ -91,10 +91,7 @@ def _run(harness: IoHarness, cycles: int, probe) -> list:  # noqa: ANN001
             await ctx.tick()
             rows.append(probe(ctx))
 
-    sim = Simulator(harness)
-    sim.add_clock(1e-6)
-    sim.add_testbench(bench)
-    sim.run()
+    run_simulation(harness, bench)
     return rows
 
 

@@ -82,7 +82,7 @@ def test_bram_blocks_best_shape() -> None:
 
 @pytest.mark.parametrize("model", ["fsm", "dog1", "dog4", "gauss3"])
 def test_state_memory_matches_the_stream_arrays_own_count(model: str) -> None:
-    from rvsm.rtl.stream_array import StreamGeometry
+    from rvsm.rtl.stream.geometry import StreamGeometry
 
     point = dataclasses.replace(default_design_point(), model=model)
     st = state_memory(point.contract())

@@ -335,7 +335,8 @@ def test_verilog_refuses_a_full_resolution_array_as_verify_does(tmp_path, capsys
     point = tmp_path / "p.toml"
     assert _run(capsys, "config", "new", "-o", point)[0] == 0  # 250x400
     for extra in ([], ["--stats"]):
-        code, _, err = _run(capsys, "verilog", point, "-o", tmp_path / "rtl", *extra)
+        code, _, err = _run(capsys, "verilog", point, "--arch", "parallel", "-o",
+                            tmp_path / "rtl", *extra)
         assert code == 2 and "limited to 64x64" in _one_line(err) and "--size" in err
     assert not (tmp_path / "rtl").exists()
 
@@ -436,7 +437,7 @@ def test_a_full_resolution_stream_array_reaches_the_output_check(tmp_path, capsy
     point = tmp_path / "p.toml"
     assert _run(capsys, "config", "new", "-o", point)[0] == 0  # 250x400: fine when streamed
     monkeypatch.setattr(outputs.os, "access", lambda *a, **k: False)
-    monkeypatch.setattr("rvsm.rtl.stream_verilog.write_stream_outputs", WORK_REFUSED)
+    monkeypatch.setattr("rvsm.rtl.verilog.write_outputs", WORK_REFUSED)
     code, _, err = _run(capsys, "verilog", point, "--arch", "stream", "-o", tmp_path / "rtl")
     assert code == 3 and "choose a writable location" in _one_line(err)
 

@@ -18,7 +18,8 @@ def test_cli_verilog_writes_verilog_and_port_map(tmp_path: Path,
                                                 capsys: pytest.CaptureFixture) -> None:
     point = replace(default_design_point().with_size(2, 3), model="fsm")
     save_design_point(tmp_path / "p.toml", point)
-    assert main(["verilog", str(tmp_path / "p.toml"), "-o", str(tmp_path / "out")]) == 0
+    assert main(["verilog", str(tmp_path / "p.toml"), "-o", str(tmp_path / "out"),
+                 "--arch", "parallel"]) == 0
     names = {p.name for p in (tmp_path / "out").iterdir()}
     assert names == {"rvsm_array.v", "rvsm_array.ports.json", "rvsm_array.ports.md"}
     assert "latency 1 cycle(s)" in capsys.readouterr().out
@@ -98,3 +99,36 @@ def test_verify_needs_scene_and_point_or_stimulus(tmp_path: Path,
     assert main(["verify", "--stimulus", str(tmp_path / "missing.npz")]) == 2
     err = capsys.readouterr().err
     assert "--stimulus" in err and "does not exist" in err
+
+
+def test_every_command_defaults_to_the_stream_array_and_names_it(
+        tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    point = tmp_path / "p.toml"
+    save_design_point(point, replace(default_design_point().with_size(4, 6), model="fsm"))
+    assert main(["verilog", str(point), "-o", str(tmp_path / "out")]) == 0
+    assert "architecture stream (lanes 1)" in capsys.readouterr().out
+    meta = json.loads((tmp_path / "out" / "rvsm_stream_array.ports.json").read_text())
+    assert meta["arch"] == "stream"
+    assert main(["verilog", str(point), "-o", str(tmp_path / "par"), "--arch",
+                 "parallel"]) == 0
+    assert "architecture parallel," in capsys.readouterr().out
+    assert json.loads((tmp_path / "par" / "rvsm_array.ports.json").read_text())["arch"] \
+        == "parallel"
+    assert main(["verify", "coin", "--fixed", str(point), "--steps", "6", "--json",
+                 "--work", str(tmp_path / "work"), "--lanes", "2"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["arch"] == "stream" and out["options"] == {"lanes": 2}
+
+
+@pytest.mark.parametrize("command", ["verilog", "verify", "fpga"])
+def test_an_option_of_another_architecture_is_refused(
+        tmp_path: Path, capsys: pytest.CaptureFixture, command: str) -> None:
+    point = tmp_path / "p.toml"
+    save_design_point(point, default_design_point().with_size(4, 6))
+    args = {"verilog": ["verilog", str(point), "-o", str(tmp_path / "o")],
+            "verify": ["verify", "coin", "--fixed", str(point), "--work", str(tmp_path / "w")],
+            "fpga": ["fpga", str(point), "--size", "4x6", "-o", str(tmp_path / "f")]}[command]
+    assert main([*args, "--lanes", "3", "--arch", "parallel"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--lanes does not apply to --arch parallel" in err[0]
+    assert not any(tmp_path.glob("[owf]"))

@@ -74,13 +74,13 @@ def _one_line(err: str) -> str:
 
 def _verify_args(point: Path, work: Path, *extra: str, steps: int = 30) -> list[str]:
     return ["verify", "coin", "--fixed", str(point), "--size", "4x4", "--steps", str(steps),
-            "--work", str(work), *extra]
+            "--work", str(work), "--arch", "parallel", *extra]
 
 
 def _long_verify_args(point: Path, work: Path, *extra: str) -> list[str]:
     """A verify whose simulation lasts seconds (a 3000-step random stimulus)."""
     return ["verify", "--random", "1", "--fixed", str(point), "--size", "4x4", "--steps",
-            "3000", "--work", str(work), *extra]
+            "3000", "--work", str(work), "--arch", "parallel", *extra]
 
 
 def _children(pid: int) -> dict[int, str]:
@@ -338,7 +338,7 @@ def test_hostile_work_path_verifies(tmp_path: Path) -> None:
 def test_yosys_stats_with_hostile_output_path(tmp_path: Path) -> None:
     out = tmp_path / HOSTILE
     r = _rvsm("verilog", str(_point(tmp_path / "p.toml", 2, 2, "fsm")), "-o", str(out),
-              "--stats", cwd=tmp_path)
+              "--stats", "--arch", "parallel", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert "yosys synth:" in r.stdout
     assert not list(tmp_path.rglob("PWNED")) and not (Path.cwd() / "PWNED").exists()
@@ -373,9 +373,9 @@ def test_two_concurrent_verifies_sharing_work_are_isolated(tmp_path: Path) -> No
     a = _point(tmp_path / "a.toml", 4, 4, "dog1")
     b = _point(tmp_path / "b.toml", 4, 5, "fsm")
     cmds = [[RVSM, "verify", "coin", "--fixed", str(a), "--size", "4x4", "--steps", "120",
-             "--work", str(work), "--json"],
+             "--work", str(work), "--json", "--arch", "parallel"],
             [RVSM, "verify", "coin", "--fixed", str(b), "--size", "4x5", "--steps", "60",
-             "--work", str(work), "--json"]]
+             "--work", str(work), "--json", "--arch", "parallel"]]
     procs = [subprocess.Popen(c, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
              for c in cmds]
     outs = [p.communicate(timeout=600) for p in procs]

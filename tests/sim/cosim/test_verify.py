@@ -72,7 +72,7 @@ def check_all(c: ArrayContract, sim: str, cosim_work: Path, rtl_builds: Path, se
     cases["exact_threshold"] = (codes, thr, ())
     for name, (codes, thr, clears) in cases.items():
         r = run_rtl(c, codes, thr, sim, clear_before=clears, work_dir=cosim_work, name=name,
-                    build_root=rtl_builds)
+                    build_root=rtl_builds, arch="parallel")
         assert r["mismatches"] == 0, (name, r["first_mismatch"])
         assert r["compared"] == codes.shape[0] * c.num_scales * c.height * c.width
         want = c.run(codes, thr, clears)
@@ -103,7 +103,7 @@ def test_every_model_icarus(small_contract, model: str, cosim_work: Path, rtl_bu
     codes = rng.integers(0, 16, (40, 3, 5))
     thr = rng.integers(1, 120, (c.num_scales, 3, 5))
     r = run_rtl(c, codes, thr, "icarus", work_dir=cosim_work, name=f"model_{model}",
-                build_root=rtl_builds)
+                build_root=rtl_builds, arch="parallel")
     assert r["mismatches"] == 0, r["first_mismatch"]
 
 
@@ -120,7 +120,7 @@ def test_checker_catches_wrong_expectation(
     good = int(wrong[step, scale, row, col])
     wrong[step, scale, row, col] = 1 if good != 1 else -1
     r = run_rtl(c, codes, thr, "icarus", expected=wrong, work_dir=cosim_work, name="wrong",
-                build_root=rtl_builds)
+                build_root=rtl_builds, arch="parallel")
     assert r["mismatches"] == 1
     assert r["first_mismatch"] == {"step": step, "scale": scale, "row": row, "column": col,
                                    "expected": int(wrong[step, scale, row, col]),
@@ -140,7 +140,7 @@ def test_checker_catches_wrong_expectation_verilator(
     wrong = c.run(codes, thr)
     wrong[9, 0, 0, 0] = 1 if wrong[9, 0, 0, 0] != 1 else 0
     r = run_rtl(c, codes, thr, "verilator", expected=wrong, work_dir=cosim_work,
-                name="wrong_v", build_root=rtl_builds)
+                name="wrong_v", build_root=rtl_builds, arch="parallel")
     assert r["mismatches"] == 1 and r["first_mismatch"]["step"] == 9
     assert r["waves"] and Path(r["waves"]).exists()
 

@@ -7,7 +7,7 @@ import pytest
 
 from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift
 from rvsm.model.fixed.widths import signed_range
-from rvsm.rtl.pixel_cell import PixelCell
+from rvsm.rtl.parallel.pixel_cell import PixelCell
 
 
 def run_cell(

@@ -17,13 +17,12 @@ from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.weights import quantise_model
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
-from rvsm.rtl.stream_array import (
-    RvsmStreamArray,
-    StreamGeometry,
-    simulate,
-    threshold_word_bits,
-)
-from rvsm.rtl.stream_schedule import OutputBeats, check_beats, pack_lanes
+from rvsm.rtl.simulation import run_simulation
+from rvsm.rtl.stream.array import RvsmStreamArray
+from rvsm.rtl.stream.drive import BeatCollector, simulate, threshold_writes
+from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.schedule import OutputBeats, check_beats, pack_lanes
+from rvsm.rtl.stream.signatures import threshold_word_bits
 
 
 def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int = 12,
@@ -129,25 +128,18 @@ def stream_with_threshold_writes(c: ArrayContract, lanes: int, codes: np.ndarray
                                  bank_words: int) -> OutputBeats:
     """Load ``thr``, stream ``codes`` back to back (then ``lag`` flush beats) and, at the
     edge accepting beat ``k``, write ``writes[k] = (s, addr, word)`` on ``thr``."""
-    from amaranth.sim import Simulator
-
     dut = RvsmStreamArray(c, lanes, bank_words)
     sched = dut.schedule
     word_bits = threshold_word_bits(sched.beats_per_frame)
-    layout = dut.geometry.spike_layout
-    fields = ("row", "group", "last", "pos", "neg")
-    got: dict[str, list[int]] = {k: [] for k in (*fields, "accepted")}
-    words = pack_lanes(sched.threshold_words(thr).reshape(-1, lanes), c.threshold_bits)
     beats = pack_lanes(sched.input_beats(codes), c.adc_bits)  # with the flush beats
+    out = BeatCollector(dut)
 
     async def bench(ctx) -> None:  # noqa: ANN001
-        for i, word in enumerate(words):
+        for addr, word in threshold_writes(dut.geometry, thr):
             ctx.set(dut.thr.we, 1)
-            ctx.set(dut.thr.addr, (i // sched.beats_per_frame << word_bits)
-                    | i % sched.beats_per_frame)
+            ctx.set(dut.thr.addr, addr)
             ctx.set(dut.thr.data, word)
             await ctx.tick()
-        previous = -1
         for k, beat in enumerate([*beats, None, None]):
             ctx.set(dut.codes.valid, beat is not None)
             ctx.set(dut.codes.payload.as_value(), beat or 0)
@@ -156,20 +148,10 @@ def stream_with_threshold_writes(c: ArrayContract, lanes: int, codes: np.ndarray
             ctx.set(dut.thr.addr, (s << word_bits) | a)
             ctx.set(dut.thr.data, w)
             await ctx.tick()
-            if ctx.get(dut.spikes.valid):
-                word = ctx.get(dut.spikes.payload.as_value())
-                for name in fields:
-                    off, width = layout[name].offset, layout[name].width
-                    got[name].append((word >> off) & ((1 << width) - 1))
-                got["accepted"].append(previous)
-            previous = k if beat is not None else -1
+            out.after_edge(ctx, k if beat is not None else -1)
 
-    sim = Simulator(dut)
-    sim.add_clock(1e-6)
-    sim.add_testbench(bench)
-    sim.run()
-    return OutputBeats.from_words(*(got[k] for k in fields), c.num_scales, lanes,
-                                  got["accepted"])
+    run_simulation(dut, bench)
+    return out.beats()
 
 
 @pytest.mark.parametrize(("lanes", "bank_words"), [(1, 8), (2, 1024), (3, 4)])

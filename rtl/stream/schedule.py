@@ -1,6 +1,6 @@
 """The beat schedule of the streaming array, in numpy: the model beside the component.
 
-:class:`~rvsm.rtl.stream_array.RvsmStreamArray` with ``P`` lanes on an ``H x W`` array
+:class:`~rvsm.rtl.stream.array.RvsmStreamArray` with ``P`` lanes on an ``H x W`` array
 (``G = W / P`` column groups) moves one *beat* per accepted input transfer:
 
 * **Beat order.** Input beat ``k`` carries ``P`` ADC codes of one row, raster order,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvsm.rtl.stream_schedule import (
+from rvsm.rtl.stream.schedule import (
     OutputBeats,
     StreamSchedule,
     check_beats,

@@ -1,7 +1,8 @@
 """One RVSM accumulator: threshold register, W-bit saturating add, compare, fire, reset.
 
-The cell is independent of how its input sum is produced, so the same cell serves the
-fully parallel :class:`~rvsm.rtl.array.RvsmArray` and a later column-streaming array.
+The cell is independent of how its input sum is produced; the fully parallel
+:class:`~rvsm.rtl.parallel.array.RvsmArray` builds one per (scale, pixel). (The streaming
+array keeps its accumulators in memories and has its own tail.)
 Per strobe it implements steps 2..5 of the contract (:mod:`rvsm.model.fixed.core`)::
 
     shifted = sum_in >>> shift                         (arithmetic, floor)

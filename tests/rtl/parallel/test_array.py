@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
-from rvsm.rtl.array import RvsmArray, simulate
-from rvsm.rtl.pixel_cell import PixelCell
+from rvsm.rtl.parallel.array import RvsmArray
+from rvsm.rtl.parallel.drive import simulate
+from rvsm.rtl.parallel.pixel_cell import PixelCell
 
 
 def test_valid_rises_latency_cycles_after_the_strobe(small_contract, amaranth_sim) -> None:

@@ -12,9 +12,12 @@ import pytest
 
 from rvsm.model.fixed.design_point import DesignPoint, default_design_point
 from rvsm.model.fixed.point_toml import save_design_point
-from rvsm.rtl.stream_array import StreamGeometry
-from rvsm.rtl.stream_verilog import STREAM_TOP, strip_zero_memory_init, write_stream_outputs
+from rvsm.rtl.architectures import get_architecture
+from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.verilog import strip_zero_memory_init, write_outputs
 from rvsm.sim.cli import main
+
+STREAM_TOP = get_architecture("stream").default_top
 
 
 @pytest.fixture(scope="module")
@@ -80,7 +83,7 @@ def test_full_sensor_verilog(tmp_path: Path, lanes: int) -> None:
     from rvsm.rtl.verilog import verilator_lint
 
     t0 = time.perf_counter()
-    paths, gen = write_stream_outputs(DesignPoint().contract(), lanes, tmp_path)
+    paths, gen = write_outputs(DesignPoint().contract(), tmp_path, "stream", lanes=lanes)
     size = paths["verilog"].stat().st_size
     print(f"P={lanes}: generated in {gen.seconds:.1f} s ({time.perf_counter() - t0:.1f} s "
           f"with port map), {size / 1e6:.2f} MB")

@@ -1,22 +1,23 @@
-"""Orbit decomposition and retimed adder trees of :mod:`rvsm.rtl.pipelined_sum`."""
+"""Orbit decomposition and retimed adder trees of :mod:`rvsm.rtl.stream.pipelined_sum`."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from amaranth.hdl import Module, Signal, unsigned
-from amaranth.sim import Simulator
 
 from rvsm.model.fixed.weights import quantise_model
+from rvsm.model.kernels.geometry import kernel_radius
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
-from rvsm.rtl.pipelined_sum import Pipeline, kernel_orbits, kernel_radius
 from rvsm.rtl.receptive_sum import sum_width
+from rvsm.rtl.simulation import run_simulation
+from rvsm.rtl.stream.pipelined_sum import Pipeline, weighted_orbits
 
 
 @pytest.mark.parametrize("model", MODEL_NAMES)
 def test_orbits_rebuild_every_kernel(model: str) -> None:
     ks = quantise_model(model, 9, "round-half-up")
-    orbits = kernel_orbits(ks)
+    orbits = weighted_orbits(ks)
     radius = kernel_radius(ks)
     for s, k in enumerate(ks):
         half = k.shape[0] // 2
@@ -31,13 +32,6 @@ def test_orbits_rebuild_every_kernel(model: str) -> None:
         else:  # the kernel's outer ring is zero
             full = k[-lo:-lo + 2 * radius + 1, -lo:-lo + 2 * radius + 1]
         assert np.array_equal(rebuilt, full)
-
-
-def test_radius_skips_zero_rings() -> None:
-    k = np.zeros((9, 9), dtype=np.int64)
-    k[4, 4], k[2, 4] = 5, -1
-    assert kernel_radius([k]) == 2
-    assert kernel_radius([np.ones((1, 1))]) == 0
 
 
 @pytest.mark.parametrize("levels", [1, 2, 3])
@@ -82,9 +76,6 @@ def test_retimed_sum_is_exact_and_planned(levels: int) -> None:
             raw = ctx.get(out)
             got.append(raw - (1 << width) if raw >> (width - 1) else raw)
 
-    sim = Simulator(m)
-    sim.add_clock(1e-6)
-    sim.add_testbench(bench)
-    sim.run()
+    run_simulation(m, bench)
     want = [sum(s * int(vec[i]) << sh for s, i, sh in terms_spec) for vec in vectors]
     assert got == want

@@ -22,14 +22,12 @@ step per strobe; strobes may be back to back); the spikes of that step are on
 and hold until the next strobe. ``clear`` (synchronous, priority over ``strobe``) zeroes
 every accumulator and spike but keeps the thresholds: a restart of the stream.
 
-The bit-accurate model of this component is :meth:`ArrayContract.run`.
+The bit-accurate model of this component is :meth:`ArrayContract.run`; it is driven in
+``amaranth.sim`` by :func:`rvsm.rtl.parallel.drive.simulate`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
-import numpy as np
 from amaranth.hdl import Module, Signal, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
@@ -37,10 +35,10 @@ from amaranth.lib.wiring import In, Out
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.widths import index_bits, unsigned_max
 from rvsm.rtl.interfaces import ThresholdWriteSignature
-from rvsm.rtl.pixel_cell import PixelCell
+from rvsm.rtl.parallel.pixel_cell import PixelCell
 from rvsm.rtl.receptive_sum import sum_width, weighted_sum
 
-__all__ = ["RvsmArray", "accumulator_index", "simulate"]
+__all__ = ["RvsmArray", "accumulator_index"]
 
 
 def accumulator_index(contract: ArrayContract, scale: int, row: int, col: int) -> int:
@@ -149,63 +147,3 @@ class RvsmArray(wiring.Component):
                         self.spike_neg[a].eq(cell.spike_neg),
                     ]
         return m
-
-
-def simulate(
-    contract: ArrayContract,
-    codes: np.ndarray,
-    thresholds: np.ndarray,
-    clear_before: Sequence[int] = (),
-    vcd_path: str | None = None,
-) -> np.ndarray:
-    """Run :class:`RvsmArray` in ``amaranth.sim``; spikes ``(T, S, H, W) int8``.
-
-    Thresholds are loaded through the configuration port, one step is strobed per clock
-    and ``clear`` is pulsed for one cycle before each step in ``clear_before``; outputs
-    are read :attr:`RvsmArray.latency` cycles after each strobe (checking ``valid``).
-    With ``vcd_path`` the run's waveform is written there.
-    """
-    from amaranth.sim import Simulator
-
-    c = contract
-    codes = np.asarray(codes, dtype=np.int64)
-    thr = np.asarray(thresholds, dtype=np.int64)
-    steps = codes.shape[0]
-    n_acc = c.num_scales * c.height * c.width
-    dut = RvsmArray(c)
-    out = np.zeros((steps, n_acc), dtype=np.int8)
-    clears = {int(t) for t in clear_before}
-    shifts = np.arange(c.height * c.width, dtype=object) * c.adc_bits
-
-    async def bench(ctx) -> None:  # noqa: ANN001 - amaranth's SimulatorContext
-        for a, value in enumerate(thr.ravel()):
-            ctx.set(dut.cfg.we, 1)
-            ctx.set(dut.cfg.addr, a)
-            ctx.set(dut.cfg.data, int(value))
-            await ctx.tick()
-        ctx.set(dut.cfg.we, 0)
-        for t in range(steps):
-            if t in clears:
-                ctx.set(dut.clear, 1)
-                await ctx.tick()
-                ctx.set(dut.clear, 0)
-            ctx.set(dut.codes, int((codes[t].ravel().astype(object) << shifts).sum()))
-            ctx.set(dut.strobe, 1)
-            await ctx.tick()
-            ctx.set(dut.strobe, 0)
-            for _ in range(dut.latency - 1):
-                await ctx.tick()
-            if not ctx.get(dut.valid):
-                raise AssertionError(f"valid low {dut.latency} cycle(s) after strobe {t}")
-            pos, neg = ctx.get(dut.spike_pos), ctx.get(dut.spike_neg)
-            out[t] = [((pos >> a) & 1) - ((neg >> a) & 1) for a in range(n_acc)]
-
-    sim = Simulator(dut)
-    sim.add_clock(1e-6)
-    sim.add_testbench(bench)
-    if vcd_path is None:
-        sim.run()
-    else:
-        with sim.write_vcd(str(vcd_path)):
-            sim.run()
-    return out.reshape(steps, c.num_scales, c.height, c.width)

@@ -1,12 +1,12 @@
 """Pipelined constant-weight receptive sums: shared symmetry orbits, retimed adder trees.
 
-The streaming array (:mod:`rvsm.rtl.stream_array`) computes, per lane and per step,
+The streaming array (:mod:`rvsm.rtl.stream.array`) computes, per lane and per step,
 ``sum_s = sum_{dy,dx} w_s[dy,dx] * code[y+dy, x+dx]`` for every scale ``s``. Two ideas
 from :mod:`rvsm.rtl.receptive_sum` are extended here:
 
 1. **Orbits shared across scales.** When every kernel has the 8-fold symmetry of the
    DoG / Gauss templates, the codes of one orbit ``{(+-a, +-b), (+-b, +-a)}`` carry the
-   same weight in every scale, so they are summed once per lane (:func:`kernel_orbits`)
+   same weight in every scale, so they are summed once per lane (:func:`weighted_orbits`)
    and each scale weights the orbit sums. Without the symmetry every tap is its own orbit.
 2. **Constant weights as canonical signed digits** (:func:`~rvsm.rtl.receptive_sum.csd_digits`):
    ``w * orbit = sum_k +-(orbit << k)``; the signed terms of a scale are added in one
@@ -36,9 +36,10 @@ from dataclasses import dataclass
 import numpy as np
 from amaranth.hdl import Cat, Const, Module, Signal, Value, unsigned
 
+from rvsm.model.kernels.geometry import is_symmetric, kernel_radius, orbit_taps, symmetric_orbits
 from rvsm.rtl.receptive_sum import csd_digits
 
-__all__ = ["Orbit", "Pipeline", "Timed", "kernel_orbits", "kernel_radius", "orbit_terms"]
+__all__ = ["Orbit", "Pipeline", "Timed", "orbit_terms", "weighted_orbits"]
 
 
 @dataclass(frozen=True)
@@ -49,33 +50,16 @@ class Orbit:
     weights: tuple[int, ...]
 
 
-def kernel_radius(weights: Sequence[Sequence[Sequence[int]]]) -> int:
-    """L: the largest ``max(|dy|, |dx|)`` of a non-zero weight over all kernels."""
-    radius = 0
-    for k in weights:
-        arr = np.asarray(k, dtype=np.int64)
-        half = arr.shape[0] // 2
-        ys, xs = np.nonzero(arr)
-        if len(ys):
-            radius = max(radius, int(np.max(np.maximum(abs(ys - half), abs(xs - half)))))
-    return radius
-
-
-def _symmetric(k: np.ndarray) -> bool:
-    return (k.ndim == 2 and k.shape[0] == k.shape[1] and k.shape[0] % 2 == 1
-            and np.array_equal(k, k.T) and np.array_equal(k, k[::-1])
-            and np.array_equal(k, k[:, ::-1]))
-
-
-def kernel_orbits(weights: Sequence[Sequence[Sequence[int]]]) -> list[Orbit]:
+def weighted_orbits(weights: Sequence[Sequence[Sequence[int]]]) -> list[Orbit]:
     """The orbits of the kernels' non-zero taps, with per-scale weights.
 
-    8-fold symmetric kernels (all of them) give orbits ``{(+-a, +-b), (+-b, +-a)}``,
-    ``0 <= b <= a <= L`` (1, 4 or 8 taps); otherwise each non-zero tap is an orbit.
-    Orbits whose weight is zero in every scale are dropped.
+    8-fold symmetric kernels (all of them) give the orbits of
+    :func:`~rvsm.model.kernels.geometry.symmetric_orbits` up to the kernels' radius
+    (1, 4 or 8 taps); otherwise each non-zero tap is an orbit. Orbits whose weight is
+    zero in every scale are dropped.
     """
     kernels = [np.asarray(k, dtype=np.int64) for k in weights]
-    radius = kernel_radius(weights)
+    radius = kernel_radius(kernels)
 
     def weight(k: np.ndarray, dy: int, dx: int) -> int:
         half = k.shape[0] // 2
@@ -83,22 +67,17 @@ def kernel_orbits(weights: Sequence[Sequence[Sequence[int]]]) -> list[Orbit]:
             return 0
         return int(k[half + dy, half + dx])
 
+    if all(is_symmetric(k) for k in kernels):
+        groups = [orbit_taps(a, b) for a, b in symmetric_orbits(radius)]
+    else:
+        groups = [((dy, dx),) for dy in range(-radius, radius + 1)
+                  for dx in range(-radius, radius + 1)]
     orbits: list[Orbit] = []
-    if all(_symmetric(k) for k in kernels):
-        for a in range(radius + 1):
-            for b in range(a + 1):
-                ws = tuple(weight(k, a, b) for k in kernels)
-                if not any(ws):
-                    continue
-                taps = sorted({(sy * p, sx * q) for p, q in ((a, b), (b, a))
-                               for sy in (1, -1) for sx in (1, -1)})
-                orbits.append(Orbit(tuple(taps), ws))
-        return orbits
-    for dy in range(-radius, radius + 1):
-        for dx in range(-radius, radius + 1):
-            ws = tuple(weight(k, dy, dx) for k in kernels)
-            if any(ws):
-                orbits.append(Orbit(((dy, dx),), ws))
+    for taps in groups:
+        dy, dx = taps[0]
+        ws = tuple(weight(k, dy, dx) for k in kernels)
+        if any(ws):
+            orbits.append(Orbit(taps, ws))
     return orbits
 
 

@@ -1,0 +1,384 @@
+"""The lane-parallel streaming RVSM pixel array, built from one :class:`ArrayContract`.
+
+Where :class:`~rvsm.rtl.parallel.array.RvsmArray` builds an adder network and an accumulator per
+(scale, pixel), this array streams the frame through ``P`` lanes: the datapath is
+O(P), and only the state memories grow with the sensor. One clock domain ``sync``
+(synchronous reset ``rst``)::
+
+    codes (P ADC codes per beat, raster order, valid/ready)
+      -> line buffer (one memory, depth W/P, word 2L rows x P codes)
+      -> window register: 2E+1 column-group slabs of 2L+1 rows       [stage 0]
+      -> zero padding by registered row/column masks                  [stage 1]
+      -> per lane: 8-fold symmetric orbit sums, shared by all scales
+      -> per scale: constant CSD shift-and-add tree, registered every
+         LEVELS_PER_STAGE adder levels, equal depth for all scales    [stage Q]
+      -> acc (+ >> shift) from the accumulator memory (banked, bank
+         outputs registered; zero in the first frame after clear)    [Q+1]
+      -> compare (on the pre-saturation total) and saturate           [Q+2]
+      -> fire / reset -> write back to the accumulator memory;
+         spikes + position registered on the output stream           [Q+3]
+
+L is the kernel radius (:func:`~rvsm.model.kernels.geometry.kernel_radius`), E =
+``ceil(L / P)`` the column groups a window reaches either side, G = ``W / P``.
+
+**State.** Per scale one accumulator memory (word = P signed W-bit accumulators) and one
+threshold memory (word = P thresholds of W-1 bits), depth ``H*G``, address ``y*G + g``,
+each a :class:`~rvsm.rtl.stream.banked_memory.BankedMemory` split into banks of at most
+:attr:`StreamGeometry.bank_words` words (a power of two, 1024 by default) whose read
+data is registered before the bank multiplexer (ECP5 block-RAM timing). Each address is
+read and written once per frame, :attr:`StreamGeometry.rmw_depth` beats apart, so the
+read-modify-write needs no forwarding as long as ``H*G > rmw_depth`` (checked). A bank's
+read is disabled when its write port writes the same address at that edge (no read-first
+bypass multiplexer after the block RAM); threshold writes are registered and forwarded
+after the bank registers to a read meeting them, so the rule below holds.
+
+**Streams.** ``codes`` (:func:`~rvsm.rtl.stream.signatures.code_beat_signature`):
+``payload`` lane ``i`` = pixel ``(y, g*P + i)``; a beat is accepted at a rising edge
+with ``valid & ready``; ``ready`` is low only while ``clear`` is high. Accepted beats
+and ``clear`` pass an input register (no combinational path from the ports into the
+datapath), and the whole pipeline advances once per accepted beat, at the edge after its
+acceptance (a clock enable), so a paused input holds everything in flight. ``spikes``
+(:func:`spike_beat_signature`, no back-pressure): ``valid`` is high for the one cycle
+after the edge that releases a position; ``payload.row``/``group`` is the position,
+``last`` marks the frame's last beat, bit ``s*P + i`` of ``pos``/``neg`` the +1/-1 spike
+of accumulator ``(s, y, g*P + i)``. The output of position ``p`` (beats counted from the
+last clear) is released by input beat ``p + lag``: it is presented in the second cycle
+after that beat's acceptance. To drain a stream, send ``lag`` more beats (any codes) and
+wait one more cycle. :mod:`rvsm.rtl.stream.schedule` is the numpy model of this
+schedule.
+
+**Frame-boundary meaning of the controls.**
+
+* ``clear`` (synchronous, any number of cycles): discards every position in flight and
+  restarts the stream: the next accepted beat is frame 0, row 0, group 0, and every
+  accumulator reads as zero during the first frame after it (the memories are not
+  swept; that frame's read-modify-write overwrites each word). Thresholds are kept.
+  The domain reset does the same. ``clear`` between frames, after draining, therefore
+  equals :meth:`ArrayContract.run` restarted at that frame.
+* ``thr`` (the shared :class:`~rvsm.rtl.interfaces.ThresholdWriteSignature`: ``we``,
+  ``addr = (s << word_bits) | (y*G + g)``, ``data`` = P thresholds, lane ``i`` at
+  ``[i*(W-1) +: W-1]``): writes one threshold word at the rising edge, at any
+  time. Position ``p`` reads its thresholds at the edge after the one accepting input
+  beat ``p + threshold_lag`` (a write at that same edge is not seen). So thresholds
+  written while
+  the stream is paused after ``t*H*G + threshold_lag`` accepted beats apply exactly from
+  frame ``t`` on (:meth:`StreamSchedule.threshold_pause_beat`); written after a clear
+  and before the first beat (as a loader does), they apply from frame 0. The threshold
+  memories are not initialised: load every threshold before streaming.
+
+The bit-accurate model is :meth:`ArrayContract.run`, rearranged into beats by
+:class:`~rvsm.rtl.stream.schedule.StreamSchedule`; the component is driven in
+``amaranth.sim`` by :mod:`rvsm.rtl.stream.drive`.
+"""
+
+from __future__ import annotations
+
+from amaranth.hdl import Cat, Const, Module, Mux, Signal, signed, unsigned
+from amaranth.lib import wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.rtl.stream.banked_memory import BankedMemory
+from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.pipelined_sum import Pipeline
+from rvsm.rtl.stream.schedule import StreamSchedule
+from rvsm.rtl.stream.signatures import (
+    code_beat_signature,
+    spike_beat_signature,
+    threshold_word_bits,
+    threshold_write_signature,
+)
+
+__all__ = ["RvsmStreamArray"]
+
+
+class RvsmStreamArray(wiring.Component):
+    """``S x H x W`` accumulators fed by a ``lanes``-wide raster stream of ADC codes.
+
+    Members: ``codes`` In(:func:`code_beat_signature`), ``spikes``
+    Out(:func:`spike_beat_signature`), ``thr`` In(:func:`threshold_write_signature`),
+    ``clear`` In(1); Verilog ports ``codes_payload``, ``codes_valid``, ``codes_ready``,
+    ``spikes_payload``, ``spikes_valid``, ``thr_we``, ``thr_addr``, ``thr_data``,
+    ``clear`` (:mod:`rvsm.rtl.ports`, described by :meth:`port_docs`). See the module
+    docstring for the schedule and the controls; sizes and the named timing properties
+    are in :attr:`geometry` (:class:`StreamGeometry`).
+    """
+
+    def __init__(self, contract: ArrayContract, lanes: int = 1,
+                 bank_words: int = StreamGeometry.BANK_WORDS):
+        geo = StreamGeometry(contract, lanes, bank_words)
+        self.geometry = geo
+        self.contract = contract
+        self.lanes = geo.lanes
+        self.groups = geo.groups
+        super().__init__(self.interface(contract, geo.lanes))
+
+    @staticmethod
+    def interface(contract: ArrayContract, lanes: int) -> wiring.Signature:
+        """The array's signature for ``contract`` and ``lanes`` (no component needed)."""
+        c = contract
+        geo = StreamGeometry(c, lanes)
+        return wiring.Signature({
+            "codes": In(code_beat_signature(c.adc_bits, geo.lanes)),
+            "spikes": Out(spike_beat_signature(c.num_scales, geo.lanes, c.height,
+                                               geo.groups)),
+            "thr": In(threshold_write_signature(c.num_scales, geo.beats_per_frame,
+                                                geo.lanes, c.threshold_bits)),
+            "clear": In(1),
+        })
+
+    @staticmethod
+    def port_docs(contract: ArrayContract, lanes: int) -> dict[str, str]:
+        """Meaning of every Verilog port (names as :func:`rvsm.rtl.ports.port_map`)."""
+        c = contract
+        geo = StreamGeometry(c, lanes)
+        p, n, g = geo.lanes, c.adc_bits, geo.groups
+        wb = threshold_word_bits(geo.beats_per_frame)
+        return {
+            "clk": "clock (rising edge)",
+            "rst": "synchronous reset: the state after a clear (memories untouched)",
+            "codes_payload": f"ADC codes of one beat: lane i = pixel (y, g*{p} + i) at bits "
+                             f"[i*{n} +: {n}]; beats in raster order (frame, row y, group "
+                             f"g = 0..{g - 1})",
+            "codes_valid": "the input beat is valid",
+            "codes_ready": "the array accepts a beat (low only while clear is high)",
+            "spikes_payload": "one output beat (fields below): position and S*P spikes",
+            "spikes_valid": "high for one cycle when a position is released",
+            "thr_we": "threshold write enable (one memory word per rising edge)",
+            "thr_addr": f"(scale s << {wb}) | (y*{g} + g)",
+            "thr_data": f"{p} thresholds, lane i at bits [i*{c.threshold_bits} +: "
+                        f"{c.threshold_bits}], each 1..{(1 << c.threshold_bits) - 1}",
+            "clear": "synchronous restart of the stream: positions in flight dropped, "
+                     "accumulators zero in the next frame, thresholds kept",
+        }
+
+    @property
+    def latency(self) -> int:
+        """:attr:`StreamGeometry.latency` (clock cycles, back-to-back beats)."""
+        return self.geometry.latency
+
+    @property
+    def lag(self) -> int:
+        """:attr:`StreamGeometry.lag` (beats)."""
+        return self.geometry.lag
+
+    @property
+    def schedule(self) -> StreamSchedule:
+        """:attr:`StreamGeometry.schedule`."""
+        return self.geometry.schedule
+
+    def elaborate(self, platform: object) -> Module:
+        """Line buffer, window, masks, sums, state memories, output register."""
+        m = Module()
+        c, geo = self.contract, self.geometry
+        h, n, p, g_count = c.height, c.adc_bits, geo.lanes, geo.groups
+        r, e = geo.radius, geo.edge_groups
+        words = geo.beats_per_frame
+        wa = c.accumulator_bits
+
+        # Input register: an accepted beat (and clear) acts one cycle later, so no
+        # combinational path runs from the ports into the datapath. Datapath registers
+        # are reset-less (only control state and valid bits are reset): less reset
+        # fan-out, and no next-state logic of the datapath depends on the ``rst`` port.
+        m.d.comb += self.codes.ready.eq(~self.clear)
+        advance = Signal(name="advance")
+        clear = Signal(name="clear_r")
+        codes_in = Signal(unsigned(p * n), name="codes_r", reset_less=True)
+        m.d.sync += [advance.eq(self.codes.valid & ~self.clear), clear.eq(self.clear)]
+        with m.If(self.codes.valid & ~self.clear):
+            m.d.sync += codes_in.eq(self.codes.payload.as_value())
+
+        # -- line buffer: word = 2L rows of P codes, row 0 the most recent -----------------
+        row_bits = p * n
+        g_in = Signal(range(g_count), name="in_group")
+        g_in_next = Mux(g_in == g_count - 1, 0, g_in + 1)
+        with m.If(clear):
+            m.d.sync += g_in.eq(0)
+        with m.Elif(advance):
+            m.d.sync += g_in.eq(g_in_next)
+        if r == 0:
+            stored = Const(0, 0)
+        elif g_count == 1:
+            stored = Signal(unsigned(2 * r * row_bits), name="line_buffer", reset_less=True)
+            with m.If(advance):
+                m.d.sync += stored.eq(Cat(codes_in, stored[:(2 * r - 1) * row_bits]))
+        else:
+            lb = Memory(shape=unsigned(2 * r * row_bits), depth=g_count, init=[])
+            m.submodules.line_buffer = lb
+            wp, rp = lb.write_port(), lb.read_port()
+            stored = rp.data
+            m.d.comb += [rp.addr.eq(Mux(clear, 0, g_in_next)),
+                         rp.en.eq(advance | clear),
+                         wp.addr.eq(g_in), wp.en.eq(advance),
+                         wp.data.eq(Cat(codes_in, stored[:(2 * r - 1) * row_bits]))]
+        # slab row d (0 = oldest, 2L = the input row): line-buffer row 2L-1-d
+        slab = Cat(*[stored[(2 * r - 1 - d) * row_bits:(2 * r - d) * row_bits]
+                     for d in range(2 * r)], codes_in)
+        slabs = [Signal(unsigned(len(slab)), name=f"slab{k}", reset_less=True)
+                 for k in range(2 * e + 1)]
+        with m.If(advance):
+            m.d.sync += slabs[0].eq(slab)
+            m.d.sync += [slabs[k].eq(slabs[k - 1]) for k in range(1, len(slabs))]
+
+        # -- window centre position (stage 0) and registered padding masks ----------------
+        lag = geo.window_lag
+        prime = Signal(range(lag + 1), name="prime")
+        primed = prime == lag
+        valid0 = Signal(name="valid_s0")
+        yc = Signal(range(h), name="centre_row")
+        gc = Signal(range(g_count), name="centre_group")
+        ac = Signal(range(words), name="centre_addr")
+        fresh0 = Signal(init=1, name="fresh_s0")
+        last0 = ac == words - 1
+        # valid0 is set only at an advance edge where primed holds, and primed stays set
+        # until a clear (which drops valid0 too): valid0 implies primed. So the position
+        # steps on valid0 alone, which keeps the prime counter out of the next-position
+        # logic (a critical path at 64x64, P = 8).
+        step = advance & valid0
+        g_end = gc == g_count - 1
+        ny, ng, na = Signal.like(yc), Signal.like(gc), Signal.like(ac)
+        with m.If(clear):
+            m.d.comb += [ny.eq(0), ng.eq(0), na.eq(0)]
+            m.d.sync += [prime.eq(0), valid0.eq(0), fresh0.eq(1)]
+        with m.Else():
+            with m.If(step):
+                m.d.comb += [ng.eq(Mux(g_end, 0, gc + 1)),
+                             ny.eq(Mux(g_end, Mux(yc == h - 1, 0, yc + 1), yc)),
+                             na.eq(Mux(last0, 0, ac + 1))]
+            with m.Else():
+                m.d.comb += [ny.eq(yc), ng.eq(gc), na.eq(ac)]
+            with m.If(advance):
+                m.d.sync += valid0.eq(primed)
+                if lag:
+                    with m.If(~primed):
+                        m.d.sync += prime.eq(prime + 1)
+                with m.If(step & last0):
+                    m.d.sync += fresh0.eq(0)
+        m.d.sync += [yc.eq(ny), gc.eq(ng), ac.eq(na)]
+        row_ok = Signal(2 * r + 1, name="row_mask")
+        col_ok = Signal(p + 2 * r, name="col_mask")
+        row_next = [(ny >= r - d) if d < r else (ny <= h - 1 - (d - r)) if d > r else Const(1)
+                    for d in range(2 * r + 1)]
+        col_next = []
+        for j in range(p + 2 * r):
+            if j < r:
+                col_next.append(ng >= -(-(r - j) // p))
+            elif j >= p + r:
+                col_next.append(ng <= -(-(c.width + r - j) // p) - 1)
+            else:
+                col_next.append(Const(1))
+        m.d.sync += [row_ok.eq(Cat(*row_next)), col_ok.eq(Cat(*col_next))]
+
+        # -- masked window (stage 1) and pipelined sums (stage Q) -------------------------
+        pipe = Pipeline(m, advance, geo.LEVELS_PER_STAGE, name="sum")
+        window = {}
+        for d, j in geo.window_cells():
+            q = e * p - r + j
+            src = slabs[2 * e - q // p]
+            lane = q % p
+            code = src[(d * p + lane) * n:(d * p + lane + 1) * n]
+            keep = row_ok[d] & col_ok[j] if (j < r or j >= p + r) else row_ok[d]
+            window[(d, j)] = pipe.register(pipe.timed(Mux(keep, code, 0), 0),
+                                           name=f"win_r{d}_c{j}")
+        sums, stage_q = geo.build_sums(pipe, window)
+        if stage_q != geo.sum_stage:
+            raise AssertionError("planned and built sum stages differ")
+        sums = [[pipe.at(t, stage_q) for t in lane] for lane in sums]
+
+        # -- position pipeline -------------------------------------------------------------
+        valid = [valid0]
+        for s in range(1, stage_q + geo.TAIL_STAGES):
+            v = Signal(name=f"valid_s{s}")
+            with m.If(clear):
+                m.d.sync += v.eq(0)
+            with m.Elif(advance):
+                m.d.sync += v.eq(valid[-1])
+            valid.append(v)
+        addr0, fresh_t, row_t = pipe.timed(ac), pipe.timed(fresh0), pipe.timed(yc)
+        group_t, last_t = pipe.timed(gc), pipe.timed(last0)
+        rd_addr = pipe.at(addr0, stage_q - 2).value
+        bank_q = pipe.at(addr0, stage_q).value >> (geo.bank_words - 1).bit_length()
+        fresh_q = pipe.at(fresh_t, stage_q).value
+        tail = stage_q + geo.TAIL_STAGES - 1  # the stage that writes back
+        wr_addr = pipe.at(addr0, tail).value
+        out_row, out_group = pipe.at(row_t, tail).value, pipe.at(group_t, tail).value
+        out_last = pipe.at(last_t, tail).value
+        wr_en = advance & valid[tail]
+
+        # -- state memories and the tail: add, compare/saturate, fire/reset ---------------
+        lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
+        tw = c.threshold_bits
+        # Threshold writes land one edge after the bus accepts them (a registered bus),
+        # so a read at the bus' edge does not see them; a read meeting the registered
+        # write at the next edge gets its data forwarded after the bank registers.
+        bus = self.thr
+        word_bits = threshold_word_bits(words)
+        bus_we = Signal(name="thr_we_r", reset_less=True)
+        bus_addr = Signal.like(bus.addr, name="thr_addr_r", reset_less=True)
+        bus_data = Signal.like(bus.data, name="thr_data_r", reset_less=True)
+        m.d.sync += [bus_we.eq(bus.we), bus_addr.eq(bus.addr), bus_data.eq(bus.data)]
+        bus_word = bus_addr[:word_bits]
+        bus_scale = bus_addr[word_bits:]
+        fwd_data = [Signal.like(bus.data, name=f"thr_fwd{k}_data", reset_less=True)
+                    for k in (1, 2)]  # shared by the scales
+        with m.If(advance):
+            m.d.sync += [fwd_data[0].eq(bus_data), fwd_data[1].eq(fwd_data[0])]
+        tail_stmts = []
+        pos_bits, neg_bits = [], []
+        for s in range(c.num_scales):
+            after_lanes = []
+            thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True)
+            m.submodules[f"thr_s{s}"] = thr_mem
+            m.d.comb += [thr_mem.advance.eq(advance), thr_mem.read_addr.eq(rd_addr),
+                         thr_mem.read_bank.eq(bank_q),
+                         thr_mem.write_en.eq(bus_we & (bus_scale == s)),
+                         thr_mem.write_addr.eq(bus_word), thr_mem.write_data.eq(bus_data),
+                         thr_mem.forward_hit.eq(bus_we & (bus_scale == s)
+                                                & (bus_word == rd_addr)),
+                         thr_mem.forward_data.eq(fwd_data[1])]
+            thr_q = thr_mem.data
+            after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
+            acc_mem = BankedMemory(p * wa, words, geo.bank_words,
+                                   guard_bits=geo.rmw_guard_bits)
+            m.submodules[f"acc_s{s}"] = acc_mem
+            m.d.comb += [acc_mem.advance.eq(advance), acc_mem.read_addr.eq(rd_addr),
+                         acc_mem.read_bank.eq(bank_q), acc_mem.write_en.eq(wr_en),
+                         acc_mem.write_addr.eq(wr_addr), acc_mem.write_data.eq(after_flat),
+                         acc_mem.may_write.eq(valid[tail])]
+            acc_q = acc_mem.data
+            for i in range(p):
+                acc = Mux(fresh_q, 0, acc_q[i * wa:(i + 1) * wa].as_signed())
+                shifted = sums[i][s].value.as_signed() >> c.shift
+                data = {"reset_less": True}
+                total = Signal(signed(max(wa, len(shifted)) + 1), name=f"total_s{s}_l{i}",
+                               **data)
+                thr1 = Signal(unsigned(tw), name=f"thr1_s{s}_l{i}", **data)
+                sat = Signal(signed(wa), name=f"sat_s{s}_l{i}", **data)
+                thr2 = Signal(unsigned(tw), name=f"thr2_s{s}_l{i}", **data)
+                pos = Signal(name=f"pos_s{s}_l{i}", **data)
+                neg = Signal(name=f"neg_s{s}_l{i}", **data)
+                fire_pos = total >= thr1
+                fire_neg = (~fire_pos & (total <= -thr1)) if c.signed else Const(0)
+                tail_stmts += [
+                    total.eq(acc + shifted),
+                    thr1.eq(thr_q[i * tw:(i + 1) * tw]),
+                    sat.eq(Mux(total > hi, hi, Mux(total < lo, lo, total))),
+                    pos.eq(fire_pos), neg.eq(fire_neg), thr2.eq(thr1),
+                ]
+                if c.reset == "zero":
+                    after = Mux(pos | neg, 0, sat)
+                else:
+                    after = Mux(pos, sat - thr2, Mux(neg, sat + thr2, sat))
+                after_lanes.append(after.as_unsigned()[:wa])
+                pos_bits.append(pos)
+                neg_bits.append(neg)
+            m.d.comb += after_flat.eq(Cat(*after_lanes))
+        out = self.spikes.payload
+        tail_stmts += [out.row.eq(out_row), out.group.eq(out_group), out.last.eq(out_last),
+                       out.pos.eq(Cat(*pos_bits)), out.neg.eq(Cat(*neg_bits))]
+        with m.If(advance):
+            m.d.sync += tail_stmts
+        m.d.sync += self.spikes.valid.eq(wr_en)
+        pipe.emit()
+        return m

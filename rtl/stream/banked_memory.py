@@ -1,0 +1,101 @@
+"""A state memory of the streaming array, split into block-RAM sized banks.
+
+:class:`BankedMemory` holds ``depth`` words of ``width`` bits in banks of at most
+``bank_words`` words (a power of two), each bank's read data registered before the
+bank multiplexer (ECP5 block-RAM timing). All registers load on ``advance`` (the
+array's beat advance), so stages count beats:
+
+* **Read.** ``read_addr`` is sampled at an ``advance`` edge; the bank's data is
+  registered at the next ``advance`` edge and multiplexed by ``read_bank``, which must
+  be the bank of that address delayed alike (one ``advance`` edge). ``data`` is the
+  result.
+* **Write.** One port: ``write_en``, ``write_addr``, ``write_data`` (the enable is used
+  as given; gate it with ``advance`` outside).
+* **Collisions.** A bank's read is disabled at an edge where the write port writes its
+  address: the read data is then undefined (yosys needs no read-first bypass
+  multiplexer after the block RAM). Either such collisions never meet a valid read, or
+  ``forward=True`` adds ``forward_hit`` / ``forward_data``: where ``forward_hit`` was set
+  with the read address, ``data`` is ``forward_data`` (the forwarded word, delayed
+  alike: two ``advance`` edges) instead of the read. ``guard_bits = k`` adds
+  ``may_write`` and gates the read where ``may_write`` holds and the low ``k`` address
+  bits match: a cheaper superset of the collisions, for a memory whose valid reads and
+  writes never match in those bits.
+"""
+
+from __future__ import annotations
+
+from amaranth.hdl import Const, Module, Mux, Shape, Signal, unsigned
+from amaranth.lib import wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+
+__all__ = ["BankedMemory"]
+
+
+class BankedMemory(wiring.Component):
+    """``depth`` words of ``width`` bits in banks of ``bank_words``; see the module
+    docstring for the ports ``advance``, ``read_addr``, ``read_bank``, ``write_en``,
+    ``write_addr``, ``write_data``, ``data`` and the optional ``forward_hit``,
+    ``forward_data`` (``forward=True``) and ``may_write`` (``guard_bits``)."""
+
+    def __init__(self, width: int, depth: int, bank_words: int, forward: bool = False,
+                 guard_bits: int | None = None):
+        self.width = width
+        self.depth = depth
+        self.bank_words = bank_words
+        self.bank_sizes = [min(bank_words, depth - i) for i in range(0, depth, bank_words)]
+        self.guard_bits = guard_bits
+        self.forward = forward
+        addr = Shape.cast(range(depth))
+        members = {
+            "advance": In(1),
+            "read_addr": In(addr),
+            "read_bank": In(addr),
+            "write_en": In(1),
+            "write_addr": In(addr),
+            "write_data": In(unsigned(width)),
+            "data": Out(unsigned(width)),
+        }
+        if forward:
+            members.update(forward_hit=In(1), forward_data=In(unsigned(width)))
+        if guard_bits is not None:
+            members["may_write"] = In(1)
+        super().__init__(members)
+
+    def elaborate(self, platform: object) -> Module:
+        """The banks, their read registers, the bank multiplexer and the forwarding."""
+        m = Module()
+        banked = len(self.bank_sizes) > 1
+        offset_bits = (self.bank_words - 1).bit_length()
+        outs = []
+        for b, depth in enumerate(self.bank_sizes):
+            mem = Memory(shape=unsigned(self.width), depth=depth, init=[])
+            m.submodules[f"b{b}"] = mem
+            wp = mem.write_port()
+            hit = (self.write_addr >> offset_bits) == b if banked else Const(1)
+            m.d.comb += [wp.addr.eq(self.write_addr[:offset_bits] if banked
+                                    else self.write_addr),
+                         wp.data.eq(self.write_data), wp.en.eq(self.write_en & hit)]
+            rp = mem.read_port()
+            m.d.comb += rp.addr.eq(self.read_addr[:offset_bits] if banked else self.read_addr)
+            if self.guard_bits is None:
+                collide = wp.en & (wp.addr == rp.addr)
+            else:
+                k = min(self.guard_bits, len(rp.addr))
+                collide = self.may_write & hit & (wp.addr[:k] == rp.addr[:k])
+            m.d.comb += rp.en.eq(self.advance & ~collide)
+            reg = Signal(unsigned(self.width), name=f"b{b}_q", reset_less=True)
+            with m.If(self.advance):
+                m.d.sync += reg.eq(rp.data)
+            outs.append(reg)
+        out = outs[-1]
+        for b in range(len(outs) - 2, -1, -1):
+            out = Mux(self.read_bank == b, outs[b], out)
+        if self.forward:
+            hit1 = Signal(name="fwd1", reset_less=True)
+            hit2 = Signal(name="fwd2", reset_less=True)
+            with m.If(self.advance):
+                m.d.sync += [hit1.eq(self.forward_hit), hit2.eq(hit1)]
+            out = Mux(hit2, self.forward_data, out)
+        m.d.comb += self.data.eq(out)
+        return m

@@ -1,0 +1,141 @@
+"""Drive the streaming array in ``amaranth.sim``: threshold loads, beats, output capture.
+
+:func:`threshold_writes` (address and data of every threshold word),
+:class:`BeatCollector` (records each presented output beat and the input beat that
+released it) and :func:`simulate` (a whole run: thresholds, segments between clears,
+flush, optional pauses and threshold updates) are shared by the ``amaranth.sim`` tests
+and anything else that drives :class:`~rvsm.rtl.stream.array.RvsmStreamArray`. Compare
+the beats with :func:`~rvsm.rtl.stream.schedule.check_beats`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.rtl.simulation import run_simulation
+from rvsm.rtl.stream.array import RvsmStreamArray
+from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.schedule import OutputBeats, pack_lanes
+from rvsm.rtl.stream.signatures import threshold_word_bits
+
+__all__ = ["BeatCollector", "simulate", "threshold_writes", "write_thresholds"]
+
+#: Payload fields of an output beat, in :meth:`OutputBeats.from_words` order.
+FIELDS = ("row", "group", "last", "pos", "neg")
+
+
+def threshold_writes(geometry: StreamGeometry, thresholds: np.ndarray
+                     ) -> list[tuple[int, int]]:
+    """``(addr, data)`` of every threshold word for thresholds ``(S, H, W)``: scale by
+    scale, word ``y*G + g`` in order (``addr = (s << word_bits) | word``)."""
+    c, sched = geometry.contract, geometry.schedule
+    words = sched.threshold_words(np.asarray(thresholds, dtype=np.int64))
+    packed = pack_lanes(words.reshape(-1, geometry.lanes), c.threshold_bits)
+    word_bits = threshold_word_bits(sched.beats_per_frame)
+    n = sched.beats_per_frame
+    return [((k // n) << word_bits | k % n, word) for k, word in enumerate(packed)]
+
+
+async def write_thresholds(ctx, dut: RvsmStreamArray,  # noqa: ANN001 - SimulatorContext
+                           thresholds: np.ndarray) -> None:
+    """Write every threshold word through ``dut.thr``, one per clock; ``we`` low after."""
+    for addr, word in threshold_writes(dut.geometry, thresholds):
+        ctx.set(dut.thr.we, 1)
+        ctx.set(dut.thr.addr, addr)
+        ctx.set(dut.thr.data, word)
+        await ctx.tick()
+    ctx.set(dut.thr.we, 0)
+
+
+class BeatCollector:
+    """Records the output beats of ``dut``: call :meth:`after_edge` after every clock
+    edge with the index of the input beat accepted at it (-1: none)."""
+
+    def __init__(self, dut: RvsmStreamArray):
+        self.dut = dut
+        layout = dut.geometry.spike_layout
+        self.fields = {name: (layout[name].offset, layout[name].width) for name in FIELDS}
+        self.got: dict[str, list[int]] = {k: [] for k in (*FIELDS, "accepted")}
+        self._accepted = [-1, -1]  # beats accepted at the previous and the latest edge
+
+    def after_edge(self, ctx, beat: int) -> None:  # noqa: ANN001 - SimulatorContext
+        """Record the output presented after an edge that accepted ``beat``."""
+        self._accepted[:] = [self._accepted[1], beat]
+        if ctx.get(self.dut.spikes.valid):
+            word = ctx.get(self.dut.spikes.payload.as_value())
+            for k, (off, width) in self.fields.items():
+                self.got[k].append((word >> off) & ((1 << width) - 1))
+            self.got["accepted"].append(self._accepted[0])
+
+    def beats(self) -> OutputBeats:
+        """The beats recorded so far; ``accepted`` the input beat that released each."""
+        c, geo = self.dut.contract, self.dut.geometry
+        return OutputBeats.from_words(*(self.got[k] for k in FIELDS), c.num_scales,
+                                      geo.lanes, self.got["accepted"])
+
+
+def simulate(
+    contract: ArrayContract,
+    codes: np.ndarray,
+    thresholds: np.ndarray,
+    lanes: int = 1,
+    clear_before: Sequence[int] = (),
+    threshold_updates: Mapping[int, np.ndarray] | None = None,
+    idle_every: int = 0,
+    bank_words: int = StreamGeometry.BANK_WORDS,
+    vcd_path: str | None = None,
+) -> OutputBeats:
+    """Run :class:`RvsmStreamArray` in ``amaranth.sim``; return every output beat.
+
+    Thresholds ``(S, H, W)`` are written through ``thr``; each segment between
+    ``clear_before`` steps is streamed back to back, flushed with ``lag`` beats and
+    followed by a one-cycle ``clear``. ``threshold_updates`` maps a frame ``t`` (of the
+    first segment) to thresholds written while the stream is paused at
+    :meth:`StreamSchedule.threshold_pause_beat` ``(t)``. ``idle_every = k > 0`` drops
+    ``valid`` for one cycle after every ``k``-th beat (a paused stream). Compare the
+    result with :func:`~rvsm.rtl.stream.schedule.check_beats`; its ``accepted`` holds,
+    per output beat, the index (within its segment) of the input beat accepted two
+    cycles before it was presented, the beat that released it.
+    """
+    c = contract
+    codes = np.asarray(codes, dtype=np.int64)
+    dut = RvsmStreamArray(c, lanes, bank_words)
+    sched = dut.schedule
+    updates = dict(threshold_updates or {})
+    out = BeatCollector(dut)
+
+    async def bench(ctx) -> None:  # noqa: ANN001 - SimulatorContext
+        await write_thresholds(ctx, dut, thresholds)
+        for seg, (a, b) in enumerate(sched.segments(len(codes), clear_before)):
+            if seg:
+                ctx.set(dut.clear, 1)
+                await ctx.tick()
+                out.after_edge(ctx, -1)
+                ctx.set(dut.clear, 0)
+            beats = pack_lanes(sched.input_beats(codes[a:b]), c.adc_bits)
+            pauses = {sched.threshold_pause_beat(t): thr for t, thr in updates.items()} \
+                if seg == 0 else {}
+            for k, word in enumerate(beats):
+                if k in pauses:
+                    ctx.set(dut.codes.valid, 0)
+                    await ctx.tick()
+                    out.after_edge(ctx, -1)
+                    await write_thresholds(ctx, dut, pauses[k])
+                ctx.set(dut.codes.payload.as_value(), word)
+                ctx.set(dut.codes.valid, 1)
+                await ctx.tick()
+                out.after_edge(ctx, k)
+                if idle_every and (k + 1) % idle_every == 0:
+                    ctx.set(dut.codes.valid, 0)
+                    await ctx.tick()
+                    out.after_edge(ctx, -1)
+            ctx.set(dut.codes.valid, 0)
+            for _ in range(2):
+                await ctx.tick()
+                out.after_edge(ctx, -1)
+
+    run_simulation(dut, bench, vcd_path)
+    return out.beats()
