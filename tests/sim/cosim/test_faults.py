@@ -241,7 +241,7 @@ def test_testbench_crash_is_a_tool_error(tmp_path: Path, small_contract,
     """))
     monkeypatch.syspath_prepend(str(mods))
     c = small_contract("fsm", 2, 2, frac_bits=0, acc_bits=6, shift=0, reset="zero")
-    sb = build(c, "icarus", tmp_path / "builds")
+    sb = build(c, "icarus", tmp_path / "builds", arch="parallel")
     stim = tmp_path / "run" / "stimulus.npz"
     stim.parent.mkdir()
     stim.write_bytes(b"")
@@ -289,18 +289,18 @@ def test_damaged_builds_are_rebuilt(tmp_path: Path, small_contract,
                                     capsys: pytest.CaptureFixture) -> None:
     c = small_contract("fsm", 2, 2, frac_bits=0, acc_bits=6, shift=0, reset="zero")
     root = tmp_path / "builds"
-    first = build(c, "icarus", root)
-    assert not first.cached and build(c, "icarus", root).cached
+    first = build(c, "icarus", root, arch="parallel")
+    assert not first.cached and build(c, "icarus", root, arch="parallel").cached
     folder = first.build_dir.parent
     (first.build_dir / "sim.vvp").unlink()
-    again = build(c, "icarus", root)
+    again = build(c, "icarus", root, arch="parallel")
     assert not again.cached and (again.build_dir / "sim.vvp").exists()
     assert "is damaged" in capsys.readouterr().err
     (folder / "build.json").write_text("")
-    assert not build(c, "icarus", root).cached
+    assert not build(c, "icarus", root, arch="parallel").cached
     (folder / "sim_build" / "sim.vvp").write_text("garbage")
-    assert not build(c, "icarus", root).cached
-    assert build(c, "icarus", root).cached
+    assert not build(c, "icarus", root, arch="parallel").cached
+    assert build(c, "icarus", root, arch="parallel").cached
     assert _leftovers(root) == []
 
 
