@@ -1,10 +1,10 @@
 """A thin adapter to cocotb's public runner API: build a Verilog top, run a testbench on it.
 
-The caller says what to build (Verilog file, top name, build folder, tracing) and what to
-run (testbench module, test folder, environment); this module knows the simulators, not
-the architectures. Each call runs ``cocotb_tools.runner.get_runner(sim).build(...)`` or
-``.test(...)`` with their documented arguments in a child Python,
-:mod:`rvsm.sim.cosim.cocotb_job`, started through
+The caller says what to build (Verilog file, top name and ports, build folder, tracing)
+and what to run (testbench module, test folder, environment); this module knows the
+simulators, not the architectures. Each call runs
+``cocotb_tools.runner.get_runner(sim).build(...)`` or ``.test(...)`` with their documented
+arguments in a child Python, :mod:`rvsm.sim.cosim.cocotb_job`, started through
 :func:`rvsm.model.infra.tools.run_tool`:
 
 * the job and every simulator, compiler and ``make`` it starts are one process group of
@@ -22,16 +22,16 @@ Verilator: cocotb's runner always passes ``--public-flat-rw`` (every signal of e
 visible to VPI) and has no switch for it. Its public ``build_args`` come after it on
 Verilator's command line and Verilator's on/off options take the last value given, so
 ``--no-public-flat-rw`` (:data:`VERILATOR_BUILD_ARGS`) turns it off; a Verilator control
-file, ``public.vlt``, passed as a source (cocotb's runner takes ``.vlt`` sources), makes
-the top-level ports the caller names public: all the testbench touches.
-(``--public-depth 1`` does not undo ``--public-flat-rw``, and after
-``--no-public-flat-rw`` it still exposes every wire of the top module.) Measured with
-``verilator --cc`` on the default dog4 design point at 16x16: the streaming array (4
-lanes, 0.16 MB of Verilog) 1.37 MB of C++ and 1610 VPI variables with
-``--public-flat-rw``, the same with ``--public-depth 1``, 0.42 MB and 22 (its 11 ports,
-in two scopes) with the control file; the parallel array (6.2 MB of Verilog, one module
-per cell) 55.4 MB with ``--public-flat-rw`` or ``--public-depth 1`` added, 34.4 MB with
-``--no-public-flat-rw --public-depth 1``.
+file, ``public.vlt`` (:func:`public_ports_control`), passed as a source (cocotb's runner
+takes ``.vlt`` sources), makes the top-level ports the caller names public: all the
+testbench touches. ``--public-depth 1`` (what this package used before) does not undo
+``--public-flat-rw`` when added to it, and without it still exposes every wire of the
+top module. Measured with ``verilator --cc`` on the default dog4 design point at 16x16:
+the streaming array (4 lanes, 0.16 MB of Verilog, one flat module) makes 1.37 MB of C++
+and 1610 VPI variables with cocotb's flag, the same with ``--public-depth 1`` instead,
+0.42 MB and 22 (its 11 ports, in two scopes) with the control file; the parallel array
+(6.2 MB of Verilog, a module per cell) 55.4 MB with cocotb's flag (also with
+``--public-depth 1`` added), 34.4 MB with ``--public-depth 1`` instead.
 """
 
 from __future__ import annotations

@@ -47,7 +47,9 @@ def main(argv: Sequence[str]) -> int:
 
     def audit(event: str, args: tuple) -> None:
         if event == "subprocess.Popen":
-            started.append([os.fspath(a) for a in args[1]])
+            cmd = args[1]
+            started.append([os.fsdecode(cmd)] if isinstance(cmd, (str, bytes))
+                           else [os.fsdecode(a) for a in cmd])
 
     sys.addaudithook(audit)
     sys.path[:] = safe_path(sys.path)
