@@ -11,12 +11,11 @@ chunked writer (:class:`DatWriter`, a spike sink) and a chunked reader
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from rvsm.model.infra.atomic import _UMASK, atomic_path
+from rvsm.model.infra.atomic import PartialFile, atomic_path
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.memory import require_memory
 from rvsm.model.spikes.arrays import single_scale_spikes
@@ -84,7 +83,7 @@ class DatWriter:
         self.path = Path(path)
         self.flip = flip
         self._handle = None
-        self._tmp: Path | None = None
+        self._partial: PartialFile | None = None
 
     def begin(self, shape, meta) -> None:
         t, s, h, w = shape
@@ -93,11 +92,8 @@ class DatWriter:
                             f"have {s} scales")
         if (h * w) % 8:
             raise RvsmError(f".dat needs H*W divisible by 8 (8 pixels per byte), got {h}x{w}")
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.stem}.", suffix=".partial.dat",
-                                   dir=self.path.parent)
-        self._handle = os.fdopen(fd, "wb")
-        self._tmp = Path(tmp)
+        self._partial = PartialFile(self.path)
+        self._handle = open(self._partial.path, "wb")  # closed in finish / abort
 
     def write(self, t0, spikes) -> None:
         arr = spikes[:, 0]
@@ -112,17 +108,16 @@ class DatWriter:
     def finish(self, meta) -> None:
         self._handle.close()
         self._handle = None
-        os.chmod(self._tmp, 0o666 & ~_UMASK)
-        os.replace(self._tmp, self.path)
-        self._tmp = None
+        self._partial.commit()
+        self._partial = None
 
     def abort(self) -> None:
         if self._handle is not None:
             self._handle.close()
             self._handle = None
-        if self._tmp is not None and self._tmp.exists():
-            self._tmp.unlink()
-        self._tmp = None
+        if self._partial is not None:
+            self._partial.abort()
+        self._partial = None
 
 
 def dat_source(path: str | os.PathLike, height: int, width: int,

@@ -22,12 +22,11 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from rvsm.model.infra.atomic import _UMASK
+from rvsm.model.infra.atomic import PartialFile
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.versions import with_versions
 from rvsm.model.spikes.packing import pack_spikes, packed_width, unpack_spikes
@@ -67,19 +66,15 @@ class H5SpikeWriter:
         self.path = Path(path)
         self.compression = None if compression == "none" else compression
         self._file = None
-        self._tmp: Path | None = None
+        self._partial: PartialFile | None = None
         self._dset = None
         self.steps_written = 0
 
     def begin(self, shape, meta) -> None:
         h5py = _h5py()
         t, s, h, w = (int(v) for v in shape)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.stem}.", suffix=".partial.h5",
-                                   dir=self.path.parent)
-        os.close(fd)
-        self._tmp = Path(tmp)
-        self._file = h5py.File(self._tmp, "w")
+        self._partial = PartialFile(self.path)
+        self._file = h5py.File(self._partial.path, "w")
         wb, dtype = (packed_width(w), np.uint8) if self.encoding == "2bit" else (w, np.int8)
         chunk_t = max(1, min(max(t, 1), CHUNK_BYTES // max(h * wb, 1)))
         opts = {"compression": self.compression} if self.compression else {}
@@ -112,18 +107,17 @@ class H5SpikeWriter:
         self._file.attrs["complete"] = True
         self._file.close()
         self._file = None
-        os.chmod(self._tmp, 0o666 & ~_UMASK)
-        os.replace(self._tmp, self.path)
-        self._tmp = None
+        self._partial.commit()
+        self._partial = None
 
     def abort(self) -> None:
         if self._file is not None:
             with contextlib.suppress(Exception):
                 self._file.close()
             self._file = None
-        if self._tmp is not None and self._tmp.exists():
-            self._tmp.unlink()
-        self._tmp = None
+        if self._partial is not None:
+            self._partial.abort()
+        self._partial = None
 
 
 def open_h5(path: str | os.PathLike) -> SpikeSource:

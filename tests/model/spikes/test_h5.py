@@ -57,7 +57,7 @@ def test_incomplete_or_foreign_files_are_refused(tmp_path):
     sink.begin((4, 1, 4, 4), {})
     sink.write(0, _spikes((4, 1, 4, 4)))
     sink._file.close()  # as if the process died here: never marked complete
-    sink._tmp.rename(path)
+    sink._partial.path.rename(path)
     with pytest.raises(RvsmError, match="incomplete"):
         open_spikes(path)
     other = tmp_path / "other.h5"
