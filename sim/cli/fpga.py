@@ -67,7 +67,7 @@ def _fpga(args: argparse.Namespace) -> int:
     point = load_design_point(args.point)
     arch.check((point.with_size(*args.size) if args.size else point).contract(), **options)
 
-    def progress(p) -> None:  # noqa: ANN001 - rvsm.rtl.fpga.tools.Progress
+    def progress(p) -> None:  # noqa: ANN001 - rvsm.model.infra.tools.Progress
         if not args.quiet:
             print(f"rvsm fpga: {p.line()}", file=sys.stderr, flush=True)
 
