@@ -73,7 +73,9 @@ The bit-accurate model is :meth:`ArrayContract.run`, rearranged into beats by
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, Const, Module, Mux, Signal, signed, unsigned
+from dataclasses import dataclass
+
+from amaranth.hdl import Cat, Const, Module, Mux, Signal, Value, signed, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -81,7 +83,7 @@ from amaranth.lib.wiring import In, Out
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.rtl.stream.banked_memory import BankedMemory
 from rvsm.rtl.stream.geometry import StreamGeometry
-from rvsm.rtl.stream.pipelined_sum import Pipeline
+from rvsm.rtl.stream.pipelined_sum import Pipeline, Timed
 from rvsm.rtl.stream.schedule import StreamSchedule
 from rvsm.rtl.stream.signatures import (
     code_beat_signature,
@@ -91,6 +93,37 @@ from rvsm.rtl.stream.signatures import (
 )
 
 __all__ = ["RvsmStreamArray"]
+
+
+@dataclass(frozen=True)
+class _Centre:
+    """The window centre at stage 0: valid bit, row, column group, address, whether it is
+    in the first frame after a clear, whether it is a frame's last position, and the
+    registered padding masks (one bit per window row / column)."""
+
+    valid0: Signal
+    yc: Signal
+    gc: Signal
+    ac: Signal
+    fresh0: Signal
+    last0: Value
+    row_ok: Signal
+    col_ok: Signal
+
+
+@dataclass(frozen=True)
+class _Tail:
+    """What the state memories and the tail need from the position pipeline."""
+
+    rd_addr: Value
+    bank_q: Value
+    fresh_q: Value
+    wr_addr: Value
+    wr_en: Value
+    valid: Signal
+    row: Value
+    group: Value
+    last: Value
 
 
 class RvsmStreamArray(wiring.Component):
@@ -169,18 +202,25 @@ class RvsmStreamArray(wiring.Component):
         return self.geometry.schedule
 
     def elaborate(self, platform: object) -> Module:
-        """Line buffer, window, masks, sums, state memories, output register."""
+        """Input register, line buffer, window, masks, sums, state memories, output
+        register: one method per stage group, in datapath order."""
         m = Module()
-        c, geo = self.contract, self.geometry
-        h, n, p, g_count = c.height, c.adc_bits, geo.lanes, geo.groups
-        r, e = geo.radius, geo.edge_groups
-        words = geo.beats_per_frame
-        wa = c.accumulator_bits
+        advance, clear, codes_in = self._input_register(m)
+        slabs = self._line_buffer(m, advance, clear, codes_in)
+        centre = self._window_centre(m, advance, clear)
+        pipe = Pipeline(m, advance, self.geometry.LEVELS_PER_STAGE, name="sum")
+        sums, stage_q = self._window_sums(pipe, slabs, centre)
+        tail = self._position_pipeline(m, pipe, advance, clear, centre, stage_q)
+        self._state_and_output(m, advance, sums, tail)
+        pipe.emit()
+        return m
 
-        # Input register: an accepted beat (and clear) acts one cycle later, so no
-        # combinational path runs from the ports into the datapath. Datapath registers
-        # are reset-less (only control state and valid bits are reset): less reset
-        # fan-out, and no next-state logic of the datapath depends on the ``rst`` port.
+    def _input_register(self, m: Module) -> tuple[Signal, Signal, Signal]:
+        """``(advance, clear_r, codes_r)``: an accepted beat (and clear) acts one cycle
+        later, so no combinational path runs from the ports into the datapath. Datapath
+        registers are reset-less (only control state and valid bits are reset): less
+        reset fan-out, and no next-state logic of the datapath depends on ``rst``."""
+        p, n = self.geometry.lanes, self.contract.adc_bits
         m.d.comb += self.codes.ready.eq(~self.clear)
         advance = Signal(name="advance")
         clear = Signal(name="clear_r")
@@ -188,8 +228,16 @@ class RvsmStreamArray(wiring.Component):
         m.d.sync += [advance.eq(self.codes.valid & ~self.clear), clear.eq(self.clear)]
         with m.If(self.codes.valid & ~self.clear):
             m.d.sync += codes_in.eq(self.codes.payload.as_value())
+        return advance, clear, codes_in
 
-        # -- line buffer: word = 2L rows of P codes, row 0 the most recent -----------------
+    def _line_buffer(self, m: Module, advance: Signal, clear: Signal, codes_in: Signal
+                     ) -> list[Signal]:
+        """The ``2E+1`` column-group slabs of ``2L+1`` rows (stage 0): a line buffer
+        whose word is 2L rows of P codes (row 0 the most recent), then the window
+        register."""
+        c, geo = self.contract, self.geometry
+        n, p, g_count = c.adc_bits, geo.lanes, geo.groups
+        r, e = geo.radius, geo.edge_groups
         row_bits = p * n
         g_in = Signal(range(g_count), name="in_group")
         g_in_next = Mux(g_in == g_count - 1, 0, g_in + 1)
@@ -220,8 +268,13 @@ class RvsmStreamArray(wiring.Component):
         with m.If(advance):
             m.d.sync += slabs[0].eq(slab)
             m.d.sync += [slabs[k].eq(slabs[k - 1]) for k in range(1, len(slabs))]
+        return slabs
 
-        # -- window centre position (stage 0) and registered padding masks ----------------
+    def _window_centre(self, m: Module, advance: Signal, clear: Signal) -> _Centre:
+        """The window centre's position (stage 0) and the registered padding masks."""
+        c, geo = self.contract, self.geometry
+        h, p, g_count, r = c.height, geo.lanes, geo.groups, geo.radius
+        words = geo.beats_per_frame
         lag = geo.window_lag
         prime = Signal(range(lag + 1), name="prime")
         primed = prime == lag
@@ -269,9 +322,15 @@ class RvsmStreamArray(wiring.Component):
             else:
                 col_next.append(Const(1))
         m.d.sync += [row_ok.eq(Cat(*row_next)), col_ok.eq(Cat(*col_next))]
+        return _Centre(valid0, yc, gc, ac, fresh0, last0, row_ok, col_ok)
 
-        # -- masked window (stage 1) and pipelined sums (stage Q) -------------------------
-        pipe = Pipeline(m, advance, geo.LEVELS_PER_STAGE, name="sum")
+    def _window_sums(self, pipe: Pipeline, slabs: list[Signal], centre: _Centre
+                     ) -> tuple[list[list[Timed]], int]:
+        """The masked window (stage 1) and every lane's per-scale sums at stage Q:
+        ``(sums[lane][scale], Q)``."""
+        geo = self.geometry
+        n, p, r, e = self.contract.adc_bits, geo.lanes, geo.radius, geo.edge_groups
+        row_ok, col_ok = centre.row_ok, centre.col_ok
         window = {}
         for d, j in geo.window_cells():
             q = e * p - r + j
@@ -285,8 +344,15 @@ class RvsmStreamArray(wiring.Component):
         if stage_q != geo.sum_stage:
             raise AssertionError("planned and built sum stages differ")
         sums = [[pipe.at(t, stage_q) for t in lane] for lane in sums]
+        return sums, stage_q
 
-        # -- position pipeline -------------------------------------------------------------
+    def _position_pipeline(self, m: Module, pipe: Pipeline, advance: Signal, clear: Signal,
+                           centre: _Centre, stage_q: int) -> _Tail:
+        """Valid bits and the position carried along the pipeline to the state-memory
+        read (stage Q-2), the add (Q) and the write-back and output (the tail)."""
+        geo = self.geometry
+        valid0, ac, fresh0, yc, gc, last0 = (centre.valid0, centre.ac, centre.fresh0,
+                                             centre.yc, centre.gc, centre.last0)
         valid = [valid0]
         for s in range(1, stage_q + geo.TAIL_STAGES):
             v = Signal(name=f"valid_s{s}")
@@ -305,8 +371,17 @@ class RvsmStreamArray(wiring.Component):
         out_row, out_group = pipe.at(row_t, tail).value, pipe.at(group_t, tail).value
         out_last = pipe.at(last_t, tail).value
         wr_en = advance & valid[tail]
+        return _Tail(rd_addr, bank_q, fresh_q, wr_addr, wr_en, valid[tail], out_row,
+                     out_group, out_last)
 
-        # -- state memories and the tail: add, compare/saturate, fire/reset ---------------
+    def _state_and_output(self, m: Module, advance: Signal, sums: list[list[Timed]],
+                          tail: _Tail) -> None:
+        """Per scale the threshold and accumulator memories, then the tail: add,
+        compare/saturate, fire/reset, write back; spikes and position on the output."""
+        c, geo = self.contract, self.geometry
+        p, words, wa = geo.lanes, geo.beats_per_frame, c.accumulator_bits
+        rd_addr, bank_q, fresh_q, wr_addr, wr_en = (tail.rd_addr, tail.bank_q, tail.fresh_q,
+                                                    tail.wr_addr, tail.wr_en)
         lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
         tw = c.threshold_bits
         # Threshold writes land one edge after the bus accepts them (a registered bus),
@@ -345,7 +420,7 @@ class RvsmStreamArray(wiring.Component):
             m.d.comb += [acc_mem.advance.eq(advance), acc_mem.read_addr.eq(rd_addr),
                          acc_mem.read_bank.eq(bank_q), acc_mem.write_en.eq(wr_en),
                          acc_mem.write_addr.eq(wr_addr), acc_mem.write_data.eq(after_flat),
-                         acc_mem.may_write.eq(valid[tail])]
+                         acc_mem.may_write.eq(tail.valid)]
             acc_q = acc_mem.data
             for i in range(p):
                 acc = Mux(fresh_q, 0, acc_q[i * wa:(i + 1) * wa].as_signed())
@@ -375,10 +450,8 @@ class RvsmStreamArray(wiring.Component):
                 neg_bits.append(neg)
             m.d.comb += after_flat.eq(Cat(*after_lanes))
         out = self.spikes.payload
-        tail_stmts += [out.row.eq(out_row), out.group.eq(out_group), out.last.eq(out_last),
+        tail_stmts += [out.row.eq(tail.row), out.group.eq(tail.group), out.last.eq(tail.last),
                        out.pos.eq(Cat(*pos_bits)), out.neg.eq(Cat(*neg_bits))]
         with m.If(advance):
             m.d.sync += tail_stmts
         m.d.sync += self.spikes.valid.eq(wr_en)
-        pipe.emit()
-        return m
