@@ -249,3 +249,17 @@ def test_checker_passes_a_clean_tree(tmp_path):
     arrows = all_arrows(packages)
     assert not wrong_way(arrows) and not circles(arrows)
     assert ("rvsm.model", "rvsm.model.a") in {(a.source, a.target) for a in arrows}
+
+
+def test_every_package_is_listed_in_pyproject():
+    """A sub-package missing from ``[tool.setuptools] packages`` would be left out of a
+    wheel (an editable install hides it)."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+                 ["packages"])
+    found = {name for name, path in module_files(PACKAGES).items()
+             if path.name == "__init__.py"}
+    assert found == listed, f"missing: {sorted(found - listed)}; stale: {sorted(listed - found)}"
