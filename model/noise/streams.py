@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 from numba import njit, prange
 
@@ -187,8 +186,3 @@ def normal_block(
         np.uint64(key), int(t0), int(num_steps), int(shape[0]), int(shape[1]),
         float(mean), float(sd), ZIG_X, ZIG_RATIO,
     )
-
-
-def numba_threads() -> int:
-    """Threads numba's parallel loops use now."""
-    return numba.get_num_threads()
