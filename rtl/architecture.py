@@ -12,7 +12,7 @@ FPGA flow look an architecture up there instead of testing its options.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -52,7 +52,10 @@ class Architecture:
     * ``compare(contract, expected, output, **options)``: the expected-output model: the
       contract's spikes ``(T, S, H, W)`` against what the RTL produced; returns
       ``compared``, ``mismatches``, ``first_mismatch``, ``mismatch_list``;
-    * ``testbench``: the cocotb testbench module (a name: rtl does not import sim).
+    * ``testbench``: the cocotb testbench module (a name: rtl does not import sim);
+    * ``formal``: formal harness factories by check name (``"properties"``,
+      ``"equivalence"``): ``factory(contract, mutation=None, **options)`` returns a
+      :class:`~rvsm.rtl.formal.FormalHarness` (``rvsm formal``).
     """
 
     name: str
@@ -69,6 +72,7 @@ class Architecture:
     simulate: Callable[..., Any]
     compare: Callable[..., dict]
     testbench: str
+    formal: Mapping[str, Callable[..., Any]] = field(default_factory=dict)
 
     def resolve(self, given: Mapping[str, int | None] | None = None) -> dict[str, int]:
         """The options from ``given`` (``None`` values: not given), defaults filled in;

@@ -35,6 +35,7 @@ from amaranth.lib.wiring import In, Out
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.widths import index_bits, unsigned_max
 from rvsm.rtl.interfaces import ThresholdWriteSignature
+from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.pixel_cell import PixelCell
 from rvsm.rtl.receptive_sum import sum_width, weighted_sum
 
@@ -58,8 +59,10 @@ class RvsmArray(wiring.Component):
     #: Clock cycles from the strobe edge sampling ``codes`` to valid spike outputs.
     LATENCY = PixelCell.LATENCY
 
-    def __init__(self, contract: ArrayContract):
+    def __init__(self, contract: ArrayContract, mutation: str | None = None):
         self.contract = contract
+        #: A deliberate bug (:mod:`rvsm.rtl.mutations`) or None (the shipped logic).
+        self.mutation = check_mutation(mutation, "parallel")
         self.num_accumulators = contract.num_scales * contract.height * contract.width
         self.addr_bits = index_bits(self.num_accumulators)
         super().__init__(self.interface(contract))

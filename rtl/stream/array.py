@@ -81,6 +81,7 @@ from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from rvsm.model.fixed.core import ArrayContract
+from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.stream.banked_memory import BankedMemory
 from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.pipelined_sum import Pipeline, Timed
@@ -139,8 +140,10 @@ class RvsmStreamArray(wiring.Component):
     """
 
     def __init__(self, contract: ArrayContract, lanes: int = 1,
-                 bank_words: int = StreamGeometry.BANK_WORDS):
+                 bank_words: int = StreamGeometry.BANK_WORDS, mutation: str | None = None):
         geo = StreamGeometry(contract, lanes, bank_words)
+        #: A deliberate bug (:mod:`rvsm.rtl.mutations`) or None (the shipped logic).
+        self.mutation = check_mutation(mutation, "stream")
         self.geometry = geo
         self.contract = contract
         self.lanes = geo.lanes

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 from amaranth.asserts import AnySeq
-from amaranth.hdl import Assert, Cover, Elaboratable, Module, Signal
+from amaranth.hdl import Assert, Cover, Elaboratable, Module, Mux, Signal
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.sim.formal.sby import run_sby
@@ -59,3 +59,29 @@ def _assert_line() -> int:
     import inspect
     lines, start = inspect.getsourcelines(WrappingCounter.elaborate)
     return start + next(i for i, line in enumerate(lines) if "Assert(" in line)
+
+
+def test_harness_names_the_failing_property(tmp_path):
+    from rvsm.rtl.formal import FormalHarness, property_at
+
+    class Harness(FormalHarness):
+        def __init__(self, wrap):
+            super().__init__()
+            self.wrap = wrap
+
+        def elaborate(self, platform):
+            m = Module()
+            count = Signal(4)
+            with m.If(AnySeq(1)):
+                m.d.sync += count.eq(Mux(count == self.wrap, 0, count + 1))
+            self.check(m, "count.bounded", count <= 10, "count stays at most 10")
+            self.check(m, "count.reaches_ten", count == 10, "ten is reachable", "cover")
+            return m
+
+    good, bad = Harness(10), Harness(15)
+    assert [p.name for p in good.statements()] == ["count.bounded", "count.reaches_ten"]
+    result = run_sby(bad, tmp_path, mode="bmc", depth=15)
+    assert result.status == "FAIL"
+    props = bad.statements()
+    assert property_at(props, result.failed[0]).name == "count.bounded"
+    assert run_sby(good, tmp_path / "good", mode="prove", depth=12).passed

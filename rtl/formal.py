@@ -1,0 +1,94 @@
+"""Formal harnesses: named properties around an RTL block, for ``rvsm formal``.
+
+A harness (:class:`FormalHarness`) is an ``Elaboratable`` that instantiates a block (the
+streaming array, the parallel array, a miter of two), drives its inputs from
+``AnySeq``/``AnyConst`` (``amaranth.asserts``) under ``Assume`` s, and states what must
+hold with ``Assert`` and what must be reachable with ``Cover``. Every statement is made
+through :meth:`FormalHarness.check` so that it has a name, a description and the source
+line sby reports (``file:line``), which :func:`property_at` maps back to the name.
+
+Properties never reach a user's Verilog: harnesses are only elaborated for the
+``"formal"`` platform (``rtlil.convert(..., platform="formal")``). A harness must drive or
+constrain the ``sync`` domain's reset itself (sby runs it with ``multiclock off``: every
+step is one clock edge; an unconstrained ``rst`` is a free input).
+
+Architectures list their harness factories in :attr:`Architecture.formal`:
+``factory(contract, mutation=None, **options) -> FormalHarness``.
+"""
+
+from __future__ import annotations
+
+import inspect
+import os
+from dataclasses import dataclass
+
+from amaranth.hdl import Assert, Assume, Cover, Elaboratable, Module, Value
+
+__all__ = ["KINDS", "FormalHarness", "Property", "property_at"]
+
+#: Statement kinds: checked (``assert``), reachable (``cover``), constraint (``assume``).
+KINDS = ("assert", "cover", "assume")
+
+
+@dataclass(frozen=True)
+class Property:
+    """One named statement of a harness: ``name`` (``"handshake.no_loss"``), ``kind``
+    (:data:`KINDS`), ``description`` (one line) and ``src`` (``"path/file.py:123"``, the
+    line sby names when it fails)."""
+
+    name: str
+    kind: str
+    description: str
+    src: str
+
+
+class FormalHarness(Elaboratable):
+    """Base class of harnesses. Members:
+
+    * ``properties``: the :class:`Property` s stated so far (filled during
+      ``elaborate``; :meth:`statements` elaborates once to list them);
+    * ``depth``: the bounded depth (clock cycles) the checks need (for the stream array:
+      two frames plus the pipeline lag), used when ``--depth`` is not given;
+    * ``provable``: whether k-induction is expected to close (small state), else BMC.
+    """
+
+    depth: int = 20
+    provable: bool = False
+
+    def __init__(self) -> None:
+        self.properties: list[Property] = []
+
+    def check(self, m: Module, name: str, test: Value, description: str,
+              kind: str = "assert") -> None:
+        """Add ``test`` to ``m`` as a named ``Assert`` / ``Cover`` / ``Assume``
+        (comb domain: it holds in every cycle where it is evaluated)."""
+        if kind not in KINDS:
+            raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+        frame = inspect.stack()[1]
+        src = f"{os.path.abspath(frame.filename)}:{frame.lineno}"
+        statement = {"assert": Assert, "cover": Cover, "assume": Assume}[kind]
+        m.d.comb += statement(test, name, src_loc_at=1)
+        if not any(p.name == name and p.kind == kind for p in self.properties):
+            self.properties.append(Property(name, kind, description, src))
+
+    def statements(self) -> list[Property]:
+        """Elaborate once (platform ``"formal"``) and list the properties."""
+        from amaranth.hdl import Fragment
+
+        self.properties = []
+        Fragment.get(self, "formal")
+        found, self.properties = list(self.properties), []
+        return found
+
+
+def property_at(properties: list[Property], location: str) -> Property | None:
+    """The property whose ``src`` ends like sby's ``location`` (``file:line``, possibly
+    with a column range ``file:12.3-12.40``), or None."""
+    path, _, rest = location.rpartition(":")
+    line = rest.split(".")[0]
+    for prop in properties:
+        p_path, _, p_line = prop.src.rpartition(":")
+        if p_line == line and (p_path.endswith(path) or path.endswith(p_path)
+                               or os.path.basename(p_path) == os.path.basename(path)):
+            return prop
+    return None
