@@ -37,6 +37,7 @@ from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
 from rvsm.model.fixed.twin import simulate_fixed
 from rvsm.model.infra.atomic import atomic_path
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.integrity import verify_npz
 from rvsm.model.infra.npy_guard import check_npz_members
 from rvsm.model.infra.versions import with_versions
 from rvsm.model.scene.scene import Scene
@@ -148,6 +149,7 @@ def load_stimulus(path: str | os.PathLike) -> Stimulus:
     if not p.is_file():
         raise RvsmError(f"stimulus file {p} does not exist")
     check_npz_members(p, {"codes": 3, "thresholds": 3, "spikes": 4})
+    verify_npz(p, "stimulus file")
     try:
         with np.load(p, allow_pickle=False) as data:
             missing = set(STIMULUS_KEYS) - set(data.files)

@@ -5,8 +5,10 @@ line instead of allocating ``(100000, 4, 250, 400)`` first."""
 from __future__ import annotations
 
 import math
+import tokenize
 import os
 import zipfile
+import zlib
 from pathlib import Path
 from typing import BinaryIO
 
@@ -28,7 +30,8 @@ def _header(handle: BinaryIO, source: str) -> tuple[tuple[int, ...], np.dtype, i
             shape, _, dtype = npformat.read_array_header_1_0(handle)
         else:
             shape, _, dtype = npformat.read_array_header_2_0(handle)
-    except (ValueError, OSError, EOFError, SyntaxError) as exc:
+    except (ValueError, OSError, EOFError, SyntaxError, tokenize.TokenError, TypeError,
+            KeyError, zipfile.BadZipFile, zlib.error) as exc:
         raise RvsmError(f"{source}: cannot load .npy data, bad array header ({exc})") from None
     return tuple(int(v) for v in shape), np.dtype(dtype), handle.tell()
 
@@ -61,7 +64,7 @@ def check_npz_members(path: str | os.PathLike, ndims: dict[str, int | None]) -> 
     p = Path(path)
     try:
         zf = zipfile.ZipFile(p)
-    except (zipfile.BadZipFile, OSError):
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError):
         return
     with zf:
         names = set(zf.namelist())
@@ -78,8 +81,10 @@ def check_npz_members(path: str | os.PathLike, ndims: dict[str, int | None]) -> 
             try:
                 with zf.open(info) as handle:
                     shape, dtype, offset = _header(handle, source)
-            except (zipfile.BadZipFile, OSError, EOFError) as exc:
-                raise RvsmError(f"{source}: unreadable member ({exc})") from None
+            except (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError,
+                    NotImplementedError, RuntimeError) as exc:
+                raise RvsmError(f"{source}: unreadable member, the archive is damaged "
+                                f"({exc})") from None
             if ndim is not None and len(shape) != ndim:
                 raise RvsmError(f"{source} must have {ndim} dimensions, got shape {shape}")
             _check(shape, dtype, info.file_size - offset, source)

@@ -15,6 +15,7 @@ import numpy as np
 
 from rvsm.model.infra.atomic import atomic_path
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.integrity import verify_npz
 from rvsm.model.infra.npy_guard import check_npz_members
 from rvsm.model.infra.versions import with_versions
 from rvsm.model.spikes.arrays import check_spikes
@@ -35,6 +36,7 @@ def load_spikes(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
     if not path.is_file():
         raise RvsmError(f"spike file {path} does not exist")
     check_npz_members(path, {"spikes": 4, "meta": 0})
+    verify_npz(path, "spike file")
     try:
         with np.load(path, allow_pickle=False) as data:
             missing = {"spikes", "meta"} - set(data.files)
