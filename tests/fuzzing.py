@@ -15,6 +15,7 @@ with :data:`fuzz_settings` and the ``fuzz`` marker.
 from __future__ import annotations
 
 import contextlib
+import faulthandler
 import os
 import resource
 import signal
@@ -89,9 +90,13 @@ def _limits(seconds: float, memory_bytes: int) -> Iterator[None]:
         limit = min(limit, hard)
     resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
     signal.setitimer(signal.ITIMER_REAL, seconds)
+    # A hang inside a C library (HDF5, zlib) never returns to Python, where the alarm is
+    # raised: the watchdog thread then ends the process with every thread's traceback.
+    faulthandler.dump_traceback_later(2 * seconds + 5, exit=True)
     try:
         yield
     finally:
+        faulthandler.cancel_dump_traceback_later()
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old_handler)
         resource.setrlimit(resource.RLIMIT_AS, (soft, hard))

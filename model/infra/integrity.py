@@ -34,9 +34,10 @@ def verify_npz(path: str | os.PathLike, what: str = "file") -> None:
     p = Path(path)
     try:
         archive = zipfile.ZipFile(p)
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
-        raise RvsmError(f"{p} is a damaged or truncated {what}: its zip directory cannot "
-                        f"be read ({exc})") from None
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError,
+            RuntimeError) as exc:
+        raise RvsmError(f"{p} is truncated or corrupt: the {what}'s zip directory "
+                        f"cannot be read ({exc})") from None
     with archive:
         try:
             infos = archive.infolist()
@@ -49,8 +50,8 @@ def verify_npz(path: str | os.PathLike, what: str = "file") -> None:
                         pass
             except (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError,
                     NotImplementedError, RuntimeError) as exc:
-                raise RvsmError(f"{p} is a damaged {what}: member {info.filename!r} fails "
-                                f"its integrity check ({exc})") from None
+                raise RvsmError(f"{p} is corrupt: member {info.filename!r} of the {what} "
+                                f"fails its integrity check ({exc})") from None
 
 
 def header_crc32(fields: dict) -> str:

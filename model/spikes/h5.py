@@ -84,7 +84,7 @@ class H5SpikeWriter:
         h5py = _h5py()
         t, s, h, w = (int(v) for v in shape)
         self._partial = PartialFile(self.path)
-        self._file = h5py.File(self._partial.path, "w")
+        self._file = h5py.File(self._partial.path, "w", libver=("v110", "latest"))
         wb, dtype = (packed_width(w), np.uint8) if self.encoding == "2bit" else (w, np.int8)
         chunk_t = max(1, min(max(t, 1), CHUNK_BYTES // max(h * wb, 1)))
         opts = {"compression": self.compression} if self.compression else {}
@@ -95,17 +95,17 @@ class H5SpikeWriter:
             chunks=(chunk_t, 1, h, wb) if t else None, shuffle=False,
             fletcher32=bool(t), **opts,
         )
-        self._file.attrs["encoding"] = self.encoding
+        self._file.attrs["encoding"] = _fixed(self.encoding)
         self._file.attrs["shape"] = np.array([t, s, h, w], dtype=np.int64)
-        self._file.attrs["format"] = FORMAT
+        self._file.attrs["format"] = _fixed(FORMAT)
         self._file.attrs["format_version"] = FORMAT_VERSION
         self._file.attrs["complete"] = False
-        self._file.attrs["meta"] = json.dumps(with_versions(meta), sort_keys=True)
+        self._file.attrs["meta"] = _fixed(json.dumps(with_versions(meta), sort_keys=True))
         self._seal()
 
     def _seal(self) -> None:
         """Set ``header_crc32`` over the other root attributes."""
-        self._file.attrs["header_crc32"] = header_crc32(_header_fields(self._file.attrs))
+        self._file.attrs["header_crc32"] = _fixed(header_crc32(_header_fields(self._file.attrs)))
 
     def write(self, t0, spikes) -> None:
         b = spikes.shape[0]
@@ -119,7 +119,7 @@ class H5SpikeWriter:
             raise RvsmError(
                 f"{self.path}: only {self.steps_written} of {expected} steps written"
             )
-        self._file.attrs["meta"] = json.dumps(with_versions(meta), sort_keys=True)
+        self._file.attrs["meta"] = _fixed(json.dumps(with_versions(meta), sort_keys=True))
         self._file.attrs["complete"] = True
         self._seal()
         self._file.close()
@@ -137,13 +137,30 @@ class H5SpikeWriter:
         self._partial = None
 
 
+def _fixed(text: str) -> np.bytes_:
+    """``text`` as a fixed-length HDF5 string attribute: it lives in the (checksummed)
+    object header, where a variable-length string lives in the unchecked global heap
+    (a damaged global heap can make HDF5 loop forever)."""
+    return np.bytes_(text.encode())
+
+
+def _text(value) -> str:
+    """An attribute's text, whether stored fixed-length (bytes) or variable-length."""
+    if isinstance(value, bytes | np.bytes_):
+        return bytes(value).decode("utf-8", errors="replace")
+    return str(value)
+
+
 def _header_fields(attrs) -> dict:
     """The root attributes the header checksum covers, as JSON-able values."""
     fields = {}
     for key in ("format", "format_version", "encoding", "shape", "complete", "meta"):
         if key in attrs:
             value = attrs[key]
-            fields[key] = value.tolist() if hasattr(value, "tolist") else value
+            if isinstance(value, bytes | np.bytes_ | str):
+                fields[key] = _text(value)
+            else:
+                fields[key] = value.tolist() if hasattr(value, "tolist") else value
     return fields
 
 
@@ -186,7 +203,7 @@ def open_h5(path: str | os.PathLike) -> SpikeSource:
 def _open_checked(handle, path: Path) -> tuple:
     """``(dataset, shape, encoding, meta)`` of an open spike file, after every check."""
     attrs = handle.attrs
-    if attrs.get("format") != FORMAT or "spikes" not in handle:
+    if _text(attrs.get("format", "")) != FORMAT or "spikes" not in handle:
         raise RvsmError(f"{path} is not an rvsm spike file (no 'spikes' / format)")
     version = int(attrs.get("format_version", 1))
     if version not in READABLE_VERSIONS:
@@ -195,13 +212,13 @@ def _open_checked(handle, path: Path) -> tuple:
                         f"damaged or from a newer rvsm")
     if version >= 2:
         stored = attrs.get("header_crc32")
-        if stored is None or str(stored) != header_crc32(_header_fields(attrs)):
+        if stored is None or _text(stored) != header_crc32(_header_fields(attrs)):
             raise RvsmError(f"{path} is damaged: its header attributes fail their CRC-32 "
                             f"check")
     if not bool(attrs.get("complete", False)):
         raise RvsmError(f"{path} is incomplete (the run that wrote it did not finish)")
     try:
-        meta = json.loads(str(attrs["meta"]))
+        meta = json.loads(_text(attrs["meta"]))
     except (KeyError, json.JSONDecodeError) as exc:
         raise RvsmError(f"{path}: 'meta' missing or not valid JSON ({exc})") from None
     if not isinstance(meta, dict):
@@ -209,7 +226,7 @@ def _open_checked(handle, path: Path) -> tuple:
     dset = handle["spikes"]
     if not isinstance(dset, _h5py().Dataset):
         raise RvsmError(f"{path}: 'spikes' is not a dataset")
-    encoding = str(attrs.get("encoding", "int8"))
+    encoding = _text(attrs.get("encoding", "int8"))
     raw_shape = np.asarray(attrs.get("shape", dset.shape)).reshape(-1)
     if raw_shape.size != 4 or not np.issubdtype(raw_shape.dtype, np.integer) \
             or (raw_shape < 0).any():

@@ -29,7 +29,8 @@ def test_h5_round_trip_chunked(tmp_path, encoding, compression):
         assert src.shape == a.shape and src.meta == with_versions(meta)
         np.testing.assert_array_equal(src.read(5, 23), a[5:23])
     with h5py.File(path) as f:
-        assert f.attrs["complete"] and f.attrs["encoding"] == encoding
+        assert f.attrs["complete"] and f.attrs["encoding"] == encoding.encode()
+        assert f["spikes"].fletcher32 and f.attrs["format_version"] == 2
     back, meta2 = load_any_spikes(path)
     np.testing.assert_array_equal(back, a)
 
