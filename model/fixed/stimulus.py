@@ -35,6 +35,7 @@ from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
 from rvsm.model.fixed.twin import simulate_fixed
+from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.atomic import atomic_path
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.integrity import verify_npz
@@ -74,6 +75,42 @@ class Stimulus:
         """True when ``contract.run(codes, thresholds, clear_before)`` reproduces ``spikes``."""
         want = self.contract.run(self.codes, self.thresholds, self.clear_before)
         return bool(np.array_equal(want, self.spikes))
+
+    def with_recomputed_expectation(self) -> Stimulus:
+        """The same stimulus with ``spikes`` recomputed from its own codes, thresholds,
+        clears and contract (``rvsm verify --stimulus F --recompute-expected``)."""
+        spikes = self.contract.run(self.codes, self.thresholds, self.clear_before)
+        return dataclasses.replace(self, spikes=np.asarray(spikes, dtype=np.int8))
+
+    def first_inconsistency(self) -> str | None:
+        """Where the file's parts disagree with each other, or None: the point's contract
+        against ``contract``; the expected ``spikes`` against what ``contract.run`` gives
+        from ``codes``, ``thresholds`` and ``clear_before`` (the first step, scale, row and
+        column that differ). Costs one fixed-twin run of the stimulus."""
+        c = self.contract
+        if self.point is not None:
+            try:
+                from_point = self.point.with_size(c.height, c.width).contract()
+            except (RvsmError, ValueError, TypeError) as exc:
+                return f"its design point cannot make a contract ({exc})"
+            if from_point != c:
+                return "its design point and its contract disagree"
+        want_shape = (self.num_steps, c.num_scales, c.height, c.width)
+        if self.spikes.shape != want_shape:
+            return f"expected spikes have shape {self.spikes.shape}, the codes need {want_shape}"
+        if self.thresholds.shape != want_shape[1:]:
+            return f"thresholds have shape {self.thresholds.shape}, need {want_shape[1:]}"
+        bad_clear = [t for t in self.clear_before if not 0 <= t < max(self.num_steps, 1)]
+        if bad_clear:
+            return f"clear_before step {bad_clear[0]} is outside 0..{self.num_steps - 1}"
+        want = self.contract.run(self.codes, self.thresholds, self.clear_before)
+        diff = np.argwhere(want != self.spikes)
+        if diff.size == 0:
+            return None
+        t, sc, y, x = (int(v) for v in diff[0])
+        return (f"{len(diff)} expected spikes do not follow from its codes, thresholds and "
+                f"contract; the first at step {t}, scale {sc}, row {y}, column {x} (file "
+                f"{int(self.spikes[t, sc, y, x])}, contract {int(want[t, sc, y, x])})")
 
     def first_steps(self, steps: int) -> Stimulus:
         """The same stimulus cut to its first ``steps`` steps (clears beyond them dropped)."""
@@ -162,17 +199,98 @@ def load_stimulus(path: str | os.PathLike) -> Stimulus:
         raise
     except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
         raise RvsmError(f"{p} is not a readable stimulus file: {exc}") from None
-    raw = json.loads(str(arrays["contract"]))
-    raw["weights"] = tuple(tuple(tuple(int(v) for v in row) for row in k) for k in raw["weights"])
-    contract = ArrayContract(**raw)
-    point_text = str(arrays["point"])
+    contract = _contract(arrays["contract"], str(p))
+    point_text = _text(arrays["point"], "point", str(p))
     point = parse_design_point(point_text, str(p)) if point_text else None
-    return Stimulus(
-        codes=arrays["codes"],
-        thresholds=arrays["thresholds"].astype(np.int64),
-        spikes=arrays["spikes"].astype(np.int8),
-        contract=contract,
-        point=point,
-        meta=json.loads(str(arrays["meta"])),
-        clear_before=tuple(int(t) for t in arrays.get("clear_before", ())),
-    )
+    try:
+        meta = json.loads(_text(arrays["meta"], "meta", str(p)))
+    except json.JSONDecodeError as exc:
+        raise RvsmError(f"{p}: 'meta' is not valid JSON ({exc})") from None
+    if not isinstance(meta, dict):
+        raise RvsmError(f"{p}: 'meta' must be a JSON object")
+    codes, thresholds, spikes, clears = _arrays(arrays, contract, str(p))
+    return Stimulus(codes=codes, thresholds=thresholds, spikes=spikes, contract=contract,
+                    point=point, meta=meta, clear_before=clears)
+
+
+#: Bounds a stimulus file's contract must keep (what the RTL generator takes).
+_CONTRACT_LIMITS = {"height": (1, 1 << 16), "width": (1, 1 << 16), "adc_bits": (1, 16),
+                    "shift": (0, 62), "accumulator_bits": (2, 62)}
+_RESETS = ("zero", "subtract")
+
+
+def _text(value: np.ndarray, name: str, source: str) -> str:
+    """A 0-d string member's text."""
+    if value.ndim != 0 or value.dtype.kind not in "US":
+        raise RvsmError(f"{source}: {name!r} must be a text scalar, got {value.dtype} "
+                        f"{value.shape}")
+    return str(value)
+
+
+def _contract(value: np.ndarray, source: str) -> ArrayContract:
+    """The file's ``contract`` member, checked field by field."""
+    try:
+        raw = json.loads(_text(value, "contract", source))
+    except json.JSONDecodeError as exc:
+        raise RvsmError(f"{source}: 'contract' is not valid JSON ({exc})") from None
+    fields = {f.name for f in dataclasses.fields(ArrayContract)}
+    if not isinstance(raw, dict) or set(raw) - fields or \
+            fields - {"reset"} - set(raw):
+        raise RvsmError(f"{source}: 'contract' must be an object with the fields "
+                        f"{', '.join(sorted(fields))}")
+    for name, (lo, hi) in _CONTRACT_LIMITS.items():
+        v = raw[name]
+        if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
+            raise RvsmError(f"{source}: contract {name} must be an integer in {lo}..{hi}, "
+                            f"got {v!r}")
+    if not isinstance(raw["signed"], bool) or raw.get("reset", "zero") not in _RESETS:
+        raise RvsmError(f"{source}: contract signed must be true/false and reset one of "
+                        f"{_RESETS}")
+    raw["weights"] = _kernels(raw["weights"], source)
+    return ArrayContract(**raw)
+
+
+def _kernels(value: object, source: str) -> tuple:
+    """Integer kernels: 1 to 4 odd square matrices of integers below 2**31 in size."""
+    ok = isinstance(value, list) and 1 <= len(value) <= 4
+    kernels = []
+    for k in value if ok else ():
+        n = len(k) if isinstance(k, list) else 0
+        ok = ok and n % 2 == 1 and n <= 63 and all(
+            isinstance(row, list) and len(row) == n and all(
+                isinstance(v, int) and not isinstance(v, bool) and abs(v) < 1 << 31
+                for v in row) for row in k)
+        if ok:
+            kernels.append(tuple(tuple(int(v) for v in row) for row in k))
+    if not ok:
+        raise RvsmError(f"{source}: contract weights must be 1 to 4 odd square matrices of "
+                        f"integers")
+    return tuple(kernels)
+
+
+def _arrays(arrays: dict, c: ArrayContract, source: str) -> tuple:
+    """``codes``, ``thresholds``, ``spikes`` and ``clear_before`` checked against the
+    contract (shapes, integer dtypes, value ranges)."""
+    codes, thresholds, spikes = arrays["codes"], arrays["thresholds"], arrays["spikes"]
+    for name, arr in (("codes", codes), ("thresholds", thresholds), ("spikes", spikes)):
+        if arr.dtype.kind not in "iu":
+            raise RvsmError(f"{source}: {name!r} must hold integers, got {arr.dtype}")
+    t = codes.shape[0] if codes.ndim == 3 else -1
+    want = {"codes": (t, c.height, c.width), "thresholds": (c.num_scales, c.height, c.width),
+            "spikes": (t, c.num_scales, c.height, c.width)}
+    for name, arr in (("codes", codes), ("thresholds", thresholds), ("spikes", spikes)):
+        if arr.shape != want[name]:
+            raise RvsmError(f"{source}: {name!r} has shape {arr.shape}, the contract needs "
+                            f"{want[name]}")
+    if codes.size and (int(codes.min()) < 0 or int(codes.max()) > unsigned_max(c.adc_bits)):
+        raise RvsmError(f"{source}: codes outside the {c.adc_bits}-bit ADC range")
+    top = unsigned_max(c.threshold_bits)
+    if thresholds.size and (int(thresholds.min()) < 0 or int(thresholds.max()) > top):
+        raise RvsmError(f"{source}: thresholds outside 0..{top}")
+    if spikes.size and (int(spikes.min()) < -1 or int(spikes.max()) > 1):
+        raise RvsmError(f"{source}: expected spikes must lie in {{-1, 0, 1}}")
+    clears = arrays.get("clear_before", np.zeros(0, np.int64))
+    if clears.dtype.kind not in "iu" or clears.ndim != 1:
+        raise RvsmError(f"{source}: 'clear_before' must be a 1-d integer array")
+    return (codes, thresholds.astype(np.int64), spikes.astype(np.int8),
+            tuple(int(v) for v in clears))

@@ -50,7 +50,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scene", nargs="?", help="built-in scene name or scene path")
     p.add_argument("--fixed", metavar="POINT.toml", help="design point TOML (with SCENE)")
     p.add_argument("--stimulus", metavar="FILE.npz",
-                   help="replay this stimulus file (from `rvsm stimulus`) instead")
+                   help="replay this stimulus file (from `rvsm stimulus`) instead; a file "
+                   "whose expected spikes do not follow from its own codes is refused as "
+                   "a bad stimulus (exit 2)")
+    p.add_argument("--recompute-expected", action="store_true",
+                   help="with --stimulus: take the expected spikes from the file's codes, "
+                   "thresholds and contract instead of the file's own (a hand-edited file)")
     p.add_argument("--random", metavar="SEED", type=int,
                    help="drive a seeded random and corner stimulus (codes at 0 and full "
                    "scale, exact threshold hits, both saturation rails, clears "
@@ -152,6 +157,9 @@ def _verify(args: argparse.Namespace) -> int:
     if args.steps is not None and args.steps < 1:
         raise RvsmError(f"--steps must be >= 1, got {args.steps}")
     arch, options = args.arch, arch_options(args)
+    if args.recompute_expected and not args.stimulus:
+        raise RvsmError("--recompute-expected applies to --stimulus FILE only (the other "
+                        "ways compute the expectation from the fixed twin anyway)")
     if args.stimulus:
         given = [n for n, v in (("SCENE", args.scene), ("--fixed", args.fixed),
                                 ("--size", args.size), ("--random", args.random),
@@ -160,7 +168,8 @@ def _verify(args: argparse.Namespace) -> int:
             raise RvsmError(f"{', '.join(given)} cannot be combined with --stimulus: the "
                             "stimulus file holds the scene's codes and the contract")
         r = replay(args.stimulus, args.sim, steps=args.steps, waves=args.waves,
-                   work_dir=args.work, arch=arch, **options)
+                   work_dir=args.work, arch=arch,
+                   recompute_expected=args.recompute_expected, **options)
     elif args.random is not None:
         given = [n for n, v in (("SCENE", args.scene), *_scene_shaping(args)) if v is not None]
         if given:

@@ -157,12 +157,18 @@ def replay(
     waves: bool = False,
     work_dir: str | os.PathLike = DEFAULT_WORK,
     arch: str | Architecture = DEFAULT_ARCHITECTURE,
+    recompute_expected: bool = False,
     **options: int | None,
 ) -> dict:
     """Replay a stimulus file (``rvsm stimulus -o FILE``) on the RTL, spike for spike.
 
-    ``steps`` keeps the first steps. Returns :func:`check_stimulus`'s result plus
-    ``stimulus``, ``height`` and ``width``.
+    ``steps`` keeps the first steps. The file is checked before the RTL is blamed: when
+    its expected spikes do not follow from its own codes, thresholds and contract
+    (a hand-edited or damaged file) it is a bad stimulus (:class:`RvsmError`, exit 2,
+    naming the first inconsistent step and accumulator), unless ``recompute_expected``
+    takes the expectation from its codes instead. Returns :func:`check_stimulus`'s result
+    plus ``stimulus``, ``height``, ``width`` and ``expectation`` (``"file"`` or
+    ``"recomputed"``).
     """
     check_simulator(sim)
     stim = load_stimulus(stimulus)
@@ -173,10 +179,19 @@ def replay(
                         f"at most {stim.num_steps}")
     if steps is not None and steps < stim.num_steps:
         stim = stim.first_steps(steps)
+    if recompute_expected:
+        stim = stim.with_recomputed_expectation()
+    else:
+        problem = stim.first_inconsistency()
+        if problem:
+            raise RvsmError(f"{stimulus} is a bad stimulus, not an RTL failure: {problem}; "
+                            f"fix the file, or replay it with --recompute-expected to take "
+                            f"the expectation from its codes")
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
                             name=Path(stimulus).stem or "stimulus", arch=arch, **options)
     result.update(stimulus=str(stimulus), height=c.height, width=c.width,
-                  coverage=_coverage(stim))
+                  coverage=_coverage(stim),
+                  expectation="recomputed" if recompute_expected else "file")
     return result
 
 
