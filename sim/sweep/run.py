@@ -32,6 +32,9 @@ class SweepSummary:
 
     total: int = 0
     already_done: int = 0
+    #: scene -> (rows, reason) of finished rows recomputed because their scene's content
+    #: is not what they were computed from.
+    recomputed: dict[str, tuple[int, str]] = field(default_factory=dict)
     computed: int = 0
     invalid: int = 0
     errors: list[str] = field(default_factory=list)
@@ -41,11 +44,15 @@ class SweepSummary:
     workers: int = 0
 
     def format(self) -> str:
-        """One-paragraph summary for the CLI."""
-        return (f"sweep: {self.total} rows: {self.already_done} already done, "
+        """One-paragraph summary for the CLI (and one line per scene whose rows were
+        recomputed because its content changed)."""
+        text = (f"sweep: {self.total} rows: {self.already_done} already done, "
                 f"{self.computed} computed, {self.invalid} invalid design(s) recorded, "
                 f"{len(self.errors)} failed; RTL: {self.hw_synthesised} synthesised, "
                 f"{self.hw_cached} cached; {self.seconds:.1f} s on {self.workers} worker(s)")
+        for scene, (rows, reason) in self.recomputed.items():
+            text += f"\nsweep: {rows} row(s) recomputed: scene {scene} {reason}"
+        return text
 
 
 @dataclass
@@ -71,6 +78,8 @@ class SweepRun:
     #: digest -> lane count -> synthesis record, until all lane counts are in.
     _halves: dict[str, dict[int, dict[str, Any]]] = field(default_factory=dict, repr=False)
     _failed: set[str] = field(default_factory=set, repr=False)
+    #: scene -> its content digest (:func:`~rvsm.model.scene.digest.scene_digest`).
+    scene_digests: dict[str, str] = field(default_factory=dict)
 
     def plan(self) -> None:
         """Work out what is missing; fail early, naming the field, on an unloadable scene."""
@@ -91,17 +100,42 @@ class SweepRun:
         store.register(spec, tasks, self.digests)
         store.attach_digests(self.digests)
         done = store.done_keys()
+        self.scene_digests = {name: self._scene_digest(name) for name in spec.run.scenes}
         for t in tasks:
             key = (t.point_id, t.scene, int(t.noise), t.seed, t.steps, t.size_text)
-            if key in done:
+            stale = key in done and self._stale(t.scene, done[key])
+            if key in done and not stale:
                 self.summary.already_done += 1
+            elif stale and t.design.point is not None:
+                rows, reason = self.summary.recomputed.get(t.scene, (0, stale))
+                self.summary.recomputed[t.scene] = (rows + 1, reason)
+                self.points.append(PointWork(t, spec.run, self.executor.threads))
             elif t.design.point is None:
-                store.write_result(t, None, "invalid", t.design.error)
+                store.write_result(t, None, "invalid", t.design.error,
+                                   scene_digest=self.scene_digests[t.scene])
                 self.summary.invalid += 1
             else:
                 self.points.append(PointWork(t, spec.run, self.executor.threads))
         if self.points:
             self._check_scenes()
+
+    def _scene_digest(self, name: str) -> str:
+        from rvsm.model.scene.digest import scene_digest
+
+        try:
+            return scene_digest(name)
+        except RvsmError as exc:
+            raise RvsmError(f"{self.spec.source}: run.scenes: {exc}") from None
+
+    def _stale(self, scene: str, stored: str | None) -> str:
+        """Why a finished row of ``scene`` computed from ``stored`` content must be
+        recomputed ("" when it need not)."""
+        current = self.scene_digests[scene]
+        if stored == current or (stored is None and current.startswith("builtin:")):
+            return ""
+        if stored is None:
+            return "was not recorded by content (a database from an older rvsm)"
+        return "changed since those rows were computed"
 
     def _check_scenes(self) -> None:
         from rvsm.model.scene.loaders import load_scene
@@ -163,11 +197,13 @@ class SweepRun:
         task = work.task
         dig = self.digests.get(task.design.design_id)
         if finished.error is None:
-            self.store.write_result(task, finished.value, "ok", hw_digest=dig)
+            self.store.write_result(task, finished.value, "ok", hw_digest=dig,
+                                    scene_digest=self.scene_digests.get(task.scene))
             self.summary.computed += 1
         else:
             msg = f"{type(finished.error).__name__}: {finished.error}"
-            self.store.write_result(task, None, "error", msg, hw_digest=dig)
+            self.store.write_result(task, None, "error", msg, hw_digest=dig,
+                                    scene_digest=self.scene_digests.get(task.scene))
             self.summary.errors.append(f"{task.design.design_id} on {task.scene}: {msg}")
 
 

@@ -7,7 +7,11 @@ Tables (see docs/design-space.md):
 - ``results``: one row per finished task, primary key ``(point_id, scene, noise, seed,
   steps, size)``; ``status`` ``ok`` (metrics), ``invalid`` (validation refused the design;
   ``error`` says why) or ``error`` (the computation failed; retried on the next run). The
-  full record (JSON) and the full design point (TOML) are stored with it.
+  full record (JSON) and the full design point (TOML) are stored with it, and
+  ``scene_digest`` (:func:`rvsm.model.scene.digest.scene_digest`): the content of the
+  scene the row was computed from, so a row whose scene file has since changed is
+  recomputed, not reported as done (databases from before the column get it added,
+  empty: their rows on scene files are recomputed once).
 - ``lane_cost``: hardware cost per distinct RTL on the streaming array, keyed by its
   digest: logic (LUT4) and flip-flops per lane from yosys, optional Fmax, the memory bits
   of the design point (:func:`rvsm.rtl.fpga.lane_cost.lane_cost`). Databases of schema 1
@@ -50,7 +54,7 @@ CREATE TABLE IF NOT EXISTS results (
     ssim_float REAL, ssim_fixed REAL, ssim_cost REAL,
     mse_float REAL, mse_fixed REAL, mse_cost REAL, max_saturation_rate REAL,
     seconds REAL, axes TEXT NOT NULL, record TEXT, design_toml TEXT NOT NULL,
-    hw_digest TEXT, finished TEXT NOT NULL,
+    hw_digest TEXT, finished TEXT NOT NULL, scene_digest TEXT,
     PRIMARY KEY (point_id, scene, noise, seed, steps, size)
 );
 CREATE INDEX IF NOT EXISTS results_design ON results (design_id);
@@ -95,6 +99,9 @@ class SweepStore:
             self.db.execute("PRAGMA journal_mode=WAL")
             self.db.execute("PRAGMA synchronous=NORMAL")
             self.db.executescript(SCHEMA)
+            columns = {r[1] for r in self.db.execute("PRAGMA table_info(results)")}
+            if "scene_digest" not in columns:
+                self.db.execute("ALTER TABLE results ADD COLUMN scene_digest TEXT")
             self.db.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)",
                             (str(SCHEMA_VERSION),))
             self.db.commit()
@@ -138,20 +145,23 @@ class SweepStore:
             )
 
     def write_result(self, task: SweepTask, record: dict[str, Any] | None, status: str,
-                     error: str | None = None, hw_digest: str | None = None) -> bool:
+                     error: str | None = None, hw_digest: str | None = None,
+                     scene_digest: str | None = None) -> bool:
         """Store one task's outcome; committed at once. Returns False if already stored
-        (a finished row is never replaced; an ``error`` row is)."""
+        (a finished row of the same scene content is never replaced; an ``error`` row,
+        or a row computed from other scene content than ``scene_digest``, is)."""
         rec = record or {}
         row = (task.point_id, task.scene, int(task.noise), task.seed, task.steps,
                task.size_text, task.design.design_id, rec.get("model"), status, error,
                *[rec.get(m) for m in METRICS], rec.get("seconds"),
                json.dumps(task.design.axes), json.dumps(rec) if record else None,
-               task.design.toml, hw_digest, _now())
+               task.design.toml, hw_digest, _now(), scene_digest)
         with self.db:
             self.db.execute(
                 "DELETE FROM results WHERE point_id = ? AND scene = ? AND noise = ? AND "
-                "seed = ? AND steps = ? AND size = ? AND status = 'error'",
-                row[:6],
+                "seed = ? AND steps = ? AND size = ? AND (status = 'error' OR "
+                "scene_digest IS NOT ?)",
+                (*row[:6], scene_digest),
             )
             cur = self.db.execute(
                 f"INSERT OR IGNORE INTO results VALUES ({', '.join('?' * len(row))})", row
@@ -172,11 +182,12 @@ class SweepStore:
 
     # -- reading ------------------------------------------------------------------------
 
-    def done_keys(self) -> set[tuple]:
-        """Keys ``(point_id, scene, noise, seed, steps, size)`` of finished rows."""
-        cur = self.db.execute("SELECT point_id, scene, noise, seed, steps, size FROM results "
-                              "WHERE status != 'error'")
-        return {tuple(r) for r in cur}
+    def done_keys(self) -> dict[tuple, str | None]:
+        """Keys ``(point_id, scene, noise, seed, steps, size)`` of finished rows, each with
+        the scene digest it was computed from (None: not recorded)."""
+        cur = self.db.execute("SELECT point_id, scene, noise, seed, steps, size, scene_digest "
+                              "FROM results WHERE status != 'error'")
+        return {tuple(r[:6]): r[6] for r in cur}
 
     def known_digests(self) -> set[str]:
         """Hardware digests already measured."""

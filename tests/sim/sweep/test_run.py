@@ -214,3 +214,60 @@ enabled = false
     with sqlite3.connect(db) as con:
         assert con.execute("SELECT COUNT(*) FROM results WHERE hw_digest IS NOT NULL"
                            ).fetchone()[0] == 1
+
+
+def _scene_file(path: Path, seed: int) -> Path:
+    import numpy as np
+
+    frames = np.random.default_rng(seed).uniform(20.0, 230.0, (3, 16, 24))
+    np.save(path, frames)
+    return path
+
+
+def test_a_replaced_scene_file_is_recomputed_and_said_so(tmp_path, counter):
+    """The issue's case: replacing ``mine.npy`` with different frames kept the old rows
+    ("4 rows: 4 already done") and their old PSNR."""
+    mine = _scene_file(tmp_path / "mine.npy", 1)
+    text = SWEEP.replace('scenes = ["coin"]', f'scenes = ["{mine}"]')
+    assert str(mine) in text
+    db = tmp_path / "r.sqlite"
+    first = run_sweep(parse_sweep(text), db, workers=0, progress=False)
+    assert first.computed == 8 and not first.recomputed
+    with sqlite3.connect(db) as con:
+        before = dict(con.execute("SELECT point_id, psnr_fixed FROM results"))
+    again = run_sweep(parse_sweep(text), db, workers=0, progress=False)
+    assert (again.already_done, again.computed) == (8, 0)  # same bytes: nothing to do
+    _scene_file(mine, 2)  # different frames under the same name
+    s = run_sweep(parse_sweep(text), db, workers=0, progress=False)
+    assert (s.already_done, s.computed) == (0, 8) and len(counter) == 16
+    assert s.recomputed == {str(mine): (8, "changed since those rows were computed")}
+    assert f"8 row(s) recomputed: scene {mine} changed" in s.format()
+    with sqlite3.connect(db) as con:
+        after = dict(con.execute("SELECT point_id, psnr_fixed FROM results"))
+    assert len(after) == 8 and after.keys() == before.keys()  # replaced, not added
+    assert all(after[k] != before[k] for k in after)
+
+
+def test_rows_of_an_older_database_without_content_are_recomputed_once(tmp_path, counter):
+    mine = _scene_file(tmp_path / "mine.npy", 1)
+    text = SWEEP.replace('scenes = ["coin"]', f'scenes = ["{mine}", "coin"]')
+    db = tmp_path / "r.sqlite"
+    run_sweep(parse_sweep(text), db, workers=0, progress=False)
+    with sqlite3.connect(db) as con:  # as an rvsm before the column left them
+        con.execute("UPDATE results SET scene_digest = NULL")
+    s = run_sweep(parse_sweep(text), db, workers=0, progress=False)
+    assert (s.already_done, s.computed) == (8, 8)  # built-in rows kept, file rows redone
+    assert "older rvsm" in s.recomputed[str(mine)][1]
+    s = run_sweep(parse_sweep(text), db, workers=0, progress=False)
+    assert (s.already_done, s.computed) == (16, 0)
+
+
+def test_a_database_from_before_the_column_is_migrated(tmp_path):
+    db = tmp_path / "old.sqlite"
+    from rvsm.sim.sweep.store import SCHEMA, SweepStore
+
+    with sqlite3.connect(db) as con:
+        con.executescript(SCHEMA.replace(", scene_digest TEXT", ""))
+    with SweepStore(db) as store:
+        cols = [r[1] for r in store.db.execute("PRAGMA table_info(results)")]
+    assert cols[-1] == "scene_digest"
