@@ -22,7 +22,7 @@ else:  # pragma: no cover
 
 from rvsm.model.fixed.design_point import FIELDS, DesignPoint
 from rvsm.model.infra.atomic import write_text_atomic
-from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.errors import RvsmError, shown
 from rvsm.model.infra.text_files import read_utf8_text
 from rvsm.model.sampling.thresholds import DEFAULT_CALIBRATION_SCENE
 
@@ -75,13 +75,14 @@ def from_toml_dict(data: dict[str, Any], source: str = "design point") -> Design
     for sec, table in data.items():
         if sec not in SECTIONS or not isinstance(table, dict):
             raise RvsmError(
-                f"{source}: unknown section [{sec}]; valid sections: "
+                f"{source}: unknown section [{shown(sec)}]; valid sections: "
                 f"{', '.join(sorted(SECTIONS))}"
             )
         for key, value in table.items():
             if (sec, key) not in known:
                 valid = ", ".join(f.key for f in FIELDS if f.section == sec)
-                raise RvsmError(f"{source}: unknown key {sec}.{key}; [{sec}] takes {valid}")
+                raise RvsmError(f"{source}: unknown key {shown(sec)}.{shown(key)}; "
+                                f"[{shown(sec)}] takes {valid}")
             kwargs[known[(sec, key)]] = value
     try:
         return DesignPoint(**kwargs)

@@ -10,8 +10,27 @@ class RvsmError(Exception):
     """A user-facing error (bad input, bad configuration, missing tool).
 
     The CLI prints ``rvsm: error: <message>`` on one line and exits non-zero; the message
-    must name what is wrong and, where possible, how to fix it.
+    must name what is wrong and, where possible, how to fix it. Line breaks a message
+    quotes from its input (a TOML key, a file name, a library's own message) are shown
+    escaped (``\\n``), so a message is always one line.
     """
+
+    def __init__(self, *args: object) -> None:
+        if args and isinstance(args[0], str):
+            args = (_one_line(args[0]), *args[1:])
+        super().__init__(*args)
+
+
+def _one_line(message: str) -> str:
+    return message.replace("\r\n", "\\n").replace("\n", "\\n").replace("\r", "\\r")
+
+
+def shown(text: object) -> str:
+    """``text`` as a message may quote it: as is when printable, else Python-escaped
+    (a TOML key ``"\\n"`` or a file name with a newline must not break the one-line
+    message)."""
+    text = str(text)
+    return text if text.isprintable() else repr(text)
 
 
 class ToolError(RvsmError):

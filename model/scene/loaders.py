@@ -152,9 +152,10 @@ def _read_frames(path: Path, what: str) -> list[np.ndarray]:
     except RvsmError:
         raise
     except Exception as exc:
+        reason = str(exc).strip().splitlines()[0] if str(exc).strip() else "unreadable"
         raise RvsmError(
-            f"{path}: cannot read this {what} ({type(exc).__name__}: {exc}); the file may be "
-            "corrupt or truncated"
+            f"{path}: cannot read this {what} ({type(exc).__name__}: {reason}); the file may "
+            "be corrupt or truncated"
         ) from None
 
 

@@ -34,11 +34,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.infra.errors import ToolError
+from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.model.infra.tools import ToolFailure, run_tool
 from rvsm.rtl.architecture import Architecture
 from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.digest import rtl_digest
+from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.verilog import GeneratedVerilog, write_outputs
 from rvsm.sim.cosim.cocotb_adapter import build_args, check_simulator, cocotb_build, cxx_opt
 
@@ -283,13 +284,19 @@ def _reuse_verilog(
         meta_path = other / f"{top}.ports.json"
         if other == root or not (other / f"{top}.v").exists() or not meta_path.exists():
             continue
+        try:  # another build's damaged port map is skipped, never copied
+            meta = load_ports_json(meta_path)
+        except RvsmError:
+            continue
         paths = {}
         for key, name in (("verilog", f"{top}.v"), ("ports_json", f"{top}.ports.json"),
                           ("ports_md", f"{top}.ports.md")):
             paths[key] = root / name
             shutil.copyfile(other / name, paths[key])
-        meta = json.loads(meta_path.read_text())
-        return paths, GeneratedVerilog("", top, meta["latency"], meta["generation_seconds"])
+        seconds = meta.get("generation_seconds", 0.0)
+        return paths, GeneratedVerilog("", top, meta["latency"],
+                                       float(seconds) if isinstance(seconds, int | float)
+                                       else 0.0)
     return None
 
 

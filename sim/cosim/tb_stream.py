@@ -27,6 +27,7 @@ from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
 from rvsm.model.fixed.stimulus import load_stimulus
+from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.stream.drive import threshold_writes
 from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, check_beats, pack_lanes
@@ -37,8 +38,7 @@ from rvsm.sim.cosim.tb_common import clock_and_reset, logic_bits, testbench_arg
 async def stream_matches_fixed_twin(dut: object) -> None:
     """Stream every step, compare every output beat with the fixed twin's expectation."""
     stim = load_stimulus(testbench_arg("stimulus"))
-    with open(testbench_arg("ports"), encoding="utf-8") as f:
-        ports = json.load(f)
+    ports = load_ports_json(testbench_arg("ports"))
     result_path = testbench_arg("result")
     c = stim.contract
     codes = stim.codes.astype(np.int64)
