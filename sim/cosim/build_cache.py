@@ -257,11 +257,15 @@ def _cached(root: Path, sim: str, top: str, traced: bool, key: str,
     problem = None
     try:
         meta = json.loads((root / "build.json").read_text())
-        if meta.get("key") != key:
+        if not (isinstance(meta, dict) and isinstance(meta.get("files"), dict)
+                and all(isinstance(meta.get(k), int | float) and not isinstance(
+                    meta.get(k), bool) for k in ("generate_seconds", "build_seconds"))):
+            problem = "build.json does not hold a build record"
+        elif meta.get("key") != key:
             problem = "its recorded key differs"
         elif _checksums(root, list(meta["files"])) != meta["files"]:
             problem = "a file is missing or changed"
-    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError):
         problem = "build.json is missing or unreadable"
     if problem is not None:
         print(f"rvsm: note: cached {sim} build {root} is damaged ({problem}); rebuilding",

@@ -284,9 +284,14 @@ def _axis_values(value: Any, where: str) -> list:
         nums = (start, stop, step)
         if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in nums):
             raise RvsmError(f"{where}: start, stop and step must be numbers")
+        if not all(math.isfinite(v) for v in nums):
+            raise RvsmError(f"{where}: start, stop and step must be finite numbers")
         if step <= 0 or stop < start:
             raise RvsmError(f"{where}: need step > 0 and stop >= start, got {value}")
-        n = int(math.floor((stop - start) / step + 1e-9)) + 1
+        count = (stop - start) / step + 1e-9
+        if not math.isfinite(count) or count >= MAX_POINTS:
+            raise RvsmError(f"{where}: range has more than {MAX_POINTS} values")
+        n = int(math.floor(count)) + 1
         if n > MAX_POINTS:
             raise RvsmError(f"{where}: range has {n} values, more than {MAX_POINTS}")
         if all(isinstance(v, int) for v in nums):
