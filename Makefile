@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress bench bench-sweep lint clean
+.PHONY: setup demo test regress bench bench-sweep fuzz lint clean
 
 setup: $(STAMP)
 
@@ -27,6 +27,10 @@ test: setup
 
 regress: setup
 	$(BIN)/python -m pytest -n $(JOBS) -q -m "slow or not slow"
+
+# the long fuzzing campaign: every reader, CASES generated cases in all (docs/fuzzing.md)
+fuzz: setup
+	$(BIN)/python scripts/fuzz.py --cases $(or $(CASES),100000) --workers $(JOBS) --json $(OUT)/fuzz.json
 
 bench: setup
 	$(BIN)/python scripts/benchmark.py
