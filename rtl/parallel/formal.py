@@ -32,6 +32,7 @@ from __future__ import annotations
 
 from amaranth.asserts import AnySeq
 from amaranth.hdl import (
+    Cat,
     ClockDomain,
     ClockSignal,
     Elaboratable,
@@ -67,6 +68,8 @@ class ParallelProperties(FormalHarness):
     every cell gets every property). ``mutation``: a ``parallel.*`` deliberate bug."""
 
     depth = 6
+    #: Steps the covers need (a rail is reached after about 2**(W-1) / max|sum| steps).
+    cover_depth = 12
     provable = True
 
     def __init__(self, contract: ArrayContract, mutation: str | None = None) -> None:
@@ -122,6 +125,16 @@ class ParallelProperties(FormalHarness):
         lo, hi = signed_range(w)
         h, wd, n = c.height, c.width, c.adc_bits
         step = started & ~p_rst & ~p_clear & p_strobe
+        rails: tuple[list, list, list] = ([], [], [])
+        full = (1 << n) - 1
+
+        def lowest_shifted_sum(kernel, y: int, x: int) -> int:
+            """The most negative shifted sum pixel (y, x) can receive (zero padding)."""
+            half = len(kernel) // 2
+            low = sum(wt * full for di, row in enumerate(kernel) for dj, wt in enumerate(row)
+                      if wt < 0 and 0 <= y + di - half < h and 0 <= x + dj - half < wd)
+            return low >> c.shift
+
         for s, kernel in enumerate(c.weights):
             half = len(kernel) // 2
             for y in range(h):
@@ -137,12 +150,24 @@ class ParallelProperties(FormalHarness):
                     self.check(m, "receptive.sum", cell.sum_in == ref_sum,
                                "the cell's input is the exact weighted sum of the codes "
                                "(codes outside the array are 0)")
-                    self._cell(m, s, a, cell, step, started, p_rst, p_clear, p_we,
-                               p_addr, p_data, lo, hi)
+                    high, low, cleared = self._cell(m, s, a, cell, step, started, p_rst,
+                                                    p_clear, p_we, p_addr, p_data, lo, hi)
+                    rails[0].append(high)
+                    rails[1].append(cleared)
+                    if c.signed and lowest_shifted_sum(kernel, y, x) < 0:
+                        rails[2].append(low)
+        self.check(m, "cover.saturate_high", Cat(*rails[0]).any(),
+                   "a total above the high rail (any cell)", "cover")
+        self.check(m, "cover.clear_after_spike", Cat(*rails[1]).any(),
+                   "a clear right after a spike (any cell)", "cover")
+        if rails[2]:
+            self.check(m, "cover.saturate_low", Cat(*rails[2]).any(),
+                       "a total below the low rail (any cell with a negative sum)", "cover")
         return m
 
     def _cell(self, m: Module, s: int, a: int, cell, step, started, p_rst, p_clear,
-              p_we, p_addr, p_data, lo: int, hi: int) -> None:
+              p_we, p_addr, p_data, lo: int, hi: int) -> tuple:
+        """The cell's properties; returns its rail and clear cover conditions."""
         c = self.contract
         w = c.accumulator_bits
         p_acc = Signal(signed(w), name=f"p_acc_{a}")
@@ -216,16 +241,8 @@ class ParallelProperties(FormalHarness):
         if c.signed:
             self.check(m, f"cover.spike_neg.s{s}", step & cell.spike_neg,
                        f"a -1 spike on scale {s}", "cover")
-        if a == 0:
-            self.check(m, "cover.saturate_high", step & (total > hi),
-                       "a total above the high rail", "cover")
-            if c.signed and c.sum_range(s)[0] < 0:
-                self.check(m, "cover.saturate_low", step & (total < lo),
-                           "a total below the low rail", "cover")
-            self.check(m, "cover.clear_after_spike",
-                       started & ~p_rst & p_clear & (p_pos | p_neg),
-                       "a clear right after a spike", "cover")
-
+        return (step & (total > hi), step & (total < lo),
+                started & ~p_rst & p_clear & (p_pos | p_neg))
 
 def parallel_properties(contract: ArrayContract, mutation: str | None = None,
                         **options: int) -> ParallelProperties:

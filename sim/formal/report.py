@@ -172,7 +172,8 @@ def run_checks(contract: ArrayContract, arch: str, options: dict[str, int], *,
     for name in chosen:
         harness = architecture.formal[name](contract, mutation=mutation, **options)
         run_mode = mode or ("prove" if harness.provable else "bmc")
-        run_depth = depth or harness.depth
+        run_depth = depth or (getattr(harness, "cover_depth", harness.depth)
+                              if run_mode == "cover" else harness.depth)
         if progress:
             progress(f"formal {arch} {name}: sby {run_mode} to depth {run_depth} ...")
         report.results.append(_run_check(name, harness, run_mode, run_depth, root,
