@@ -100,14 +100,18 @@ def fsm_point() -> DesignPoint:
     return dataclasses.replace(default_design_point(), model="fsm")
 
 
+#: The tiny design point of the formal checks (``make formal``).
+FORMAL_POINT = Path(__file__).parent / "data" / "formal-tiny.toml"
+
+
 @pytest.fixture
 def formal_point() -> DesignPoint:
-    """A tiny design point for ``rvsm formal`` (about a second of solver time per check):
-    2x2 pixels, dog2 (two signed scales, negative surround), 2-bit ADC, 5 fraction bits,
-    shift 1, 6-bit accumulators, reset subtract."""
-    return dataclasses.replace(default_design_point(), height=2, width=2, model="dog2",
-                               adc_bits=2, weight_frac_bits=5, shift=1,
-                               accumulator_bits=6, phi=8.0, reset="subtract")
+    """``tests/data/formal-tiny.toml``, the point of ``make formal`` (seconds of solver
+    time per check): 2x2 pixels, dog2 (two signed scales, negative surround), 2-bit ADC,
+    5 fraction bits, shift 1, 6-bit accumulators, reset subtract."""
+    from rvsm.model.fixed.point_toml import load_design_point
+
+    return load_design_point(FORMAL_POINT)
 
 
 @pytest.fixture

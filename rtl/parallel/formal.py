@@ -47,6 +47,7 @@ from amaranth.hdl import (
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.widths import signed_range
 from rvsm.rtl.formal import FormalHarness
+from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.array import RvsmArray, accumulator_index
 
 __all__ = ["ParallelProperties", "parallel_properties"]
@@ -75,7 +76,7 @@ class ParallelProperties(FormalHarness):
     def __init__(self, contract: ArrayContract, mutation: str | None = None) -> None:
         super().__init__()
         self.contract = contract
-        self.mutation = mutation
+        self.mutation = check_mutation(mutation, "parallel")
 
     def elaborate(self, platform: object) -> Module:
         m = Module()

@@ -25,6 +25,7 @@ from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.rtl.architectures import get_architecture
 from rvsm.rtl.formal import FormalHarness, Property, property_at
+from rvsm.rtl.mutations import check_mutation
 from rvsm.sim.formal.sby import MODES, SbyResult, check_tools, run_sby
 
 __all__ = ["CHECK_ORDER", "CheckResult", "Counterexample", "FormalReport",
@@ -165,6 +166,7 @@ def run_checks(contract: ArrayContract, arch: str, options: dict[str, int], *,
         raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
     if depth is not None and depth < 1:
         raise RvsmError(f"formal depth must be at least 1, got {depth}")
+    check_mutation(mutation, arch)
     architecture.check(contract, **options)
     check_tools()
     report = FormalReport(arch, dict(options), mutation)
