@@ -105,6 +105,12 @@ FORMAL_POINT = Path(__file__).parent / "data" / "formal-tiny.toml"
 
 
 @pytest.fixture
+def formal_point_toml() -> Path:
+    """The path of the tiny formal design point (:data:`FORMAL_POINT`)."""
+    return FORMAL_POINT
+
+
+@pytest.fixture
 def formal_point() -> DesignPoint:
     """``tests/data/formal-tiny.toml``, the point of ``make formal`` (seconds of solver
     time per check): 2x2 pixels, dog2 (two signed scales, negative surround), 2-bit ADC,
