@@ -205,6 +205,12 @@ def _run_check(name: str, harness: FormalHarness, mode: str, depth: int, root: P
     return _assert_result(name, sby, props, text, root, seconds)
 
 
+def _at(props: list[Property], location: str) -> list[Property]:
+    """Every property stated at sby's ``location`` (several when a harness states more
+    than one name on one source line: sby cannot tell them apart)."""
+    return [p for p in props if property_at([p], location) is not None]
+
+
 def _status(p: Property, status: str, depth: int | None) -> PropertyStatus:
     return PropertyStatus(p.name, p.kind, p.src, status, depth, p.description)
 
@@ -246,12 +252,12 @@ def _assert_result(name: str, sby: SbyResult, props: list[Property], text: str,
                            [_status(p, f"passed to depth {sby.depth}", sby.depth)
                             for p in asserts], None, sby.log, why)
     step = _failing_step(text)
-    failing = [property_at(props, loc) for loc in sby.failed]
-    failing_names = {p.name for p in failing if p is not None}
+    failing = [p for loc in sby.failed for p in _at(asserts, loc)]
+    failing_names = {p.name for p in failing}
     statuses = [_status(p, "failed", step) if p.name in failing_names
                 else _status(p, f"passed to depth {step}" if step is not None
                              else "not checked", step) for p in asserts]
-    first = next((p for p in failing if p is not None), None)
+    first = failing[0] if failing else None
     vcd = None
     if sby.trace is not None and sby.trace.is_file():
         vcd = root / f"{name}.counterexample.vcd"
@@ -272,10 +278,9 @@ def _cover_result(name: str, sby: SbyResult, props: list[Property], text: str,
     # every one is reached, at the step of the last
     reached: dict[str, int] = {}
     for step, loc in _REACHED.findall(text):
-        prop = property_at(covers, loc)
-        if prop is not None:
+        for prop in _at(covers, loc):
             reached[prop.name] = max(reached.get(prop.name, 0), int(step))
-    unreached = {p.name for p in (property_at(covers, loc) for loc in sby.failed) if p}
+    unreached = {p.name for loc in sby.failed for p in _at(covers, loc)}
     statuses = [_status(p, "not covered", sby.depth) if p.name in unreached
                 else _status(p, "covered", reached.get(p.name, sby.depth))
                 for p in covers]

@@ -32,13 +32,13 @@ def test_statements_name_every_property(formal_point, model, reset):
     asserts = {p.name for p in props if p.kind == "assert"}
     covers = {p.name for p in props if p.kind == "cover"}
     assert asserts == ASSERTS | {f"reset.{reset}"}
-    scales = range(contract.num_scales)
-    assert {f"cover.spike_pos.s{s}" for s in scales} <= covers
+    assert "cover.spike_pos" in covers
     assert {"cover.saturate_high", "cover.clear_after_spike"} <= covers
     assert ("cover.saturate_low" in covers) == contract.signed
-    negative = {f"cover.spike_neg.s{s}" for s in scales}
-    assert (negative <= covers) if contract.signed else not (negative & covers)
+    assert ("cover.spike_neg" in covers) == contract.signed
     assert all(p.src.split(":")[0].endswith("rtl/parallel/formal.py") for p in props)
+    # sby names a failing statement by its line: one property per line
+    assert len({p.src for p in props}) == len(props)
 
 
 @pytest.mark.parametrize("reset", ["subtract", "zero"])
