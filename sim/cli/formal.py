@@ -100,7 +100,10 @@ def format_report(report, height: int, width: int) -> str:
             lines.append(f"  note: {r.message}")
         cex = r.counterexample
         if cex is not None:
-            lines += [f"\nCOUNTEREXAMPLE ({r.check}): property {cex.property} fails",
+            others = [p.name for p in r.properties
+                      if p.status == "failed" and p.name != cex.property]
+            lines += [f"\nCOUNTEREXAMPLE ({r.check}): property {cex.property} fails"
+                      + (f" (also failing: {', '.join(others)})" if others else ""),
                       f"  what:   {cex.description}",
                       f"  source: {cex.src}",
                       f"  step:   {cex.step} (clock cycle from 0)",

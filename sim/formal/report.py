@@ -254,9 +254,11 @@ def _assert_result(name: str, sby: SbyResult, props: list[Property], text: str,
     step = _failing_step(text)
     failing = [p for loc in sby.failed for p in _at(asserts, loc)]
     failing_names = {p.name for p in failing}
+    # sby names every assertion failing at that step: the others held in steps 0..step
     statuses = [_status(p, "failed", step) if p.name in failing_names
-                else _status(p, f"passed to depth {step}" if step is not None
-                             else "not checked", step) for p in asserts]
+                else _status(p, f"passed to depth {step + 1}" if step is not None
+                             else "not checked", None if step is None else step + 1)
+                for p in asserts]
     first = failing[0] if failing else None
     vcd = None
     if sby.trace is not None and sby.trace.is_file():

@@ -52,7 +52,7 @@ def test_seeded_bug_gives_a_readable_counterexample(formal_point, tmp_path):
     names, times = parse_vcd(cex.vcd)
     assert any("spike_pos" in n for n in names) and len(times) >= cex.step + 1
     held = {p.status for p in result.properties if p.name not in failed}
-    assert held == {"passed to depth 1"}
+    assert held == {"passed to depth 2"}  # steps 0 and 1
     assert json.loads(json.dumps(report.to_json()))["checks"][0]["counterexample"][
         "property"] == cex.property
 
