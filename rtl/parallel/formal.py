@@ -25,7 +25,8 @@ and checks every accumulator cell against the contract's integer rules
   saturation rails, a clear right after a spike.
 
 Every property is 1-inductive (the harness remembers the previous cycle's inputs and
-state), so k-induction closes at any size: :attr:`ParallelProperties.provable`.
+state), so k-induction closes at any size and a small depth (3):
+:attr:`ParallelProperties.provable`.
 """
 
 from __future__ import annotations
@@ -68,7 +69,7 @@ class ParallelProperties(FormalHarness):
     """The properties of an ``H x W`` :class:`RvsmArray` for ``contract`` (tiny sizes:
     every cell gets every property). ``mutation``: a ``parallel.*`` deliberate bug."""
 
-    depth = 6
+    depth = 3
     #: Steps the covers need (a rail is reached after about 2**(W-1) / max|sum| steps).
     cover_depth = 12
     provable = True

@@ -44,7 +44,8 @@ def test_statements_name_every_property(formal_point, model, reset):
 @pytest.mark.parametrize("reset", ["subtract", "zero"])
 def test_shipped_array_is_proven(formal_point, tmp_path, reset):
     contract = dataclasses.replace(formal_point, reset=reset).contract()
-    result = run_sby(ParallelProperties(contract), tmp_path, mode="prove", depth=4)
+    harness = ParallelProperties(contract)
+    result = run_sby(harness, tmp_path, mode="prove", depth=harness.depth)
     assert result.status == "PASS", result.log.read_text()[-2000:]
 
 
