@@ -23,6 +23,7 @@ def test_registered_as_the_parallel_properties(formal_point):
     factory = get_architecture("parallel").formal["properties"]
     harness = factory(formal_point.contract(), mutation=None)
     assert isinstance(harness, ParallelProperties) and harness.provable
+    assert {p.name for p in harness.statements() if p.kind == "assert"} >= ASSERTS
 
 
 @pytest.mark.parametrize("model, reset", [("dog2", "subtract"), ("fsm", "zero")])
