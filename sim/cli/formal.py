@@ -30,8 +30,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mode", choices=("prove", "bmc", "cover"),
                    help="prove (k-induction), bmc (bounded) or cover (reachability); "
                    "default prove for a provable harness, else bmc")
-    p.add_argument("--check", action="append", metavar="NAME",
-                   help="run only this check (properties, equivalence); repeatable")
+    p.add_argument("--check", action="extend", nargs="+", metavar="NAME",
+                   help="run only these checks (properties, equivalence); default every "
+                   "check the architecture registers")
     p.add_argument("--timeout", type=float, metavar="SECONDS",
                    help="stop a check's solver after this long (exit 3)")
     p.add_argument("-o", "--out", default="build/formal",

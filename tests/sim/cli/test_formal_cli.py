@@ -26,7 +26,7 @@ def formal(tmp_path: Path, formal_point_toml: Path):
 
 
 def test_proven_json(formal, tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
-    assert formal("--json") == 0
+    assert formal("--json", "--check", "properties") == 0
     out = json.loads(capsys.readouterr().out)
     assert (out["arch"], out["ok"], out["exit_status"], out["size"]) == \
         ("parallel", True, 0, [2, 2])
