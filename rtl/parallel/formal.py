@@ -31,6 +31,8 @@ state), so k-induction closes at any size and a small depth (3):
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from amaranth.asserts import AnySeq
 from amaranth.hdl import (
     Cat,
@@ -41,6 +43,7 @@ from amaranth.hdl import (
     Mux,
     ResetSignal,
     Signal,
+    Value,
     signed,
     unsigned,
 )
@@ -50,6 +53,7 @@ from rvsm.model.fixed.widths import signed_range
 from rvsm.rtl.formal import FormalHarness
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.array import RvsmArray, accumulator_index
+from rvsm.rtl.parallel.pixel_cell import PixelCell
 
 __all__ = ["ParallelProperties", "parallel_properties"]
 
@@ -63,6 +67,30 @@ class _After(Elaboratable):
 
     def elaborate(self, platform: object) -> Module:
         return self.build(platform)
+
+
+@dataclass(frozen=True)
+class _Past:
+    """The previous cycle's inputs, as the harness's never-reset registers remember them
+    (``started``: a previous cycle exists)."""
+
+    started: Signal
+    rst: Signal
+    strobe: Signal
+    clear: Signal
+    we: Signal
+    addr: Signal
+    data: Signal
+
+    @property
+    def step(self) -> Value:
+        """The previous cycle was a contract step: strobe without clear or reset."""
+        return self.started & ~self.rst & ~self.clear & self.strobe
+
+    @property
+    def observed(self) -> Value:
+        """A previous cycle exists and was not a domain reset."""
+        return self.started & ~self.rst
 
 
 class ParallelProperties(FormalHarness):
@@ -103,30 +131,26 @@ class ParallelProperties(FormalHarness):
                    "written thresholds lie in 1 .. 2**(W-1)-1 (the contract's range)",
                    "assume")
 
-        started = Signal(name="past_valid")
-        p_rst, p_strobe, p_clear = Signal(), Signal(), Signal()
-        p_we = Signal()
-        p_addr = Signal.like(dut.cfg.addr, name="p_addr")
-        p_data = Signal.like(dut.cfg.data, name="p_data")
-        p_valid_in = Signal()
-        m.d.past += [started.eq(1), p_rst.eq(rst), p_strobe.eq(dut.strobe),
-                     p_clear.eq(dut.clear), p_we.eq(dut.cfg.we), p_addr.eq(dut.cfg.addr),
-                     p_data.eq(dut.cfg.data), p_valid_in.eq(dut.strobe & ~dut.clear)]
-        m.submodules.properties = _After(
-            lambda platform: self._cells(dut, rst, started, p_rst, p_strobe, p_clear,
-                                         p_we, p_addr, p_data))
-        self.check(m, "valid.latency", ~started | p_rst | (dut.valid == p_valid_in),
+        prev = _Past(Signal(name="past_valid"), Signal(name="p_rst"),
+                     Signal(name="p_strobe"), Signal(name="p_clear"), Signal(name="p_we"),
+                     Signal.like(dut.cfg.addr, name="p_addr"),
+                     Signal.like(dut.cfg.data, name="p_data"))
+        m.d.past += [prev.started.eq(1), prev.rst.eq(rst), prev.strobe.eq(dut.strobe),
+                     prev.clear.eq(dut.clear), prev.we.eq(dut.cfg.we),
+                     prev.addr.eq(dut.cfg.addr), prev.data.eq(dut.cfg.data)]
+        m.submodules.properties = _After(lambda platform: self._cells(dut, prev))
+        self.check(m, "valid.latency",
+                   ~prev.observed | (dut.valid == (prev.strobe & ~prev.clear)),
                    "valid is high exactly one cycle after a strobe without clear")
         return m
 
-    def _cells(self, dut: RvsmArray, rst, started, p_rst, p_strobe, p_clear, p_we,
-               p_addr, p_data) -> Module:
+    def _cells(self, dut: RvsmArray, prev: _Past) -> Module:
+        """Every cell's properties and the array-wide covers (``dut`` elaborated)."""
         m = Module()
         c = self.contract
         w = c.accumulator_bits
         lo, hi = signed_range(w)
         h, wd, n = c.height, c.width, c.adc_bits
-        step = started & ~p_rst & ~p_clear & p_strobe
         rails: tuple[list, list, list] = ([], [], [])
         full = (1 << n) - 1
 
@@ -152,8 +176,7 @@ class ParallelProperties(FormalHarness):
                     self.check(m, "receptive.sum", cell.sum_in == ref_sum,
                                "the cell's input is the exact weighted sum of the codes "
                                "(codes outside the array are 0)")
-                    high, low, cleared = self._cell(m, s, a, cell, step, started, p_rst,
-                                                    p_clear, p_we, p_addr, p_data, lo, hi)
+                    high, low, cleared = self._cell(m, a, cell, prev, lo, hi)
                     rails[0].append(high)
                     rails[1].append(cleared)
                     if c.signed and lowest_shifted_sum(kernel, y, x) < 0:
@@ -167,10 +190,11 @@ class ParallelProperties(FormalHarness):
                        "a total below the low rail (any cell with a negative sum)", "cover")
         return m
 
-    def _cell(self, m: Module, s: int, a: int, cell, step, started, p_rst, p_clear,
-              p_we, p_addr, p_data, lo: int, hi: int) -> tuple:
-        """The cell's properties; returns its rail and clear cover conditions."""
+    def _cell(self, m: Module, a: int, cell: PixelCell, prev: _Past, lo: int,
+              hi: int) -> tuple[Value, Value, Value]:
+        """Cell ``a``'s properties; returns its rail and clear cover conditions."""
         c = self.contract
+        step = prev.step
         w = c.accumulator_bits
         p_acc = Signal(signed(w), name=f"p_acc_{a}")
         p_thr = Signal(unsigned(w - 1), name=f"p_thr_{a}")
@@ -218,22 +242,22 @@ class ParallelProperties(FormalHarness):
                    f"{c.reset!r} leaves")
         held = ((cell.acc == p_acc) & (cell.spike_pos == p_pos)
                 & (cell.spike_neg == p_neg))
-        self.check(m, "hold.no_strobe", ~started | p_rst | p_clear | step | held,
+        self.check(m, "hold.no_strobe", ~prev.observed | prev.clear | step | held,
                    "without strobe, clear or reset the accumulator and spikes keep")
         self.check(m, "clear.zeroes_state",
-                   ~started | p_rst | ~p_clear
+                   ~prev.observed | ~prev.clear
                    | ((cell.acc == 0) & ~cell.spike_pos & ~cell.spike_neg),
                    "clear zeroes the accumulator and the spikes")
         self.check(m, "reset.domain",
-                   ~started | ~p_rst
+                   ~prev.started | ~prev.rst
                    | ((cell.acc == 0) & ~cell.spike_pos & ~cell.spike_neg
                       & (cell.threshold == hi)),
                    f"the domain reset zeroes accumulator and spikes, threshold to {hi}")
-        written = p_we & (p_addr == a)
-        self.check(m, "threshold.write", ~started | p_rst | ~written
-                   | (cell.threshold == p_data),
+        written = prev.we & (prev.addr == a)
+        self.check(m, "threshold.write", ~prev.observed | ~written
+                   | (cell.threshold == prev.data),
                    "a threshold write to the cell's address loads it from the next cycle")
-        self.check(m, "threshold.kept", ~started | p_rst | written
+        self.check(m, "threshold.kept", ~prev.observed | written
                    | (cell.threshold == p_thr),
                    "without a write to its address (or a reset) the threshold keeps "
                    "(clear keeps it too)")
@@ -246,7 +270,8 @@ class ParallelProperties(FormalHarness):
             self.check(m, "cover.spike_neg", step & cell.spike_neg,
                        "a -1 spike on every scale, in every cell", "cover")
         return (step & (total > hi), step & (total < lo),
-                started & ~p_rst & p_clear & (p_pos | p_neg))
+                prev.observed & prev.clear & (p_pos | p_neg))
+
 
 def parallel_properties(contract: ArrayContract, mutation: str | None = None,
                         **options: int) -> ParallelProperties:
