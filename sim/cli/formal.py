@@ -73,7 +73,8 @@ def _formal(args: argparse.Namespace) -> int:
         print(format_report(report, contract.height, contract.width))
     for r in report.results:
         if r.status == "error":
-            print(f"rvsm: error: formal check {r.check}: {r.message} (log: {r.log})",
+            where = "" if str(r.log) in r.message else f" (log: {r.log})"
+            print(f"rvsm: error: formal check {r.check}: {r.message}{where}",
                   file=sys.stderr)
     return report.exit_status
 
@@ -110,7 +111,7 @@ def format_report(report, height: int, width: int) -> str:
                       f"  step:   {cex.step} (clock cycle from 0)",
                       f"  trace:  {cex.vcd if cex.vcd else '(no VCD written)'}",
                       f"  log:    {r.log}"]
-        elif r.status == "error":
+        elif r.status == "error" and str(r.log) not in r.message:
             lines.append(f"  sby log: {r.log}")
     verdict = {0: "every property holds", 1: "a property FAILED",
                3: "a tool failed"}[report.exit_status]

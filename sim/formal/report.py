@@ -195,9 +195,10 @@ def _run_check(name: str, harness: FormalHarness, mode: str, depth: int, root: P
                       timeout=timeout)
     except ToolError as exc:
         log = root / name / "formal.log"
+        kind = "cover" if mode == "cover" else "assert"
         return CheckResult(name, mode, depth, "error", time.perf_counter() - started,
                            [_status(p, "not checked", None) for p in props
-                            if p.kind != "assume"], None, log, str(exc))
+                            if p.kind == kind], None, log, str(exc))
     seconds = time.perf_counter() - started
     text = sby.log.read_text(errors="replace") if sby.log.is_file() else ""
     if mode == "cover":

@@ -92,3 +92,11 @@ def test_missing_solver_is_exit_3(formal, tmp_path: Path, capsys: pytest.Capture
     assert formal() == 3
     err = capsys.readouterr().err.strip()
     assert "not found" in err and len(err.splitlines()) == 1
+
+
+def test_solver_over_its_time_limit_is_exit_3(formal, capsys: pytest.CaptureFixture) -> None:
+    assert formal("--timeout", "0.2") == 3
+    captured = capsys.readouterr()
+    errors = [line for line in captured.err.splitlines() if line.startswith("rvsm: error")]
+    assert len(errors) == 1 and "time limit" in errors[0]
+    assert "not checked" in captured.out and "cover" not in captured.out.split("note:")[0]
