@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress bench bench-sweep fuzz lint clean
+.PHONY: setup demo test regress formal fuzz bench bench-sweep lint clean
 
 setup: $(STAMP)
 
@@ -27,6 +27,24 @@ test: setup
 
 regress: setup
 	$(BIN)/python -m pytest -n $(JOBS) -q -m "slow or not slow"
+	$(MAKE) formal
+
+# Every formal check of both architectures at the tiny configurations, both reset modes
+# (docs/formal.md): prove (or bmc to the harness's depth) and cover. Reports and
+# counterexample VCDs in build/formal/.
+FORMAL_POINTS := tests/data/formal-tiny.toml tests/data/formal-tiny-zero.toml
+formal: setup
+	set -e; for point in $(FORMAL_POINTS); do \
+	  name=$$(basename $$point .toml); \
+	  for mode in "" "--mode cover"; do \
+	    tag=$$(echo "$$mode" | tr -d ' -'); \
+	    $(BIN)/rvsm formal $$point --arch parallel $$mode -o build/formal/$$name-parallel$$tag; \
+	    for lanes in 1 3; do \
+	      $(BIN)/rvsm formal $$point --arch stream --size 4x3 --lanes $$lanes $$mode \
+	        -o build/formal/$$name-stream-l$$lanes$$tag; \
+	    done; \
+	  done; \
+	done
 
 # the long fuzzing campaign: every reader, CASES generated cases in all (docs/fuzzing.md)
 fuzz: setup

@@ -28,7 +28,10 @@ class Mutation:
 
 
 #: Every mutation, by name.
-MUTATIONS: dict[str, Mutation] = {}
+MUTATIONS: dict[str, Mutation] = {m.name: m for m in (
+    Mutation("parallel.threshold_off_by_one", "parallel", "rtl/parallel/pixel_cell.py",
+             "fire +1 when the saturated total exceeds the threshold (> instead of >=)"),
+)}
 
 
 def mutations_for(architecture: str) -> list[Mutation]:

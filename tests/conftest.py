@@ -9,6 +9,8 @@
   cache shared by every pytest-xdist worker of the session.
 - :func:`fsm_point` / :func:`fake_tool`: the smallest design point for the FPGA flow, and
   stand-in tool scripts for its failure paths.
+- :func:`formal_point`: a tiny design point with narrow widths (2x2, dog2, 2-bit ADC,
+  6-bit accumulators, subtract reset) for the formal checks.
 - :func:`shell_env`: the environment in which documented shell lines run (README, docs).
 """
 
@@ -96,6 +98,26 @@ def rtl_builds(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def fsm_point() -> DesignPoint:
     """The default design point with the FSM model: the smallest RTL, for tool flows."""
     return dataclasses.replace(default_design_point(), model="fsm")
+
+
+#: The tiny design point of the formal checks (``make formal``).
+FORMAL_POINT = Path(__file__).parent / "data" / "formal-tiny.toml"
+
+
+@pytest.fixture
+def formal_point_toml() -> Path:
+    """The path of the tiny formal design point (:data:`FORMAL_POINT`)."""
+    return FORMAL_POINT
+
+
+@pytest.fixture
+def formal_point() -> DesignPoint:
+    """``tests/data/formal-tiny.toml``, the point of ``make formal`` (seconds of solver
+    time per check): 2x2 pixels, dog2 (two signed scales, negative surround), 2-bit ADC,
+    5 fraction bits, shift 1, 6-bit accumulators, reset subtract."""
+    from rvsm.model.fixed.point_toml import load_design_point
+
+    return load_design_point(FORMAL_POINT)
 
 
 @pytest.fixture

@@ -9,6 +9,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architecture import Architecture
 from rvsm.rtl.parallel.array import RvsmArray
 from rvsm.rtl.parallel.drive import compare_spikes, simulate
+from rvsm.rtl.parallel.formal import parallel_properties
 from rvsm.rtl.ports import port_map
 
 __all__ = ["MAX_SIDE", "PARALLEL", "check_size"]
@@ -55,4 +56,5 @@ PARALLEL = Architecture(
     simulate=simulate,
     compare=_compare,
     testbench="rvsm.sim.cosim.tb_array",
+    formal={"properties": parallel_properties},
 )

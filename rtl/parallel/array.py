@@ -65,6 +65,9 @@ class RvsmArray(wiring.Component):
         self.mutation = check_mutation(mutation, "parallel")
         self.num_accumulators = contract.num_scales * contract.height * contract.width
         self.addr_bits = index_bits(self.num_accumulators)
+        #: The cells by accumulator index, filled when elaborated (formal harnesses
+        #: observe their ``acc`` and ``threshold``).
+        self.cells: dict[int, PixelCell] = {}
         super().__init__(self.interface(contract))
 
     @staticmethod
@@ -138,7 +141,8 @@ class RvsmArray(wiring.Component):
                                 wts.append(wt)
                     a = accumulator_index(c, s, y, x)
                     cell = PixelCell(sum_width(lo, hi), c.shift, c.accumulator_bits,
-                                     c.signed, c.reset)
+                                     c.signed, c.reset, self.mutation)
+                    self.cells[a] = cell
                     m.submodules[f"cell_s{s}_y{y}_x{x}"] = cell
                     m.d.comb += [
                         cell.sum_in.eq(weighted_sum(taps, wts, lo, hi)),

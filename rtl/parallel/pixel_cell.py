@@ -39,7 +39,9 @@ class PixelCell(wiring.Component):
     Ports: ``sum_in`` In(signed(sum_bits)); ``strobe``, ``clear`` In(1); ``thr``
     In(ThresholdWriteSignature(W-1)): ``thr.we``, ``thr.data``; ``spike_pos``,
     ``spike_neg`` Out(1), registered, valid :attr:`LATENCY` cycles after the strobe;
-    ``acc`` Out(signed(W)) for observation.
+    ``acc`` Out(signed(W)) and ``threshold`` Out(unsigned(W-1)) for observation (the
+    formal harness :mod:`rvsm.rtl.parallel.formal`). ``mutation``: a deliberate bug of
+    :mod:`rvsm.rtl.mutations` (``parallel.*``) or None.
     """
 
     #: Clock cycles from the strobe edge that samples ``sum_in`` to valid spike outputs.
@@ -52,6 +54,7 @@ class PixelCell(wiring.Component):
         accumulator_bits: int,
         signed_model: bool,
         reset: str = "zero",
+        mutation: str | None = None,
     ):
         if reset not in ("zero", "subtract"):
             raise ValueError(f"reset must be 'zero' or 'subtract', got {reset!r}")
@@ -60,6 +63,8 @@ class PixelCell(wiring.Component):
         self.accumulator_bits = accumulator_bits
         self.signed_model = signed_model
         self.reset = reset
+        #: A deliberate bug (:mod:`rvsm.rtl.mutations`) or None (the shipped logic).
+        self.mutation = mutation
         super().__init__({
             "sum_in": In(signed(sum_bits)),
             "strobe": In(1),
@@ -68,6 +73,7 @@ class PixelCell(wiring.Component):
             "spike_pos": Out(1),
             "spike_neg": Out(1),
             "acc": Out(signed(accumulator_bits)),
+            "threshold": Out(unsigned(accumulator_bits - 1)),
         })
 
     @property
@@ -82,7 +88,7 @@ class PixelCell(wiring.Component):
         w = self.accumulator_bits
         thr = Signal(unsigned(w - 1), init=hi)
         acc = Signal(signed(w))
-        m.d.comb += self.acc.eq(acc)
+        m.d.comb += [self.acc.eq(acc), self.threshold.eq(thr)]
 
         shifted = self.sum_in >> self.shift if self.shift else self.sum_in
         total = Signal(signed(max(w, len(shifted)) + 1))
@@ -92,7 +98,10 @@ class PixelCell(wiring.Component):
 
         pos = Signal()
         neg = Signal()
-        m.d.comb += pos.eq(sat >= thr)
+        if self.mutation == "parallel.threshold_off_by_one":
+            m.d.comb += pos.eq(sat > thr)
+        else:
+            m.d.comb += pos.eq(sat >= thr)
         if self.signed_model:
             m.d.comb += neg.eq(~pos & (sat <= -thr))
 

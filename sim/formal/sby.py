@@ -24,7 +24,7 @@ from amaranth.hdl import Elaboratable
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.model.infra.tools import find_tool, run_tool
 
-__all__ = ["MODES", "SbyResult", "run_sby", "sby_config"]
+__all__ = ["MODES", "SbyResult", "check_tools", "run_sby", "sby_config"]
 
 #: sby modes: ``prove`` (k-induction), ``bmc`` (bounded), ``cover`` (reachability).
 MODES = ("prove", "bmc", "cover")
@@ -78,6 +78,12 @@ def sby_config(rtlil_text: str, mode: str, depth: int, top: str = "top") -> str:
         """)
 
 
+def check_tools() -> None:
+    """:class:`ToolError` (one line naming it) when a tool of the flow is missing."""
+    for tool in _TOOLS:
+        find_tool(tool)
+
+
 def _tool_env() -> dict[str, str]:
     bindir = str(Path(sys.executable).parent)
     env = dict(os.environ)
@@ -98,8 +104,7 @@ def run_sby(harness: Elaboratable, workdir: str | os.PathLike, *, mode: str = "p
     result with ``status == "FAIL"``, not an exception."""
     if mode not in MODES:
         raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
-    for tool in _TOOLS:
-        find_tool(tool)
+    check_tools()
     root = Path(workdir)
     root.mkdir(parents=True, exist_ok=True)
     text = rtlil.convert(harness, name=name, ports=ports if ports is not None else [],

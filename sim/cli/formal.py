@@ -1,0 +1,119 @@
+"""``rvsm formal``: prove (or check to a bound, or cover) the RTL's formal properties."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from rvsm.model.infra.errors import RvsmError
+from rvsm.sim.cli.args import parse_size_arg
+from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
+from rvsm.sim.cli.rtl import add_arch_arguments, arch_options
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``formal`` sub-command."""
+    p = sub.add_parser(
+        "formal", help="prove the RTL's formal properties with yowasp-sby (smtbmc z3)",
+        description="Run the formal checks of an architecture (its property harness and, "
+        "where it has one, its bounded equivalence with a reference) at a design point, "
+        "usually at a tiny --size. Prints each property's status and, on a failure, the "
+        "property, its source line, the failing step and the counterexample VCD. Exit "
+        "status: 0 every property holds (every cover reached), 1 a counterexample or an "
+        "unreached cover, 2 bad input, 3 a tool failed (docs/formal.md).")
+    p.add_argument("point", help="design point TOML")
+    p.add_argument("--size", metavar="HxW", help="override the array size (keep it tiny)")
+    add_arch_arguments(p)
+    p.add_argument("--depth", type=int, metavar="N",
+                   help="steps (clock cycles) to check; default the harness's")
+    p.add_argument("--mode", choices=("prove", "bmc", "cover"),
+                   help="prove (k-induction), bmc (bounded) or cover (reachability); "
+                   "default prove for a provable harness, else bmc")
+    p.add_argument("--check", action="extend", nargs="+", metavar="NAME",
+                   help="run only these checks (properties, equivalence); default every "
+                   "check the architecture registers")
+    p.add_argument("--timeout", type=float, metavar="SECONDS",
+                   help="stop a check's solver after this long (exit 3)")
+    p.add_argument("-o", "--out", default="build/formal",
+                   help="output folder: sby work folders, counterexample VCDs, "
+                   "report.json (default: build/formal)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_formal)
+
+
+def _formal(args: argparse.Namespace) -> int:
+    from rvsm.model.fixed.point_toml import load_design_point
+    from rvsm.model.infra.atomic import write_text_atomic
+    from rvsm.rtl.architectures import ARCHITECTURES
+    from rvsm.sim.formal.report import run_checks
+
+    arch = ARCHITECTURES[args.arch]
+    options = arch_options(args)
+    if args.depth is not None and args.depth < 1:
+        raise RvsmError(f"--depth must be at least 1, got {args.depth}")
+    if args.timeout is not None and args.timeout <= 0:
+        raise RvsmError(f"--timeout must be positive, got {args.timeout}")
+    size = parse_size_arg(args.size)
+    point = load_design_point(args.point)
+    if size is not None:
+        point = point.with_size(*size)
+    contract = point.contract()
+    arch.check(contract, **options)
+    check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
+    report = run_checks(contract, args.arch, options, checks=args.check, mode=args.mode,
+                        depth=args.depth, workdir=args.out, timeout=args.timeout,
+                        progress=lambda line: print(line, file=sys.stderr, flush=True))
+    data = report.to_json()
+    data["size"] = [contract.height, contract.width]
+    write_text_atomic(f"{args.out}/report.json", json.dumps(data, indent=2) + "\n")
+    if args.json:
+        print(json.dumps(data, indent=2))
+    else:
+        print(format_report(report, contract.height, contract.width))
+    for r in report.results:
+        if r.status == "error":
+            where = "" if str(r.log) in r.message else f" (log: {r.log})"
+            print(f"rvsm: error: formal check {r.check}: {r.message}{where}",
+                  file=sys.stderr)
+    return report.exit_status
+
+
+def format_report(report, height: int, width: int) -> str:
+    """The table (property, kind, status, depth, time) of every check and, per failing
+    check, one block: property, description, source line, step, VCD."""
+    opts = "".join(f", {k} {v}" for k, v in report.options.items())
+    lines = [f"rvsm formal: --arch {report.arch} {height}x{width}{opts}"]
+    for r in report.results:
+        lines.append(f"\n{r.check}: {r.mode} to depth {r.depth}, {r.status} "
+                     f"({r.seconds:.1f} s)")
+        rows = [(p.name, p.kind, p.status, "" if p.depth is None else str(p.depth))
+                for p in r.properties]
+        widths = [max(len(h), *(len(row[i]) for row in rows)) if rows else len(h)
+                  for i, h in enumerate(("property", "kind", "status", "depth"))]
+        head = ("property", "kind", "status", "depth")
+        lines.append("  " + "  ".join(h.ljust(w) for h, w in zip(head, widths, strict=True))
+                     + "  time")
+        for i, row in enumerate(rows):
+            t = f"{r.seconds:.1f} s" if i == 0 else ""
+            lines.append("  " + "  ".join(v.ljust(w) for v, w in zip(row, widths,
+                                                                      strict=True)) + "  " + t)
+        if r.message:
+            lines.append(f"  note: {r.message}")
+        cex = r.counterexample
+        if cex is not None:
+            others = [p.name for p in r.properties
+                      if p.status == "failed" and p.name != cex.property]
+            lines += [f"\nCOUNTEREXAMPLE ({r.check}): property {cex.property} fails"
+                      + (f" (also failing: {', '.join(others)})" if others else ""),
+                      f"  what:   {cex.description}",
+                      f"  source: {cex.src}",
+                      f"  step:   {cex.step} (clock cycle from 0)",
+                      f"  trace:  {cex.vcd if cex.vcd else '(no VCD written)'}",
+                      f"  log:    {r.log}"]
+        elif r.status == "error" and str(r.log) not in r.message:
+            lines.append(f"  sby log: {r.log}")
+    verdict = {0: "every property holds", 1: "a property FAILED",
+               3: "a tool failed"}[report.exit_status]
+    lines.append(f"\n{verdict}; report {'ok' if report.ok else 'not ok'}")
+    return "\n".join(lines)

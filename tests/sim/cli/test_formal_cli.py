@@ -1,0 +1,102 @@
+"""``rvsm formal`` at the tiny point: exit 0 (proven, --json shape), 1 (a counterexample
+block naming property, source line, step and VCD; an unreached cover), 2 (bad input, one
+line), 3 (a missing solver, one line)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from rvsm.model.infra.errors import ToolError
+from rvsm.rtl.parallel.architecture import PARALLEL
+from rvsm.rtl.parallel.formal import ParallelProperties
+from rvsm.sim.cli import main
+from rvsm.sim.formal import sby
+
+
+@pytest.fixture
+def formal(tmp_path: Path, formal_point_toml: Path):
+    """``rvsm formal POINT --arch parallel -o tmp/out EXTRA...`` -> exit status."""
+    def run(*extra: str) -> int:
+        return main(["formal", str(formal_point_toml), "--arch", "parallel",
+                     "-o", str(tmp_path / "out"), *extra])
+    return run
+
+
+def test_proven_json(formal, tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    assert formal("--json", "--check", "properties") == 0
+    out = json.loads(capsys.readouterr().out)
+    assert (out["arch"], out["ok"], out["exit_status"], out["size"]) == \
+        ("parallel", True, 0, [2, 2])
+    (check,) = out["checks"]
+    assert (check["check"], check["mode"], check["status"]) == ("properties", "prove",
+                                                                 "pass")
+    assert check["depth"] == ParallelProperties.depth and check["counterexample"] is None
+    assert {p["status"] for p in check["properties"]} == {"proven"}
+    assert {"fire.threshold_implies_spike", "reset.subtract"} <= {
+        p["name"] for p in check["properties"]}
+    assert set(check["properties"][0]) == {"name", "kind", "src", "status", "depth",
+                                           "description"}
+    assert json.loads((tmp_path / "out" / "report.json").read_text())["ok"] is True
+
+
+def test_counterexample_block(formal, tmp_path: Path, capsys: pytest.CaptureFixture,
+                              monkeypatch: pytest.MonkeyPatch) -> None:
+    def buggy(contract, mutation=None, **options):
+        return ParallelProperties(contract, mutation="parallel.threshold_off_by_one")
+
+    monkeypatch.setitem(PARALLEL.formal, "properties", buggy)
+    assert formal("--mode", "bmc", "--depth", "3") == 1
+    out = capsys.readouterr().out
+    block = out[out.index("COUNTEREXAMPLE"):]
+    assert "rtl/parallel/formal.py:" in block and "step:   1" in block
+    vcd = Path(block.split("trace:")[1].split()[0])
+    assert vcd.is_file() and vcd.parent == tmp_path / "out"
+    assert "failed" in out and "a property FAILED" in out
+
+
+def test_unreached_cover_is_exit_1(formal, capsys: pytest.CaptureFixture) -> None:
+    assert formal("--mode", "cover", "--depth", "1", "--json") == 1
+    check = json.loads(capsys.readouterr().out)["checks"][0]
+    assert check["status"] == "fail" and "not covered" in {
+        p["status"] for p in check["properties"]}
+
+
+@pytest.mark.parametrize("extra, message", [
+    (("--size", "2x"), "size"),
+    (("--depth", "0"), "--depth"),
+    (("--check", "nope"), "unknown formal check"),
+    (("--lanes", "2"), "lanes"),
+])
+def test_bad_input_is_exit_2(formal, tmp_path: Path, capsys: pytest.CaptureFixture,
+                             extra: tuple[str, ...], message: str) -> None:
+    assert formal(*extra) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1
+
+
+def test_bad_mode_is_a_usage_error(formal) -> None:
+    with pytest.raises(SystemExit) as exc:
+        formal("--mode", "sim")
+    assert exc.value.code == 2
+
+
+def test_missing_solver_is_exit_3(formal, tmp_path: Path, capsys: pytest.CaptureFixture,
+                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    def missing(name: str) -> str:
+        raise ToolError(f"{name} not found; install it with `pip install z3-solver`")
+
+    monkeypatch.setattr(sby, "find_tool", missing)
+    assert formal() == 3
+    err = capsys.readouterr().err.strip()
+    assert "not found" in err and len(err.splitlines()) == 1
+
+
+def test_solver_over_its_time_limit_is_exit_3(formal, capsys: pytest.CaptureFixture) -> None:
+    assert formal("--timeout", "0.2") == 3
+    captured = capsys.readouterr()
+    errors = [line for line in captured.err.splitlines() if line.startswith("rvsm: error")]
+    assert len(errors) == 1 and "time limit" in errors[0]
+    assert "not checked" in captured.out and "cover" not in captured.out.split("note:")[0]
