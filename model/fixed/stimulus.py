@@ -185,7 +185,9 @@ def load_stimulus(path: str | os.PathLike) -> Stimulus:
     p = Path(path)
     if not p.is_file():
         raise RvsmError(f"stimulus file {p} does not exist")
-    check_npz_members(p, {"codes": 3, "thresholds": 3, "spikes": 4})
+    check_npz_members(p, {"codes": 3, "thresholds": 3, "spikes": 4, "weights": None,
+                          "half_widths": None, "contract": 0, "point": 0, "meta": 0,
+                          "clear_before": None})
     verify_npz(p, "stimulus file")
     try:
         with np.load(p, allow_pickle=False) as data:
@@ -195,6 +197,10 @@ def load_stimulus(path: str | os.PathLike) -> Stimulus:
                     f"{p} is not an rvsm stimulus file: missing {', '.join(sorted(missing))}"
                 )
             arrays = {k: data[k] for k in STIMULUS_KEYS + OPTIONAL_KEYS if k in data.files}
+            odd = [k for k, v in arrays.items() if not isinstance(v, np.ndarray)]
+            if odd:
+                raise RvsmError(f"{p}: member {odd[0]!r} is not a .npy array; the file is "
+                                f"damaged or not an rvsm stimulus file")
     except RvsmError:
         raise
     except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:

@@ -22,8 +22,26 @@ from rvsm.model.infra.memory import require_memory
 MAX_DEFLATE_RATIO = 1100
 
 
-def _header(handle: BinaryIO, source: str) -> tuple[tuple[int, ...], np.dtype, int]:
-    """``(shape, dtype, header bytes)`` of the ``.npy`` stream at ``handle``."""
+#: Largest ``.npy`` header read (bytes); numpy writes a few hundred.
+MAX_HEADER_BYTES = 1 << 16
+
+
+def _header(handle: BinaryIO, source: str,
+            available: int | None = None) -> tuple[tuple[int, ...], np.dtype, int]:
+    """``(shape, dtype, header bytes)`` of the ``.npy`` stream at ``handle`` (seekable),
+    ``available`` bytes long; a header length beyond the data (or over
+    :data:`MAX_HEADER_BYTES`) is refused before numpy reads it."""
+    try:
+        head = handle.read(12)
+        handle.seek(0)
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
+        raise RvsmError(f"{source}: cannot load .npy data ({exc})") from None
+    if len(head) >= 10 and head[:6] == b"\x93NUMPY":
+        size = (int.from_bytes(head[8:10], "little") if head[6] == 1
+                else int.from_bytes(head[8:12], "little"))
+        if size > MAX_HEADER_BYTES or (available is not None and size > available):
+            raise RvsmError(f"{source}: cannot load .npy data, its header claims {size} "
+                            f"bytes; the file is truncated or corrupt")
     try:
         version = npformat.read_magic(handle)
         if version == (1, 0):
@@ -52,7 +70,7 @@ def check_npy_file(path: str | os.PathLike) -> tuple[int, ...]:
     """Check an ``.npy`` file's header against its size and the memory; returns the shape."""
     p = Path(path)
     with open(p, "rb") as handle:
-        shape, dtype, offset = _header(handle, str(p))
+        shape, dtype, offset = _header(handle, str(p), p.stat().st_size)
     _check(shape, dtype, p.stat().st_size - offset, str(p))
     return shape
 
@@ -81,7 +99,7 @@ def check_npz_members(path: str | os.PathLike, ndims: dict[str, int | None]) -> 
                                 f"{info.compress_size} compressed; the archive is corrupt")
             try:
                 with zf.open(info) as handle:
-                    shape, dtype, offset = _header(handle, source)
+                    shape, dtype, offset = _header(handle, source, info.file_size)
             except (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError,
                     NotImplementedError, RuntimeError) as exc:
                 raise RvsmError(f"{source}: unreadable member, the archive is damaged "

@@ -30,8 +30,8 @@ def validate_frames(frames: np.ndarray, source: str = "scene") -> np.ndarray:
     arr = np.asarray(frames)
     if arr.dtype == object or not (
         np.issubdtype(arr.dtype, np.number) or arr.dtype == bool
-    ):
-        raise RvsmError(f"{source}: frames must be numeric, got dtype {arr.dtype}")
+    ) or np.issubdtype(arr.dtype, np.complexfloating):
+        raise RvsmError(f"{source}: frames must be real numbers, got dtype {arr.dtype}")
     if arr.ndim == 2:
         arr = arr[None]
     if arr.ndim != 3:

@@ -44,8 +44,11 @@ def load_spikes(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
                 raise RvsmError(
                     f"{path} is not an rvsm spike file: missing {', '.join(sorted(missing))}"
                 )
-            spikes = data["spikes"]
-            meta_text = str(data["meta"])
+            spikes, meta_value = data["spikes"], data["meta"]
+            if not (isinstance(spikes, np.ndarray) and isinstance(meta_value, np.ndarray)):
+                raise RvsmError(f"{path}: 'spikes' or 'meta' is not a .npy array; the file "
+                                f"is damaged or not an rvsm spike file")
+            meta_text = str(meta_value)
     except RvsmError:
         raise
     except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:

@@ -200,3 +200,19 @@ def test_refusals_name_the_problem(stimulus_bytes, tmp_path) -> None:
         path.write_bytes(_edited(stimulus_bytes, member, MEMBER_EDITS[member][index]))
         with pytest.raises(RvsmError, match=words):
             load_stimulus(path)
+
+
+def test_a_member_that_is_not_an_array_is_refused(stimulus_bytes, tmp_path) -> None:
+    """Found by ``make fuzz``: a member whose bytes are not ``.npy`` data (numpy returns
+    them as raw ``bytes``) was used as an array (``AttributeError``)."""
+    source = zipfile.ZipFile(io.BytesIO(stimulus_bytes))
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w") as target:
+        for info in source.infolist():
+            name = info.filename.removesuffix(".npy")
+            data = b"not npy data" if name == "contract" else source.read(info)
+            target.writestr(name, data)
+    path = tmp_path / "s.npz"
+    path.write_bytes(out.getvalue())
+    outcome = reader_outcome(lambda: load_stimulus(path))
+    assert not outcome.ok

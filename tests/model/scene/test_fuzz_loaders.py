@@ -144,3 +144,15 @@ def test_unusual_file_names(name, tmp_path_factory) -> None:
         return
     outcome = _scene_outcome(path)
     assert outcome.ok, outcome.message
+
+
+def test_a_header_claiming_gigabytes_is_refused_before_reading(tmp_path) -> None:
+    """Found by ``make fuzz``: a damaged version byte made numpy read a 3.2 GB header."""
+    buf = io.BytesIO()
+    np.save(buf, np.zeros((3, 8, 10)))
+    data = bytearray(buf.getvalue())
+    data[6:12] = b"\x02\x00\x00\x00\x00\xc1"  # version 2.0, header length 0xc1000000
+    path = tmp_path / "s.npy"
+    path.write_bytes(bytes(data))
+    outcome = reader_outcome(lambda: load_scene(str(path)), memory_bytes=1 << 28)
+    assert "header claims" in outcome.message
