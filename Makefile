@@ -37,7 +37,7 @@ formal: setup
 	set -e; for point in $(FORMAL_POINTS); do \
 	  name=$$(basename $$point .toml); \
 	  for mode in "" "--mode cover"; do \
-	    tag=$$(echo "$$mode" | tr -d ' -'); \
+	    tag=$${mode:+-cover}; \
 	    $(BIN)/rvsm formal $$point --arch parallel $$mode -o build/formal/$$name-parallel$$tag; \
 	    for lanes in 1 3; do \
 	      $(BIN)/rvsm formal $$point --arch stream --size 4x3 --lanes $$lanes $$mode \

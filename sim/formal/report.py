@@ -179,7 +179,7 @@ def run_checks(contract: ArrayContract, arch: str, options: dict[str, int], *,
         if progress:
             progress(f"formal {arch} {name}: sby {run_mode} to depth {run_depth} ...")
         report.results.append(_run_check(name, harness, run_mode, run_depth, root,
-                                         timeout))
+                                         timeout, progress))
         if progress:
             r = report.results[-1]
             progress(f"formal {arch} {name}: {r.status} ({r.seconds:.1f} s)")
@@ -187,12 +187,15 @@ def run_checks(contract: ArrayContract, arch: str, options: dict[str, int], *,
 
 
 def _run_check(name: str, harness: FormalHarness, mode: str, depth: int, root: Path,
-               timeout: float | None) -> CheckResult:
+               timeout: float | None,
+               progress: Callable[[str], None] | None) -> CheckResult:
     started = time.perf_counter()
     props = harness.statements()
     try:
         sby = run_sby(harness, root / name, mode=mode, depth=depth, name="formal",
-                      timeout=timeout)
+                      timeout=timeout,
+                      progress=(lambda line: progress(f"formal {name}: {line}"))
+                      if progress else None)
     except ToolError as exc:
         log = root / name / "formal.log"
         kind = "cover" if mode == "cover" else "assert"

