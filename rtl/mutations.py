@@ -28,9 +28,43 @@ class Mutation:
 
 
 #: Every mutation, by name.
+_ARRAY = "rtl/stream/array.py"
+_CELL = "rtl/parallel/pixel_cell.py"
 MUTATIONS: dict[str, Mutation] = {m.name: m for m in (
-    Mutation("parallel.threshold_off_by_one", "parallel", "rtl/parallel/pixel_cell.py",
+    Mutation("stream.threshold_off_by_one", "stream", _ARRAY,
+             "fire +1 when the total exceeds the threshold (> instead of >=)"),
+    Mutation("stream.no_saturation", "stream", _ARRAY,
+             "no saturation: an overflowing accumulator wraps around"),
+    Mutation("stream.no_reset_on_spike", "stream", _ARRAY,
+             "keep the accumulator after a spike (missed reset)"),
+    Mutation("stream.zero_instead_of_subtract", "stream", _ARRAY,
+             "reset to zero where the contract subtracts the threshold"),
+    Mutation("stream.no_negative_spikes", "stream", _ARRAY,
+             "never fire -1 (the negative compare left out)"),
+    Mutation("stream.stale_threshold", "stream", _ARRAY,
+             "compare with the previous position's threshold (a stale threshold read)"),
+    Mutation("stream.no_threshold_forwarding", "stream", _ARRAY,
+             "a threshold write meeting a read of its word is not forwarded"),
+    Mutation("stream.shift_off_by_one", "stream", _ARRAY,
+             "shift the receptive sum one bit too far"),
+    Mutation("stream.swapped_lanes", "stream", _ARRAY,
+             "lanes 0 and 1 of every scale swapped on the output (P >= 2)"),
+    Mutation("stream.top_padding_off_by_one", "stream", _ARRAY,
+             "the top border's zero-padding mask lets one row too many through"),
+    Mutation("stream.right_padding_off_by_one", "stream", _ARRAY,
+             "the right border's zero-padding mask lets one column group through"),
+    Mutation("stream.advance_during_stall", "stream", _ARRAY,
+             "the pipeline advances while the input stalls (a beat duplicated)"),
+    Mutation("stream.clear_forgets_scale0", "stream", _ARRAY,
+             "after a clear, scale 0 reads its old accumulators (a bank not cleared)"),
+    Mutation("parallel.threshold_off_by_one", "parallel", _CELL,
              "fire +1 when the saturated total exceeds the threshold (> instead of >=)"),
+    Mutation("parallel.wrapping_accumulator", "parallel", _CELL,
+             "no saturation: the accumulator wraps around"),
+    Mutation("parallel.zero_instead_of_subtract", "parallel", _CELL,
+             "reset to zero where the contract subtracts the threshold"),
+    Mutation("parallel.clear_ignored", "parallel", _CELL,
+             "clear does not zero the accumulators"),
 )}
 
 

@@ -24,20 +24,22 @@ def simulate(
     thresholds: np.ndarray,
     clear_before: Sequence[int] = (),
     vcd_path: str | None = None,
+    mutation: str | None = None,
 ) -> np.ndarray:
     """Run :class:`RvsmArray` in ``amaranth.sim``; spikes ``(T, S, H, W) int8``.
 
     Thresholds are loaded through the configuration port, one step is strobed per clock
     and ``clear`` is pulsed for one cycle before each step in ``clear_before``; outputs
     are read :attr:`RvsmArray.latency` cycles after each strobe (checking ``valid``).
-    With ``vcd_path`` the run's waveform is written there.
+    With ``vcd_path`` the run's waveform is written there; ``mutation`` builds a
+    deliberately broken array (:mod:`rvsm.rtl.mutations`, ``rvsm mutate``).
     """
     c = contract
     codes = np.asarray(codes, dtype=np.int64)
     thr = np.asarray(thresholds, dtype=np.int64)
     steps = codes.shape[0]
     n_acc = c.num_scales * c.height * c.width
-    dut = RvsmArray(c)
+    dut = RvsmArray(c, mutation=mutation)
     out = np.zeros((steps, n_acc), dtype=np.int8)
     clears = {int(t) for t in clear_before}
     shifts = np.arange(c.height * c.width, dtype=object) * c.adc_bits

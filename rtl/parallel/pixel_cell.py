@@ -94,7 +94,10 @@ class PixelCell(wiring.Component):
         total = Signal(signed(max(w, len(shifted)) + 1))
         m.d.comb += total.eq(acc + shifted)
         sat = Signal(signed(w))
-        m.d.comb += sat.eq(Mux(total > hi, hi, Mux(total < lo, lo, total)))
+        if self.mutation == "parallel.wrapping_accumulator":
+            m.d.comb += sat.eq(total[:w].as_signed())  # no saturation: wraps around
+        else:
+            m.d.comb += sat.eq(Mux(total > hi, hi, Mux(total < lo, lo, total)))
 
         pos = Signal()
         neg = Signal()
@@ -105,14 +108,15 @@ class PixelCell(wiring.Component):
         if self.signed_model:
             m.d.comb += neg.eq(~pos & (sat <= -thr))
 
-        if self.reset == "zero":
+        if self.reset == "zero" or self.mutation == "parallel.zero_instead_of_subtract":
             after = Mux(pos | neg, 0, sat)
         else:
             after = Mux(pos, sat - thr, Mux(neg, sat + thr, sat))
 
         with m.If(self.thr.we):
             m.d.sync += thr.eq(self.thr.data)
-        with m.If(self.clear):
+        clear = self.clear if self.mutation != "parallel.clear_ignored" else 0
+        with m.If(clear):
             m.d.sync += [acc.eq(0), self.spike_pos.eq(0), self.spike_neg.eq(0)]
         with m.Elif(self.strobe):
             m.d.sync += [acc.eq(after), self.spike_pos.eq(pos), self.spike_neg.eq(neg)]

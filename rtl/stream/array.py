@@ -228,7 +228,10 @@ class RvsmStreamArray(wiring.Component):
         advance = Signal(name="advance")
         clear = Signal(name="clear_r")
         codes_in = Signal(unsigned(p * n), name="codes_r", reset_less=True)
-        m.d.sync += [advance.eq(self.codes.valid & ~self.clear), clear.eq(self.clear)]
+        taken = self.codes.valid & ~self.clear
+        if self.mutation == "stream.advance_during_stall":
+            taken = ~self.clear  # a stalled cycle repeats the last beat
+        m.d.sync += [advance.eq(taken), clear.eq(self.clear)]
         with m.If(self.codes.valid & ~self.clear):
             m.d.sync += codes_in.eq(self.codes.payload.as_value())
         return advance, clear, codes_in
@@ -314,14 +317,16 @@ class RvsmStreamArray(wiring.Component):
         m.d.sync += [yc.eq(ny), gc.eq(ng), ac.eq(na)]
         row_ok = Signal(2 * r + 1, name="row_mask")
         col_ok = Signal(p + 2 * r, name="col_mask")
-        row_next = [(ny >= r - d) if d < r else (ny <= h - 1 - (d - r)) if d > r else Const(1)
-                    for d in range(2 * r + 1)]
+        top = 1 if self.mutation == "stream.top_padding_off_by_one" else 0
+        row_next = [(ny >= r - d - top) if d < r else (ny <= h - 1 - (d - r)) if d > r
+                    else Const(1) for d in range(2 * r + 1)]
         col_next = []
         for j in range(p + 2 * r):
             if j < r:
                 col_next.append(ng >= -(-(r - j) // p))
             elif j >= p + r:
-                col_next.append(ng <= -(-(c.width + r - j) // p) - 1)
+                right = 0 if self.mutation == "stream.right_padding_off_by_one" else 1
+                col_next.append(ng <= -(-(c.width + r - j) // p) - right)
             else:
                 col_next.append(Const(1))
         m.d.sync += [row_ok.eq(Cat(*row_next)), col_ok.eq(Cat(*col_next))]
@@ -412,8 +417,9 @@ class RvsmStreamArray(wiring.Component):
                          thr_mem.read_bank.eq(bank_q),
                          thr_mem.write_en.eq(bus_we & (bus_scale == s)),
                          thr_mem.write_addr.eq(bus_word), thr_mem.write_data.eq(bus_data),
-                         thr_mem.forward_hit.eq(bus_we & (bus_scale == s)
-                                                & (bus_word == rd_addr)),
+                         thr_mem.forward_hit.eq(
+                             bus_we & (bus_scale == s) & (bus_word == rd_addr)
+                             if self.mutation != "stream.no_threshold_forwarding" else 0),
                          thr_mem.forward_data.eq(fwd_data[1])]
             thr_q = thr_mem.data
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
@@ -426,8 +432,12 @@ class RvsmStreamArray(wiring.Component):
                          acc_mem.may_write.eq(tail.valid)]
             acc_q = acc_mem.data
             for i in range(p):
-                acc = Mux(fresh_q, 0, acc_q[i * wa:(i + 1) * wa].as_signed())
-                shifted = sums[i][s].value.as_signed() >> c.shift
+                fresh = fresh_q
+                if self.mutation == "stream.clear_forgets_scale0" and s == 0:
+                    fresh = 0  # the first frame after a clear reads scale 0's old state
+                acc = Mux(fresh, 0, acc_q[i * wa:(i + 1) * wa].as_signed())
+                extra = 1 if self.mutation == "stream.shift_off_by_one" else 0
+                shifted = sums[i][s].value.as_signed() >> (c.shift + extra)
                 data = {"reset_less": True}
                 total = Signal(signed(max(wa, len(shifted)) + 1), name=f"total_s{s}_l{i}",
                                **data)
@@ -437,14 +447,24 @@ class RvsmStreamArray(wiring.Component):
                 pos = Signal(name=f"pos_s{s}_l{i}", **data)
                 neg = Signal(name=f"neg_s{s}_l{i}", **data)
                 fire_pos = total >= thr1
+                if self.mutation == "stream.threshold_off_by_one":
+                    fire_pos = total > thr1
+                elif self.mutation == "stream.stale_threshold":
+                    fire_pos = total >= thr2  # the previous position's threshold
                 fire_neg = (~fire_pos & (total <= -thr1)) if c.signed else Const(0)
+                if self.mutation == "stream.no_negative_spikes":
+                    fire_neg = Const(0)
                 tail_stmts += [
                     total.eq(acc + shifted),
                     thr1.eq(thr_q[i * tw:(i + 1) * tw]),
-                    sat.eq(Mux(total > hi, hi, Mux(total < lo, lo, total))),
+                    sat.eq(total[:wa].as_signed()
+                           if self.mutation == "stream.no_saturation"  # wraps around
+                           else Mux(total > hi, hi, Mux(total < lo, lo, total))),
                     pos.eq(fire_pos), neg.eq(fire_neg), thr2.eq(thr1),
                 ]
-                if c.reset == "zero":
+                if self.mutation == "stream.no_reset_on_spike":
+                    after = sat
+                elif c.reset == "zero" or self.mutation == "stream.zero_instead_of_subtract":
                     after = Mux(pos | neg, 0, sat)
                 else:
                     after = Mux(pos, sat - thr2, Mux(neg, sat + thr2, sat))
@@ -453,6 +473,10 @@ class RvsmStreamArray(wiring.Component):
                 neg_bits.append(neg)
             m.d.comb += after_flat.eq(Cat(*after_lanes))
         out = self.spikes.payload
+        if self.mutation == "stream.swapped_lanes" and p > 1:
+            for bits in (pos_bits, neg_bits):  # lanes 0 and 1 of every scale swapped
+                for s in range(c.num_scales):
+                    bits[s * p], bits[s * p + 1] = bits[s * p + 1], bits[s * p]
         tail_stmts += [out.row.eq(tail.row), out.group.eq(tail.group), out.last.eq(tail.last),
                        out.pos.eq(Cat(*pos_bits)), out.neg.eq(Cat(*neg_bits))]
         with m.If(advance):

@@ -87,6 +87,7 @@ def simulate(
     idle_every: int = 0,
     bank_words: int = StreamGeometry.BANK_WORDS,
     vcd_path: str | None = None,
+    mutation: str | None = None,
 ) -> OutputBeats:
     """Run :class:`RvsmStreamArray` in ``amaranth.sim``; return every output beat.
 
@@ -95,14 +96,15 @@ def simulate(
     followed by a one-cycle ``clear``. ``threshold_updates`` maps a frame ``t`` (of the
     first segment) to thresholds written while the stream is paused at
     :meth:`StreamSchedule.threshold_pause_beat` ``(t)``. ``idle_every = k > 0`` drops
-    ``valid`` for one cycle after every ``k``-th beat (a paused stream). Compare the
+    ``valid`` for one cycle after every ``k``-th beat (a paused stream); ``mutation``
+    builds a deliberately broken array (:mod:`rvsm.rtl.mutations`). Compare the
     result with :func:`~rvsm.rtl.stream.schedule.check_beats`; its ``accepted`` holds,
     per output beat, the index (within its segment) of the input beat accepted two
     cycles before it was presented, the beat that released it.
     """
     c = contract
     codes = np.asarray(codes, dtype=np.int64)
-    dut = RvsmStreamArray(c, lanes, bank_words)
+    dut = RvsmStreamArray(c, lanes, bank_words, mutation=mutation)
     sched = dut.schedule
     updates = dict(threshold_updates or {})
     out = BeatCollector(dut)
