@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress formal fuzz bench bench-sweep lint clean
+.PHONY: setup demo test regress formal mutate fuzz bench bench-sweep lint clean
 
 setup: $(STAMP)
 
@@ -28,6 +28,7 @@ test: setup
 regress: setup
 	$(BIN)/python -m pytest -n $(JOBS) -q -m "slow or not slow"
 	$(MAKE) formal
+	$(MAKE) mutate
 
 # Every formal check of both architectures at the tiny configurations, both reset modes
 # (docs/formal.md): prove (or bmc to the harness's depth) and cover. Reports and
@@ -45,6 +46,11 @@ formal: setup
 	    done; \
 	  done; \
 	done
+
+# every RTL mutation against the co-simulation and formal checks (docs/mutation.md)
+mutate: setup
+	$(BIN)/rvsm config new -o $(OUT)/mutate-point.toml --force > /dev/null
+	$(BIN)/rvsm mutate $(OUT)/mutate-point.toml -o build/mutate
 
 # the long fuzzing campaign: every reader, CASES generated cases in all (docs/fuzzing.md)
 fuzz: setup

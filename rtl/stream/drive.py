@@ -21,7 +21,8 @@ from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, pack_lanes
 from rvsm.rtl.stream.signatures import threshold_word_bits
 
-__all__ = ["BeatCollector", "simulate", "threshold_writes", "write_thresholds"]
+__all__ = ["BeatCollector", "colliding_threshold_writes", "simulate",
+           "simulate_with_threshold_writes", "threshold_writes", "write_thresholds"]
 
 #: Payload fields of an output beat, in :meth:`OutputBeats.from_words` order.
 FIELDS = ("row", "group", "last", "pos", "neg")
@@ -141,3 +142,79 @@ def simulate(
 
     run_simulation(dut, bench, vcd_path)
     return out.beats()
+
+
+def simulate_with_threshold_writes(
+    contract: ArrayContract, lanes: int, codes: np.ndarray, thresholds: np.ndarray,
+    writes: Mapping[int, tuple[int, int, int]],
+    bank_words: int = StreamGeometry.BANK_WORDS, mutation: str | None = None,
+) -> OutputBeats:
+    """Load ``thresholds``, stream ``codes`` back to back (then ``lag`` flush beats) and,
+    at the edge accepting beat ``k``, write ``writes[k] = (s, addr, word)`` on ``thr``
+    (threshold writes while the stream runs, :func:`colliding_threshold_writes`)."""
+    c = contract
+    dut = RvsmStreamArray(c, lanes, bank_words, mutation=mutation)
+    sched = dut.schedule
+    word_bits = threshold_word_bits(sched.beats_per_frame)
+    beats = pack_lanes(sched.input_beats(np.asarray(codes, dtype=np.int64)), c.adc_bits)
+    out = BeatCollector(dut)
+
+    async def bench(ctx) -> None:  # noqa: ANN001 - SimulatorContext
+        for addr, word in threshold_writes(dut.geometry, thresholds):
+            ctx.set(dut.thr.we, 1)
+            ctx.set(dut.thr.addr, addr)
+            ctx.set(dut.thr.data, word)
+            await ctx.tick()
+        for k, beat in enumerate([*beats, None, None]):
+            ctx.set(dut.codes.valid, beat is not None)
+            ctx.set(dut.codes.payload.as_value(), beat or 0)
+            s, a, w = writes.get(k, (0, 0, 0))
+            ctx.set(dut.thr.we, k in writes)
+            ctx.set(dut.thr.addr, (s << word_bits) | a)
+            ctx.set(dut.thr.data, w)
+            await ctx.tick()
+            out.after_edge(ctx, k if beat is not None else -1)
+
+    run_simulation(dut, bench)
+    return out.beats()
+
+
+def colliding_threshold_writes(
+    geometry: StreamGeometry, thresholds: np.ndarray, steps: int, seed: int,
+    thr_hi: int,
+) -> tuple[dict[int, tuple[int, int, int]], list[np.ndarray], list[np.ndarray], int]:
+    """Threshold writes while ``steps`` frames stream back to back, many at the very edge
+    that reads the same word (not seen by that read) or one edge earlier (seen).
+
+    Returns ``(writes, frames, frames_late, collisions)``: the writes for
+    :func:`simulate_with_threshold_writes`, the threshold words ``(S, H*G, P)`` each frame
+    reads under the documented rule, the same if a write were seen at its own edge (a
+    wrong rule), and how many writes meet their own read."""
+    c, schedule = geometry.contract, geometry.schedule
+    lanes, hg, lag = schedule.lanes, schedule.beats_per_frame, schedule.threshold_lag
+    rng = np.random.default_rng(seed)
+    state = schedule.threshold_words(np.asarray(thresholds, dtype=np.int64)).copy()
+    seen_late = state.copy()
+    frames: list[np.ndarray] = []
+    frames_late: list[np.ndarray] = []
+    writes: dict[int, tuple[int, int, int]] = {}
+    collisions = 0
+    # back to back, position p reads at the edge accepting beat p + threshold_lag + 1
+    for p in range(steps * hg):
+        k = p + lag + 1
+        s, lanes_thr = int(rng.integers(c.num_scales)), rng.integers(1, thr_hi, lanes)
+        kind = rng.integers(4)  # 0: p's own word, 1: p+1's word, 2: any word, 3: none
+        a = [p % hg, (p + 1) % hg, int(rng.integers(hg)), None][kind]
+        if a is not None:
+            writes[k] = (s, a, pack_lanes(lanes_thr[None], c.threshold_bits)[0])
+            collisions += kind == 0
+        if p % hg == 0:
+            frames.append(np.empty_like(state))
+            frames_late.append(np.empty_like(state))
+        frames[-1][:, p % hg] = state[:, p % hg]
+        if a is not None:
+            seen_late[s, a] = lanes_thr
+        frames_late[-1][:, p % hg] = seen_late[:, p % hg]
+        if a is not None:
+            state[s, a] = lanes_thr
+    return writes, frames, frames_late, collisions

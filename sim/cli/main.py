@@ -14,12 +14,23 @@ import sys
 from types import ModuleType
 
 from rvsm.model.infra.errors import RvsmError, ToolError
-from rvsm.sim.cli import demo, fixed, formal, fpga, rtl, sampling, scenes, studies, sweep
+from rvsm.sim.cli import (
+    demo,
+    fixed,
+    formal,
+    fpga,
+    mutate,
+    rtl,
+    sampling,
+    scenes,
+    studies,
+    sweep,
+)
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
 #: co-simulation, formal checks, FPGA timing and area, paper studies, the demo, design sweeps.
-FAMILIES: tuple[ModuleType, ...] = (sampling, scenes, fixed, rtl, formal, fpga, studies, demo,
-                                    sweep)
+FAMILIES: tuple[ModuleType, ...] = (sampling, scenes, fixed, rtl, formal, mutate, fpga, studies,
+                                    demo, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -77,8 +77,7 @@ def _expected(contract: ArrayContract, stim: Stimulus) -> np.ndarray:
     update's frame on (what ``docs/stream-array.md`` says a paused write does)."""
     if not stim.threshold_updates:
         return contract.run(stim.codes, stim.thresholds, stim.clear_before)
-    from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift, \
-        integer_receptive_sums
+    from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift, integer_receptive_sums
 
     (frame, new), = stim.threshold_updates.items()
     c = contract
@@ -114,6 +113,31 @@ def _run_parallel(contract: ArrayContract, stim: Stimulus, lanes: int,
     return int((got != _expected(contract, stim)).sum())
 
 
+def _run_collisions(contract: ArrayContract, lanes: int, mutation: str | None) -> int:
+    """Threshold writes while the stream runs, many meeting the read of their word
+    (``tests/rtl/stream/test_array.py``'s scenario)."""
+    from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift, integer_receptive_sums
+    from rvsm.rtl.stream.drive import colliding_threshold_writes, simulate_with_threshold_writes
+    from rvsm.rtl.stream.geometry import StreamGeometry
+    from rvsm.rtl.stream.schedule import check_beats
+
+    c = contract
+    stim = stimulus(c, "random")
+    steps = len(stim.codes)
+    geo = StreamGeometry(c, lanes)
+    top = int(stim.thresholds.max()) + 1
+    writes, frames, _, _ = colliding_threshold_writes(geo, stim.thresholds, steps, 7, top)
+    integrator = FixedIntegrator(stim.thresholds, c.accumulator_bits, c.signed, c.reset)
+    sums = arithmetic_shift(integer_receptive_sums(stim.codes, c.weight_arrays), c.shift)
+    want = []
+    for t in range(steps):
+        integrator.thr = frames[t].reshape(c.num_scales, c.height, c.width)  # words -> pixels
+        want.append(integrator.step(sums[t]))
+    got = simulate_with_threshold_writes(c, lanes, stim.codes, stim.thresholds, writes,
+                                         mutation=mutation)
+    return int(check_beats(geo.schedule, np.stack(want), got)["mismatches"])
+
+
 @dataclass(frozen=True)
 class CosimCheck:
     """One co-simulation scenario: ``name``, ``description``, the architectures it runs
@@ -126,6 +150,8 @@ class CosimCheck:
     def mismatches(self, contract: ArrayContract, arch: str, lanes: int,
                    mutation: str | None) -> int:
         """Spikes of the (mutated) array that differ from the contract's."""
+        if self.name == "threshold_collisions":
+            return _run_collisions(contract, lanes, mutation)
         stim = stimulus(contract, self.name)
         run: Callable[..., int] = _run_stream if arch == "stream" else _run_parallel
         return run(contract, stim, lanes, mutation)
@@ -139,6 +165,8 @@ COSIM_CHECKS: tuple[CosimCheck, ...] = (
     CosimCheck("clear", "a clear between steps, mid-stream", ("stream", "parallel")),
     CosimCheck("threshold_update", "thresholds rewritten while the stream pauses",
                ("stream",)),
+    CosimCheck("threshold_collisions", "threshold writes while the stream runs, many "
+               "meeting the read of their own word", ("stream",)),
     CosimCheck("exact", "every threshold equal to the accumulator after the first step",
                ("stream", "parallel")),
     CosimCheck("rails", "the top threshold: accumulators saturate at both rails",

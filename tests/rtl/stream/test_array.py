@@ -17,12 +17,13 @@ from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.weights import quantise_model
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
-from rvsm.rtl.simulation import run_simulation
-from rvsm.rtl.stream.array import RvsmStreamArray
-from rvsm.rtl.stream.drive import BeatCollector, simulate, threshold_writes
+from rvsm.rtl.stream.drive import (
+    colliding_threshold_writes,
+    simulate,
+    simulate_with_threshold_writes,
+)
 from rvsm.rtl.stream.geometry import StreamGeometry
-from rvsm.rtl.stream.schedule import OutputBeats, check_beats, pack_lanes
-from rvsm.rtl.stream.signatures import threshold_word_bits
+from rvsm.rtl.stream.schedule import check_beats
 
 
 def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int = 12,
@@ -123,37 +124,6 @@ def test_threshold_write_at_frame_boundary() -> None:
     assert_exact(c, 3, codes, thr, want, threshold_updates={2: thr2})
 
 
-def stream_with_threshold_writes(c: ArrayContract, lanes: int, codes: np.ndarray,
-                                 thr: np.ndarray, writes: dict[int, tuple[int, int, int]],
-                                 bank_words: int) -> OutputBeats:
-    """Load ``thr``, stream ``codes`` back to back (then ``lag`` flush beats) and, at the
-    edge accepting beat ``k``, write ``writes[k] = (s, addr, word)`` on ``thr``."""
-    dut = RvsmStreamArray(c, lanes, bank_words)
-    sched = dut.schedule
-    word_bits = threshold_word_bits(sched.beats_per_frame)
-    beats = pack_lanes(sched.input_beats(codes), c.adc_bits)  # with the flush beats
-    out = BeatCollector(dut)
-
-    async def bench(ctx) -> None:  # noqa: ANN001
-        for addr, word in threshold_writes(dut.geometry, thr):
-            ctx.set(dut.thr.we, 1)
-            ctx.set(dut.thr.addr, addr)
-            ctx.set(dut.thr.data, word)
-            await ctx.tick()
-        for k, beat in enumerate([*beats, None, None]):
-            ctx.set(dut.codes.valid, beat is not None)
-            ctx.set(dut.codes.payload.as_value(), beat or 0)
-            s, a, w = writes.get(k, (0, 0, 0))
-            ctx.set(dut.thr.we, k in writes)
-            ctx.set(dut.thr.addr, (s << word_bits) | a)
-            ctx.set(dut.thr.data, w)
-            await ctx.tick()
-            out.after_edge(ctx, k if beat is not None else -1)
-
-    run_simulation(dut, bench)
-    return out.beats()
-
-
 @pytest.mark.parametrize(("lanes", "bank_words"), [(1, 8), (2, 1024), (3, 4)])
 def test_threshold_writes_colliding_with_reads(lanes: int, bank_words: int) -> None:
     """Threshold writes while the stream runs, many at the very edge that reads the same
@@ -162,32 +132,10 @@ def test_threshold_writes_colliding_with_reads(lanes: int, bank_words: int) -> N
     c = model_contract("dog2", 5, 6, reset="subtract")
     steps = 4
     codes, thr = random_run(c, steps, seed=43, thr_hi=400)
-    sched = StreamGeometry(c, lanes, bank_words).schedule
-    hg, lag = sched.beats_per_frame, sched.threshold_lag
-    rng = np.random.default_rng(47)
-    state = sched.threshold_words(thr).copy()  # (S, H*G, P), as the reads see it
-    seen_late = state.copy()  # the same if a write were seen at its own edge
-    frames, frames_late = [], []
-    writes: dict[int, tuple[int, int, int]] = {}
-    collisions = 0
-    # back to back, position p reads at the edge accepting beat p + threshold_lag + 1
-    for p in range(steps * hg):
-        k = p + lag + 1
-        s, lanes_thr = int(rng.integers(c.num_scales)), rng.integers(1, 400, lanes)
-        kind = rng.integers(4)  # 0: p's own word, 1: p+1's word, 2: any word, 3: none
-        a = [p % hg, (p + 1) % hg, int(rng.integers(hg)), None][kind]
-        if a is not None:
-            writes[k] = (s, a, pack_lanes(lanes_thr[None], c.threshold_bits)[0])
-            collisions += kind == 0
-        if p % hg == 0:
-            frames.append(np.empty_like(state))
-            frames_late.append(np.empty_like(state))
-        frames[-1][:, p % hg] = state[:, p % hg]
-        if a is not None:
-            seen_late[s, a] = lanes_thr
-        frames_late[-1][:, p % hg] = seen_late[:, p % hg]
-        if a is not None:
-            state[s, a] = lanes_thr
+    geo = StreamGeometry(c, lanes, bank_words)
+    sched = geo.schedule
+    writes, frames, frames_late, collisions = colliding_threshold_writes(
+        geo, thr, steps, seed=47, thr_hi=400)
     assert collisions > 10
 
     def run(per_frame: list[np.ndarray]) -> np.ndarray:
@@ -201,7 +149,7 @@ def test_threshold_writes_colliding_with_reads(lanes: int, bank_words: int) -> N
 
     want = run(frames)
     assert not np.array_equal(want, run(frames_late))  # the same-edge rule is visible
-    got = stream_with_threshold_writes(c, lanes, codes, thr, writes, bank_words)
+    got = simulate_with_threshold_writes(c, lanes, codes, thr, writes, bank_words)
     result = check_beats(sched, want, got)
     assert result["mismatches"] == 0, result["first_mismatch"]
     assert result["compared"] == want.size
