@@ -30,7 +30,7 @@ regress: setup
 	$(MAKE) formal
 	$(MAKE) mutate
 
-# Every formal check of both architectures at the tiny configurations, both reset modes
+# Every formal check at the tiny configurations, both reset modes
 # (docs/formal.md): prove (or bmc to the harness's depth) and cover. Reports and
 # counterexample VCDs in build/formal/.
 FORMAL_POINTS := tests/data/formal-tiny.toml tests/data/formal-tiny-zero.toml
@@ -40,10 +40,6 @@ formal: setup
 	  for mode in "" "--mode cover"; do \
 	    tag=$${mode:+-cover}; \
 	    $(BIN)/rvsm formal $$point --arch parallel $$mode -o build/formal/$$name-parallel$$tag; \
-	    for lanes in 1 3; do \
-	      $(BIN)/rvsm formal $$point --arch stream --size 4x3 --lanes $$lanes $$mode \
-	        -o build/formal/$$name-stream-l$$lanes$$tag; \
-	    done; \
 	  done; \
 	done
 
