@@ -29,7 +29,8 @@ from hypothesis import strategies as st
 from rvsm.model.infra.errors import RvsmError
 
 __all__ = ["CASE_MEMORY_BYTES", "CASE_SECONDS", "CaseTimeout", "Outcome",
-           "assert_no_partial_files", "corrupted", "fuzz_settings", "reader_outcome"]
+           "assert_no_partial_files", "corrupted", "damaged_copy", "fuzz_settings",
+           "reader_outcome"]
 
 #: Wall-clock limit of one case (s): a reader that takes longer hangs.
 CASE_SECONDS = float(os.environ.get("RVSM_FUZZ_CASE_SECONDS", "20"))
@@ -160,3 +161,11 @@ def corrupted(draw: st.DrawFn, data: bytes) -> bytes:
             buf[start] ^= 0xFF
         return bytes(buf)
     return data + draw(st.binary(min_size=1, max_size=256))
+
+
+def damaged_copy(data: st.DataObject, original: bytes, folder: Path, name: str) -> Path:
+    """Write ``original`` damaged one way (:func:`corrupted`, drawn from ``data``) to
+    ``folder/name``; returns the path."""
+    path = Path(folder) / name
+    path.write_bytes(data.draw(corrupted(original)))
+    return path

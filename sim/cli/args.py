@@ -88,6 +88,21 @@ def parse_size_arg(text: str | None) -> tuple[int, int] | None:
     return parse_size(text)
 
 
+def sized_contract(point_path: str, size_text: str | None, arch, options: dict):
+    """``(point, contract)`` of the design point TOML at ``point_path``, resized by
+    ``--size`` when given, after ``arch``'s size rule with ``options`` (:class:`RvsmError`
+    when the array cannot be built)."""
+    from rvsm.model.fixed.point_toml import load_design_point
+
+    size = parse_size_arg(size_text)
+    point = load_design_point(point_path)
+    if size is not None:
+        point = point.with_size(*size)
+    contract = point.contract()
+    arch.check(contract, **options)
+    return point, contract
+
+
 @dataclass(frozen=True)
 class SceneRequest:
     """``SCENE`` and how to shape it: the one rule of every command that takes a scene.

@@ -7,7 +7,7 @@ import json
 import sys
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.sim.cli.args import parse_size_arg
+from rvsm.sim.cli.args import sized_contract
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 from rvsm.sim.cli.rtl import add_arch_arguments, arch_options
 
@@ -43,7 +43,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _formal(args: argparse.Namespace) -> int:
-    from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.model.infra.atomic import write_text_atomic
     from rvsm.rtl.architectures import ARCHITECTURES
     from rvsm.sim.formal.report import run_checks
@@ -54,12 +53,7 @@ def _formal(args: argparse.Namespace) -> int:
         raise RvsmError(f"--depth must be at least 1, got {args.depth}")
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be positive, got {args.timeout}")
-    size = parse_size_arg(args.size)
-    point = load_design_point(args.point)
-    if size is not None:
-        point = point.with_size(*size)
-    contract = point.contract()
-    arch.check(contract, **options)
+    _, contract = sized_contract(args.point, args.size, arch, options)
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
     report = run_checks(contract, args.arch, options, checks=args.check, mode=args.mode,
                         depth=args.depth, workdir=args.out, timeout=args.timeout,

@@ -13,6 +13,7 @@ from rvsm.sim.cli.args import (
     add_force_argument,
     add_scene_arguments,
     parse_size_arg,
+    sized_contract,
 )
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.cosim import SIMULATORS
@@ -98,17 +99,11 @@ def arch_options(args: argparse.Namespace) -> dict[str, int]:
 
 
 def _verilog(args: argparse.Namespace) -> int:
-    from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.verilog import verilator_lint, write_outputs, yosys_stats
 
     arch = ARCHITECTURES[args.arch]
     options = arch_options(args)
-    size = parse_size_arg(args.size)
-    point = load_design_point(args.point)
-    if size is not None:
-        point = point.with_size(*size)
-    contract = point.contract()
-    arch.check(contract, **options)
+    _, contract = sized_contract(args.point, args.size, arch, options)
     args.top = args.top or arch.default_top
     files = tuple((f"{args.top}{ext}", PLAIN) for ext in (".v", ".ports.json", ".ports.md"))
     check_outputs([Output(args.out, "-o", FOLDER, files)], [args.point], args.force)

@@ -19,7 +19,12 @@ from rvsm.model.fixed.point_toml import (
     to_toml_dict,
 )
 from rvsm.model.infra.errors import RvsmError
-from tests.fuzzing import assert_no_partial_files, corrupted, fuzz_settings, reader_outcome
+from tests.fuzzing import (
+    assert_no_partial_files,
+    damaged_copy,
+    fuzz_settings,
+    reader_outcome,
+)
 
 #: TOML values of every type, the extremes included.
 TOML_VALUES = st.recursive(
@@ -84,8 +89,7 @@ def point_bytes(tmp_path_factory) -> bytes:
 @fuzz_settings
 @given(data=st.data())
 def test_damaged_point_files(data, point_bytes, tmp_path_factory) -> None:
-    path = tmp_path_factory.mktemp("bad") / "p.toml"
-    path.write_bytes(data.draw(corrupted(point_bytes)))
+    path = damaged_copy(data, point_bytes, tmp_path_factory.mktemp("bad"), "p.toml")
     reader_outcome(lambda: load_design_point(path))
 
 

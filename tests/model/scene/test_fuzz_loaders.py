@@ -13,7 +13,13 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from rvsm.model.scene.loaders import load_scene
-from tests.fuzzing import assert_no_partial_files, corrupted, fuzz_settings, reader_outcome
+from tests.fuzzing import (
+    assert_no_partial_files,
+    corrupted,
+    damaged_copy,
+    fuzz_settings,
+    reader_outcome,
+)
 
 DTYPES = [np.uint8, np.uint16, np.int16, np.int64, np.float32, np.float64, np.bool_,
           np.complex64, np.dtype("<U3")]
@@ -87,9 +93,7 @@ def npy_bytes() -> bytes:
 @fuzz_settings
 @given(data=st.data())
 def test_damaged_npy(data, npy_bytes, tmp_path_factory) -> None:
-    path = tmp_path_factory.mktemp("bad") / "s.npy"
-    path.write_bytes(data.draw(corrupted(npy_bytes)))
-    _scene_outcome(path)
+    _scene_outcome(damaged_copy(data, npy_bytes, tmp_path_factory.mktemp("bad"), "s.npy"))
 
 
 def _png(frame: np.ndarray) -> bytes:

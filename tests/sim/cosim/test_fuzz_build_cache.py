@@ -15,7 +15,7 @@ from rvsm.model.fixed.design_point import default_design_point
 from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.verilog import write_outputs
 from rvsm.sim.cosim.build_cache import _build_files, _cached, _checksums, cosim_design
-from tests.fuzzing import corrupted, fuzz_settings, reader_outcome
+from tests.fuzzing import corrupted, damaged_copy, fuzz_settings, reader_outcome
 from tests.model.fixed.test_fuzz_point_toml import TOML_VALUES
 
 KEY = "0123abcd"
@@ -95,8 +95,8 @@ def ports_text(good_build) -> str:
 @fuzz_settings
 @given(data=st.data())
 def test_damaged_port_maps(data, ports_text, tmp_path_factory) -> None:
-    path = tmp_path_factory.mktemp("ports") / "t.ports.json"
-    path.write_bytes(data.draw(corrupted(ports_text.encode())))
+    path = damaged_copy(data, ports_text.encode(), tmp_path_factory.mktemp("ports"),
+                        "t.ports.json")
     reader_outcome(lambda: load_ports_json(path))
 
 

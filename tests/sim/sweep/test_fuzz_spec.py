@@ -13,7 +13,7 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 
 from rvsm.sim.sweep.spec import load_sweep, parse_sweep
-from tests.fuzzing import corrupted, fuzz_settings, reader_outcome
+from tests.fuzzing import damaged_copy, fuzz_settings, reader_outcome
 from tests.model.fixed.test_fuzz_point_toml import TOML_VALUES
 
 SWEEP = (Path(__file__).parents[2] / "data" / "small-sweep.toml").read_text()
@@ -75,6 +75,5 @@ def test_hand_edited_sweeps(text: str) -> None:
 @fuzz_settings
 @given(data=st.data())
 def test_damaged_sweep_files(data, tmp_path_factory) -> None:
-    path = tmp_path_factory.mktemp("bad") / "s.toml"
-    path.write_bytes(data.draw(corrupted(SWEEP.encode())))
+    path = damaged_copy(data, SWEEP.encode(), tmp_path_factory.mktemp("bad"), "s.toml")
     reader_outcome(lambda: load_sweep(path))
