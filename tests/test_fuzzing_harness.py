@@ -30,11 +30,19 @@ def test_traceback_hang_and_blow_up_fail():
     with pytest.raises(AssertionError, match="memory blow-up"):
         reader_outcome(lambda: np.ones(1 << 31), memory_bytes=1 << 28)
 
-    def two_lines():
-        raise RvsmError("one\ntwo")
+    # RvsmError escapes line breaks, so a reader's message is one line...
+    assert reader_outcome(lambda: _raise(RvsmError("one\ntwo"))).message == "one\\ntwo"
+
+    class TwoLines(RvsmError):  # ...unless a subclass builds its own text
+        def __str__(self) -> str:
+            return "one\ntwo"
 
     with pytest.raises(AssertionError, match="one line"):
-        reader_outcome(two_lines)
+        reader_outcome(lambda: _raise(TwoLines()))
+
+
+def _raise(exc: Exception):
+    raise exc
 
 
 @fuzz_settings

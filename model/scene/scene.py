@@ -31,7 +31,7 @@ def validate_frames(frames: np.ndarray, source: str = "scene") -> np.ndarray:
     if arr.dtype == object or not (
         np.issubdtype(arr.dtype, np.number) or arr.dtype == bool
     ) or np.issubdtype(arr.dtype, np.complexfloating):
-        raise RvsmError(f"{source}: frames must be real numbers, got dtype {arr.dtype}")
+        raise RvsmError(f"{source}: frames must be real numeric values, got dtype {arr.dtype}")
     if arr.ndim == 2:
         arr = arr[None]
     if arr.ndim != 3:

@@ -46,7 +46,7 @@ def test_verilog_ports_follow_the_signature(small_contract) -> None:
 def test_port_map_of_any_component_refuses_missing_or_stale_docs() -> None:
     cell = PixelCell(10, 0, 8, False)
     names = ["clk", "rst", "sum_in", "strobe", "clear", "thr_we", "thr_data", "spike_pos",
-             "spike_neg", "acc"]
+             "spike_neg", "acc", "threshold"]
     docs = {n: n.upper() for n in names}
     rows = port_map(cell, docs)
     assert port_map(cell.signature, docs) == rows
