@@ -156,7 +156,8 @@ def run_checks(contract: ArrayContract, arch: str, options: dict[str, int], *,
     architecture = get_architecture(arch)
     known = available_checks(arch)
     if not known:
-        raise RvsmError(f"--arch {arch} has no formal checks")
+        raise RvsmError(f"--arch {arch} has no formal checks yet (docs/formal.md says why); "
+                        f"--arch parallel has them")
     chosen = list(dict.fromkeys(checks)) if checks else known
     unknown = [c for c in chosen if c not in known]
     if unknown:
