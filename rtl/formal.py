@@ -24,10 +24,22 @@ from dataclasses import dataclass
 
 from amaranth.hdl import Assert, Assume, Cover, Elaboratable, Module, Value
 
-__all__ = ["KINDS", "FormalHarness", "Property", "property_at"]
+__all__ = ["KINDS", "ElaborateAfter", "FormalHarness", "Property", "property_at"]
 
 #: Statement kinds: checked (``assert``), reachable (``cover``), constraint (``assume``).
 KINDS = ("assert", "cover", "assume")
+
+
+class ElaborateAfter(Elaboratable):
+    """Calls ``build(platform)`` when elaborated: properties that observe a block's
+    internals (cells, probes), added as a submodule after the block so that the block
+    is elaborated first."""
+
+    def __init__(self, build) -> None:
+        self.build = build
+
+    def elaborate(self, platform: object) -> Module:
+        return self.build(platform)
 
 
 @dataclass(frozen=True)
@@ -59,15 +71,16 @@ class FormalHarness(Elaboratable):
         self.properties: list[Property] = []
 
     def check(self, m: Module, name: str, test: Value, description: str,
-              kind: str = "assert") -> None:
+              kind: str = "assert", src_loc_at: int = 0) -> None:
         """Add ``test`` to ``m`` as a named ``Assert`` / ``Cover`` / ``Assume``
-        (comb domain: it holds in every cycle where it is evaluated)."""
+        (comb domain: it holds in every cycle where it is evaluated); its source line is
+        the caller's (``src_loc_at`` frames further out for a wrapper)."""
         if kind not in KINDS:
             raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-        frame = inspect.stack()[1]
+        frame = inspect.stack()[1 + src_loc_at]
         src = f"{os.path.abspath(frame.filename)}:{frame.lineno}"
         statement = {"assert": Assert, "cover": Cover, "assume": Assume}[kind]
-        m.d.comb += statement(test, name, src_loc_at=1)
+        m.d.comb += statement(test, name, src_loc_at=1 + src_loc_at)
         if not any(p.name == name and p.kind == kind for p in self.properties):
             self.properties.append(Property(name, kind, description, src))
 

@@ -38,7 +38,6 @@ from amaranth.hdl import (
     Cat,
     ClockDomain,
     ClockSignal,
-    Elaboratable,
     Module,
     Mux,
     ResetSignal,
@@ -50,23 +49,12 @@ from amaranth.hdl import (
 
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.widths import signed_range
-from rvsm.rtl.formal import FormalHarness
+from rvsm.rtl.formal import ElaborateAfter, FormalHarness
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.array import RvsmArray, accumulator_index
 from rvsm.rtl.parallel.pixel_cell import PixelCell
 
 __all__ = ["ParallelProperties", "parallel_properties"]
-
-
-class _After(Elaboratable):
-    """Calls ``build(platform)`` when elaborated: the properties, elaborated after the
-    array (a sibling submodule added before it) so its cells exist."""
-
-    def __init__(self, build) -> None:
-        self.build = build
-
-    def elaborate(self, platform: object) -> Module:
-        return self.build(platform)
 
 
 @dataclass(frozen=True)
@@ -138,7 +126,7 @@ class ParallelProperties(FormalHarness):
         m.d.past += [prev.started.eq(1), prev.rst.eq(rst), prev.strobe.eq(dut.strobe),
                      prev.clear.eq(dut.clear), prev.we.eq(dut.cfg.we),
                      prev.addr.eq(dut.cfg.addr), prev.data.eq(dut.cfg.data)]
-        m.submodules.properties = _After(lambda platform: self._cells(dut, prev))
+        m.submodules.properties = ElaborateAfter(lambda platform: self._cells(dut, prev))
         self.check(m, "valid.latency",
                    ~prev.observed | (dut.valid == (prev.strobe & ~prev.clear)),
                    "valid is high exactly one cycle after a strobe without clear")

@@ -9,6 +9,7 @@ from rvsm.rtl.architecture import Architecture, Option
 from rvsm.rtl.ports import port_map
 from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.drive import simulate
+from rvsm.rtl.stream.formal import PROPERTY_GROUPS, stream_check, stream_equivalence
 from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, check_beats
 
@@ -92,4 +93,6 @@ STREAM = Architecture(
     simulate=simulate,
     compare=_compare,
     testbench="rvsm.sim.cosim.tb_stream",
+    formal={**{group: stream_check(group) for group in PROPERTY_GROUPS},
+            "equivalence": stream_equivalence},
 )

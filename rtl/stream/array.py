@@ -64,7 +64,10 @@ schedule.
   the stream is paused after ``t*H*G + threshold_lag`` accepted beats apply exactly from
   frame ``t`` on (:meth:`StreamSchedule.threshold_pause_beat`); written after a clear
   and before the first beat (as a loader does), they apply from frame 0. The threshold
-  memories are not initialised: load every threshold before streaming.
+  memories start (at configuration: block-RAM initial contents) with every threshold at
+  the top rail ``2**(W-1)-1``, like the parallel array after its reset, so an array
+  whose thresholds were never loaded fires only at saturation instead of reading
+  undefined data; neither ``rst`` nor ``clear`` reloads them (a block RAM has no reset).
 
 The bit-accurate model is :meth:`ArrayContract.run`, rearranged into beats by
 :class:`~rvsm.rtl.stream.schedule.StreamSchedule`; the component is driven in
@@ -117,6 +120,7 @@ class _Tail:
     """What the state memories and the tail need from the position pipeline."""
 
     rd_addr: Value
+    rd_valid: Value
     bank_q: Value
     fresh_q: Value
     wr_addr: Value
@@ -125,6 +129,28 @@ class _Tail:
     row: Value
     group: Value
     last: Value
+
+
+@dataclass
+class StreamProbes:
+    """Internal signals a formal harness observes (:mod:`rvsm.rtl.stream.formal`), set
+    when the array is elaborated: ``advance`` (the pipeline steps at this edge),
+    ``clear`` (the registered clear that flushes it), the accumulator memories' read
+    (``acc_read_addr`` sampled at an ``advance`` edge where ``acc_read_valid``) and
+    write-back (``acc_write_en``, ``acc_write_addr``), and per scale and lane the tail's
+    registers (``lanes[s][i]``: ``acc`` (the accumulator read, 0 in a fresh frame; the
+    value ``total`` is loaded from), ``total``, ``thr1``, ``sat``, ``thr2``, ``pos``, ``neg``,
+    ``after``: the pre-saturation total, the threshold read, the saturated total, that
+    threshold one stage on, the spikes and the value written back), valid in a cycle
+    where ``acc_write_en`` is high."""
+
+    advance: Signal
+    clear: Signal
+    acc_read_addr: Value
+    acc_read_valid: Value
+    acc_write_en: Value
+    acc_write_addr: Value
+    lanes: list[list[dict[str, Value]]]
 
 
 class RvsmStreamArray(wiring.Component):
@@ -148,6 +174,9 @@ class RvsmStreamArray(wiring.Component):
         self.contract = contract
         self.lanes = geo.lanes
         self.groups = geo.groups
+        #: Internal signals for formal harnesses (:class:`StreamProbes`), set by
+        #: :meth:`elaborate`.
+        self.probes: StreamProbes | None = None
         super().__init__(self.interface(contract, geo.lanes))
 
     @staticmethod
@@ -214,7 +243,9 @@ class RvsmStreamArray(wiring.Component):
         pipe = Pipeline(m, advance, self.geometry.LEVELS_PER_STAGE, name="sum")
         sums, stage_q = self._window_sums(pipe, slabs, centre)
         tail = self._position_pipeline(m, pipe, advance, clear, centre, stage_q)
-        self._state_and_output(m, advance, sums, tail)
+        lanes = self._state_and_output(m, advance, sums, tail)
+        self.probes = StreamProbes(advance, clear, tail.rd_addr, advance & tail.rd_valid,
+                                   tail.wr_en, tail.wr_addr, lanes)
         pipe.emit()
         return m
 
@@ -379,11 +410,11 @@ class RvsmStreamArray(wiring.Component):
         out_row, out_group = pipe.at(row_t, tail).value, pipe.at(group_t, tail).value
         out_last = pipe.at(last_t, tail).value
         wr_en = advance & valid[tail]
-        return _Tail(rd_addr, bank_q, fresh_q, wr_addr, wr_en, valid[tail], out_row,
-                     out_group, out_last)
+        return _Tail(rd_addr, valid[stage_q - 2], bank_q, fresh_q, wr_addr, wr_en,
+                     valid[tail], out_row, out_group, out_last)
 
     def _state_and_output(self, m: Module, advance: Signal, sums: list[list[Timed]],
-                          tail: _Tail) -> None:
+                          tail: _Tail) -> list[list[dict[str, Value]]]:
         """Per scale the threshold and accumulator memories, then the tail: add,
         compare/saturate, fire/reset, write back; spikes and position on the output."""
         c, geo = self.contract, self.geometry
@@ -409,9 +440,13 @@ class RvsmStreamArray(wiring.Component):
             m.d.sync += [fwd_data[0].eq(bus_data), fwd_data[1].eq(fwd_data[0])]
         tail_stmts = []
         pos_bits, neg_bits = [], []
+        probes: list[list[dict[str, Value]]] = []
         for s in range(c.num_scales):
             after_lanes = []
-            thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True)
+            probes.append([])
+            top = (1 << tw) - 1  # no spike until loaded (see the module docstring)
+            thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True,
+                                   init_word=sum(top << (i * tw) for i in range(p)))
             m.submodules[f"thr_s{s}"] = thr_mem
             m.d.comb += [thr_mem.advance.eq(advance), thr_mem.read_addr.eq(rd_addr),
                          thr_mem.read_bank.eq(bank_q),
@@ -469,6 +504,8 @@ class RvsmStreamArray(wiring.Component):
                 else:
                     after = Mux(pos, sat - thr2, Mux(neg, sat + thr2, sat))
                 after_lanes.append(after.as_unsigned()[:wa])
+                probes[s].append({"acc": acc, "total": total, "thr1": thr1, "sat": sat,
+                                  "thr2": thr2, "pos": pos, "neg": neg, "after": after})
                 pos_bits.append(pos)
                 neg_bits.append(neg)
             m.d.comb += after_flat.eq(Cat(*after_lanes))
@@ -482,3 +519,4 @@ class RvsmStreamArray(wiring.Component):
         with m.If(advance):
             m.d.sync += tail_stmts
         m.d.sync += self.spikes.valid.eq(wr_en)
+        return probes

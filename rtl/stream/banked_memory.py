@@ -20,6 +20,8 @@ array's beat advance), so stages count beats:
   ``may_write`` and gates the read where ``may_write`` holds and the low ``k`` address
   bits match: a cheaper superset of the collisions, for a memory whose valid reads and
   writes never match in those bits.
+* **Initial contents.** ``init_word``: every word's value at configuration (block-RAM
+  initialisation; 0 by default). No reset reloads it.
 """
 
 from __future__ import annotations
@@ -39,8 +41,9 @@ class BankedMemory(wiring.Component):
     ``forward_data`` (``forward=True``) and ``may_write`` (``guard_bits``)."""
 
     def __init__(self, width: int, depth: int, bank_words: int, forward: bool = False,
-                 guard_bits: int | None = None):
+                 guard_bits: int | None = None, init_word: int = 0):
         self.width = width
+        self.init_word = init_word
         self.depth = depth
         self.bank_words = bank_words
         self.bank_sizes = [min(bank_words, depth - i) for i in range(0, depth, bank_words)]
@@ -69,7 +72,8 @@ class BankedMemory(wiring.Component):
         offset_bits = (self.bank_words - 1).bit_length()
         outs = []
         for b, depth in enumerate(self.bank_sizes):
-            mem = Memory(shape=unsigned(self.width), depth=depth, init=[])
+            mem = Memory(shape=unsigned(self.width), depth=depth,
+                         init=[self.init_word] * depth if self.init_word else [])
             m.submodules[f"b{b}"] = mem
             wp = mem.write_port()
             hit = (self.write_addr >> offset_bits) == b if banked else Const(1)

@@ -15,7 +15,7 @@ from rvsm.sim.cli.rtl import add_arch_arguments, arch_options
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``formal`` sub-command."""
     p = sub.add_parser(
-        "formal", help="prove the RTL's formal properties with yowasp-sby (smtbmc z3)",
+        "formal", help="prove the RTL's formal properties with yowasp-sby (smtbmc yices or z3)",
         description="Run the formal checks of an architecture (its property harness and, "
         "where it has one, its bounded equivalence with a reference) at a design point, "
         "usually at a tiny --size. Prints each property's status and, on a failure, the "
@@ -31,8 +31,14 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="prove (k-induction), bmc (bounded) or cover (reachability); "
                    "default prove for a provable harness, else bmc")
     p.add_argument("--check", action="extend", nargs="+", metavar="NAME",
-                   help="run only these checks (properties, equivalence); default every "
+                   help="run only these checks (parallel: properties; stream: protocol, state, "
+                   "thresholds, tail, equivalence); default every "
                    "check the architecture registers")
+    p.add_argument("--solver", choices=("yices", "z3"), default="yices",
+                   help="smtbmc's SMT solver (default yices: much faster on the streaming "
+                   "array's memories; z3 for a second opinion)")
+    p.add_argument("-j", "--jobs", type=int, default=1, metavar="N",
+                   help="run N checks at once (one sby process each; default 1)")
     p.add_argument("--timeout", type=float, metavar="SECONDS",
                    help="stop a check's solver after this long (exit 3)")
     p.add_argument("-o", "--out", default="build/formal",
@@ -51,12 +57,15 @@ def _formal(args: argparse.Namespace) -> int:
     options = arch_options(args)
     if args.depth is not None and args.depth < 1:
         raise RvsmError(f"--depth must be at least 1, got {args.depth}")
+    if args.jobs < 1:
+        raise RvsmError(f"--jobs must be at least 1, got {args.jobs}")
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be positive, got {args.timeout}")
     _, contract = sized_contract(args.point, args.size, arch, options)
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
     report = run_checks(contract, args.arch, options, checks=args.check, mode=args.mode,
                         depth=args.depth, workdir=args.out, timeout=args.timeout,
+                        solver=args.solver, jobs=args.jobs,
                         progress=lambda line: print(line, file=sys.stderr, flush=True))
     data = report.to_json()
     data["size"] = [contract.height, contract.width]

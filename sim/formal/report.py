@@ -17,6 +17,7 @@ import re
 import shutil
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -26,13 +27,13 @@ from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.rtl.architectures import get_architecture
 from rvsm.rtl.formal import FormalHarness, Property, property_at
 from rvsm.rtl.mutations import check_mutation
-from rvsm.sim.formal.sby import MODES, SbyResult, check_tools, run_sby
+from rvsm.sim.formal.sby import MODES, SOLVERS, SbyResult, check_tools, run_sby
 
 __all__ = ["CHECK_ORDER", "CheckResult", "Counterexample", "FormalReport",
            "PropertyStatus", "available_checks", "run_checks"]
 
 #: Checks in the order they run (any other a harness registers runs after these).
-CHECK_ORDER = ("properties", "equivalence")
+CHECK_ORDER = ("properties", "protocol", "state", "thresholds", "tail", "equivalence")
 
 
 @dataclass(frozen=True)
@@ -140,13 +141,15 @@ def available_checks(arch: str) -> list[str]:
 def run_checks(contract: ArrayContract, arch: str, options: dict[str, int], *,
                checks: list[str] | None = None, mode: str | None = None,
                depth: int | None = None, mutation: str | None = None, workdir: Path,
-               timeout: float | None = None,
+               timeout: float | None = None, solver: str = "yices", jobs: int = 1,
                progress: Callable[[str], None] | None = None) -> FormalReport:
     """Run ``checks`` (default: every check ``arch`` registers) of ``arch`` built from
     ``contract`` with ``options`` (resolved, e.g. ``{"lanes": 2}``) and ``mutation``,
     each in ``workdir/<check>``. ``mode`` (default ``prove`` for a provable harness,
     else ``bmc``) and ``depth`` (default the harness's) apply to every check;
-    ``timeout`` (seconds) to each sby run; ``progress`` receives one line per check.
+    ``timeout`` (seconds) to each sby run; ``solver`` is smtbmc's (``yices`` or ``z3``,
+    :data:`~rvsm.sim.formal.sby.SOLVERS`); ``jobs`` checks run at once (each is one sby
+    process); ``progress`` receives lines per check.
 
     Bad input (unknown check, mode or depth) is a :class:`RvsmError`; a missing tool a
     :class:`ToolError`; a tool that crashes or gives no verdict is a check with status
@@ -167,34 +170,45 @@ def run_checks(contract: ArrayContract, arch: str, options: dict[str, int], *,
         raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
     if depth is not None and depth < 1:
         raise RvsmError(f"formal depth must be at least 1, got {depth}")
+    if solver not in SOLVERS:
+        raise RvsmError(f"formal solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
     check_mutation(mutation, arch)
     architecture.check(contract, **options)
-    check_tools()
+    check_tools(solver)
+    if jobs < 1:
+        raise RvsmError(f"formal jobs must be at least 1, got {jobs}")
     report = FormalReport(arch, dict(options), mutation)
     root = Path(workdir)
-    for name in chosen:
+
+    def run(name: str) -> CheckResult:
         harness = architecture.formal[name](contract, mutation=mutation, **options)
         run_mode = mode or ("prove" if harness.provable else "bmc")
         run_depth = depth or (getattr(harness, "cover_depth", harness.depth)
                               if run_mode == "cover" else harness.depth)
         if progress:
             progress(f"formal {arch} {name}: sby {run_mode} to depth {run_depth} ...")
-        report.results.append(_run_check(name, harness, run_mode, run_depth, root,
-                                         timeout, progress))
+        result = _run_check(name, harness, run_mode, run_depth, root, timeout, solver,
+                            progress)
         if progress:
-            r = report.results[-1]
-            progress(f"formal {arch} {name}: {r.status} ({r.seconds:.1f} s)")
+            progress(f"formal {arch} {name}: {result.status} ({result.seconds:.1f} s)")
+        return result
+
+    if jobs == 1 or len(chosen) == 1:
+        report.results.extend(run(name) for name in chosen)
+    else:  # each check is its own sby process: threads only wait for them
+        with ThreadPoolExecutor(max_workers=jobs) as pool:
+            report.results.extend(pool.map(run, chosen))
     return report
 
 
 def _run_check(name: str, harness: FormalHarness, mode: str, depth: int, root: Path,
-               timeout: float | None,
+               timeout: float | None, solver: str,
                progress: Callable[[str], None] | None) -> CheckResult:
     started = time.perf_counter()
     props = harness.statements()
     try:
         sby = run_sby(harness, root / name, mode=mode, depth=depth, name="formal",
-                      timeout=timeout,
+                      timeout=timeout, solver=solver,
                       progress=(lambda line: progress(f"formal {name}: {line}"))
                       if progress else None)
     except ToolError as exc:
