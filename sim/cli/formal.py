@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.sim.cli.args import sized_contract
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 from rvsm.sim.cli.rtl import add_arch_arguments, arch_options
@@ -24,6 +26,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "unreached cover, 2 bad input, 3 a tool failed (docs/formal.md).")
     p.add_argument("point", help="design point TOML")
     p.add_argument("--size", metavar="HxW", help="override the array size (keep it tiny)")
+    p.add_argument("--model", choices=MODEL_NAMES,
+                   help="override the point's sampling model (one point, every model)")
     add_arch_arguments(p)
     p.add_argument("--depth", type=int, metavar="N",
                    help="steps (clock cycles) to check; default the harness's")
@@ -61,7 +65,13 @@ def _formal(args: argparse.Namespace) -> int:
         raise RvsmError(f"--jobs must be at least 1, got {args.jobs}")
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be positive, got {args.timeout}")
-    _, contract = sized_contract(args.point, args.size, arch, options)
+    point, contract = sized_contract(args.point, args.size, arch, options)
+    if args.model is not None and args.model != point.model:
+        if point.scale_phi is not None:
+            raise RvsmError(f"--model {args.model}: the point sets per-scale thresholds "
+                            "(scale_phi) for its own model; remove them or drop --model")
+        contract = dataclasses.replace(point, model=args.model).contract()
+        arch.check(contract, **options)
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
     report = run_checks(contract, args.arch, options, checks=args.check, mode=args.mode,
                         depth=args.depth, workdir=args.out, timeout=args.timeout,
@@ -69,11 +79,13 @@ def _formal(args: argparse.Namespace) -> int:
                         progress=lambda line: print(line, file=sys.stderr, flush=True))
     data = report.to_json()
     data["size"] = [contract.height, contract.width]
+    data["model"] = args.model or point.model
     write_text_atomic(f"{args.out}/report.json", json.dumps(data, indent=2) + "\n")
     if args.json:
         print(json.dumps(data, indent=2))
     else:
-        print(format_report(report, contract.height, contract.width))
+        print(format_report(report, contract.height, contract.width, data["model"],
+                            contract.reset))
     for r in report.results:
         if r.status == "error":
             where = "" if str(r.log) in r.message else f" (log: {r.log})"
@@ -82,11 +94,13 @@ def _formal(args: argparse.Namespace) -> int:
     return report.exit_status
 
 
-def format_report(report, height: int, width: int) -> str:
+def format_report(report, height: int, width: int, model: str = "",
+                  reset: str = "") -> str:
     """The table (property, kind, status, depth, time) of every check and, per failing
     check, one block: property, description, source line, step, VCD."""
     opts = "".join(f", {k} {v}" for k, v in report.options.items())
-    lines = [f"rvsm formal: --arch {report.arch} {height}x{width}{opts}"]
+    point = "".join(f", {k} {v}" for k, v in (("model", model), ("reset", reset)) if v)
+    lines = [f"rvsm formal: --arch {report.arch} {height}x{width}{point}{opts}"]
     for r in report.results:
         lines.append(f"\n{r.check}: {r.mode} to depth {r.depth}, {r.status} "
                      f"({r.seconds:.1f} s)")

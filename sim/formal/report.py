@@ -159,13 +159,12 @@ def run_checks(contract: ArrayContract, arch: str, options: dict[str, int], *,
     architecture = get_architecture(arch)
     known = available_checks(arch)
     if not known:
-        raise RvsmError(f"--arch {arch} has no formal checks yet (docs/formal.md says why); "
-                        f"--arch parallel has them")
-    chosen = list(dict.fromkeys(checks)) if checks else known
-    unknown = [c for c in chosen if c not in known]
+        raise RvsmError(f"--arch {arch} has no formal checks")
+    unknown = [c for c in checks or () if c not in known]
     if unknown:
         raise RvsmError(f"unknown formal check {unknown[0]!r} for --arch {arch} (known: "
                         f"{', '.join(known)})")
+    chosen = [c for c in known if c in checks] if checks else known  # registry order
     if mode is not None and mode not in MODES:
         raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
     if depth is not None and depth < 1:

@@ -100,3 +100,35 @@ def test_solver_over_its_time_limit_is_exit_3(formal, capsys: pytest.CaptureFixt
     errors = [line for line in captured.err.splitlines() if line.startswith("rvsm: error")]
     assert len(errors) == 1 and "time limit" in errors[0]
     assert "not checked" in captured.out and "cover" not in captured.out.split("note:")[0]
+
+
+def test_stream_checks_run_side_by_side(formal_point_toml: Path, tmp_path: Path,
+                                        capsys: pytest.CaptureFixture) -> None:
+    out = tmp_path / "stream"
+    assert main(["formal", str(formal_point_toml), "--arch", "stream", "--size", "3x4",
+                 "--lanes", "2", "--model", "fsm", "--check", "equivalence", "tail",
+                 "-j", "2", "--json", "-o", str(out)]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert (report["model"], report["size"], report["options"]) == ("fsm", [3, 4],
+                                                                   {"lanes": 2})
+    # in the registry's order whatever the order asked, each to two frames plus the lag
+    assert [(c["check"], c["mode"], c["status"], c["depth"]) for c in report["checks"]] == [
+        ("tail", "bmc", "pass", 19), ("equivalence", "bmc", "pass", 19)]
+    assert (out / "tail" / "formal.log").is_file()
+
+
+@pytest.mark.parametrize("extra, message", [
+    (("--jobs", "0"), "--jobs"),
+    (("--model", "dog9"), "--model"),
+])
+def test_stream_bad_input_is_exit_2(formal_point_toml: Path, tmp_path: Path,
+                                    capsys: pytest.CaptureFixture,
+                                    extra: tuple[str, ...], message: str) -> None:
+    argv = ["formal", str(formal_point_toml), "--arch", "stream", "--size", "3x4",
+            "--lanes", "2", "-o", str(tmp_path / "o"), *extra]
+    try:
+        status = main(argv)
+    except SystemExit as exc:  # argparse's choices
+        status = exc.code
+    assert status == 2
+    assert message in capsys.readouterr().err
