@@ -142,7 +142,8 @@ class StreamProbes:
     value ``total`` is loaded from), ``total``, ``thr1``, ``sat``, ``thr2``, ``pos``, ``neg``,
     ``after``: the pre-saturation total, the threshold read, the saturated total, that
     threshold one stage on, the spikes and the value written back), valid in a cycle
-    where ``acc_write_en`` is high."""
+    where ``acc_write_en`` is high; ``threshold_memories``: per scale the threshold
+    :class:`BankedMemory` (its formal-only ``probe_addr``/``probe_data``)."""
 
     advance: Signal
     clear: Signal
@@ -151,6 +152,7 @@ class StreamProbes:
     acc_write_en: Value
     acc_write_addr: Value
     lanes: list[list[dict[str, Value]]]
+    threshold_memories: list[BankedMemory]
 
 
 class RvsmStreamArray(wiring.Component):
@@ -245,7 +247,8 @@ class RvsmStreamArray(wiring.Component):
         tail = self._position_pipeline(m, pipe, advance, clear, centre, stage_q)
         lanes = self._state_and_output(m, advance, sums, tail)
         self.probes = StreamProbes(advance, clear, tail.rd_addr, advance & tail.rd_valid,
-                                   tail.wr_en, tail.wr_addr, lanes)
+                                   tail.wr_en, tail.wr_addr, lanes,
+                                   self._threshold_memories)
         pipe.emit()
         return m
 
@@ -441,6 +444,8 @@ class RvsmStreamArray(wiring.Component):
         tail_stmts = []
         pos_bits, neg_bits = [], []
         probes: list[list[dict[str, Value]]] = []
+        thr_memories = []
+        self._threshold_memories = thr_memories
         for s in range(c.num_scales):
             after_lanes = []
             probes.append([])
@@ -448,6 +453,7 @@ class RvsmStreamArray(wiring.Component):
             thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True,
                                    init_word=sum(top << (i * tw) for i in range(p)))
             m.submodules[f"thr_s{s}"] = thr_mem
+            thr_memories.append(thr_mem)
             m.d.comb += [thr_mem.advance.eq(advance), thr_mem.read_addr.eq(rd_addr),
                          thr_mem.read_bank.eq(bank_q),
                          thr_mem.write_en.eq(bus_we & (bus_scale == s)),

@@ -22,6 +22,9 @@ array's beat advance), so stages count beats:
   writes never match in those bits.
 * **Initial contents.** ``init_word``: every word's value at configuration (block-RAM
   initialisation; 0 by default). No reset reloads it.
+* **Formal observation.** For the ``"formal"`` platform only, ``probe_data`` shows the
+  word at ``probe_addr`` (asynchronous read ports), for harnesses to state what the
+  memory holds; other platforms elaborate no such port.
 """
 
 from __future__ import annotations
@@ -50,6 +53,11 @@ class BankedMemory(wiring.Component):
         self.guard_bits = guard_bits
         self.forward = forward
         addr = Shape.cast(range(depth))
+        #: Formal observation (driven only when elaborated for the ``"formal"``
+        #: platform, never in a user's Verilog): ``probe_data`` is the word at
+        #: ``probe_addr`` now (an asynchronous read port per bank).
+        self.probe_addr = Signal(addr, name="probe_addr")
+        self.probe_data = Signal(unsigned(width), name="probe_data")
         members = {
             "advance": In(1),
             "read_addr": In(addr),
@@ -70,7 +78,7 @@ class BankedMemory(wiring.Component):
         m = Module()
         banked = len(self.bank_sizes) > 1
         offset_bits = (self.bank_words - 1).bit_length()
-        outs = []
+        outs, probes = [], []
         for b, depth in enumerate(self.bank_sizes):
             mem = Memory(shape=unsigned(self.width), depth=depth,
                          init=[self.init_word] * depth if self.init_word else [])
@@ -80,6 +88,11 @@ class BankedMemory(wiring.Component):
             m.d.comb += [wp.addr.eq(self.write_addr[:offset_bits] if banked
                                     else self.write_addr),
                          wp.data.eq(self.write_data), wp.en.eq(self.write_en & hit)]
+            if platform == "formal":
+                probe = mem.read_port(domain="comb")
+                m.d.comb += probe.addr.eq(self.probe_addr[:offset_bits] if banked
+                                          else self.probe_addr)
+                probes.append(probe.data)
             rp = mem.read_port()
             m.d.comb += rp.addr.eq(self.read_addr[:offset_bits] if banked else self.read_addr)
             if self.guard_bits is None:
@@ -95,6 +108,11 @@ class BankedMemory(wiring.Component):
         out = outs[-1]
         for b in range(len(outs) - 2, -1, -1):
             out = Mux(self.read_bank == b, outs[b], out)
+        if probes:
+            word = probes[-1]
+            for b in range(len(probes) - 2, -1, -1):
+                word = Mux((self.probe_addr >> offset_bits) == b, probes[b], word)
+            m.d.comb += self.probe_data.eq(word)
         if self.forward:
             hit1 = Signal(name="fwd1", reset_less=True)
             hit2 = Signal(name="fwd2", reset_less=True)

@@ -54,23 +54,20 @@ class MutantResult:
                 "seconds": round(self.seconds, 2)}
 
 
-#: The stream's formal checks run at dog2 (two signed scales with a surround: every
-#: kernel, padding, sign, lane and reset bug shows) except the threshold check, at fsm:
-#: the threshold path after the read edge is the same for every model (the read edge
-#: itself is ``rmw.read_timing``), and fsm's short lag keeps its bound in minutes.
-STREAM_FORMAL_MODELS = {"thresholds": "fsm"}
+#: The stream's formal checks run at dog2: two signed scales with a surround, so every
+#: kernel, padding, sign, lane and reset bug shows, and each check takes seconds.
 STREAM_FORMAL_MODEL = "dog2"
 
 
-def tiny_formal_point(point: DesignPoint, arch: str, check: str = "") -> DesignPoint:
+def tiny_formal_point(point: DesignPoint, arch: str) -> DesignPoint:
     """A point the solver closes quickly, as ``tests/data/formal-tiny.toml``: 2x2 and the
-    point's model (parallel), or 3x4 and :data:`STREAM_FORMAL_MODELS` (stream, per
-    ``check``); 2-bit ADC, 5 weight fraction bits, shift 1, 6-bit accumulators,
-    threshold 8 (the formal harnesses take thresholds from the solver anyway)."""
+    point's model (parallel), or 3x4 and :data:`STREAM_FORMAL_MODEL` (stream); 2-bit ADC,
+    5 weight fraction bits, shift 1, 6-bit accumulators, threshold 8 (the formal
+    harnesses take thresholds from the solver anyway)."""
     if arch == "parallel":
         h, w, model = 2, 2, point.model
     else:
-        h, w, model = 3, 4, STREAM_FORMAL_MODELS.get(check, STREAM_FORMAL_MODEL)
+        h, w, model = 3, 4, STREAM_FORMAL_MODEL
     return dataclasses.replace(point, height=h, width=w, model=model, adc_bits=2,
                                weight_frac_bits=5, shift=1, accumulator_bits=6, phi=8.0,
                                scale_phi=None)
@@ -113,7 +110,7 @@ def _formal(point: DesignPoint, arch: str, lanes: int, mutation: str | None,
         checks = sorted(checks, key=lambda c: order.index(c) if c in order else len(order))
     for check in checks:
         for reset in RESETS:
-            base = tiny_formal_point(point, arch, check).contract()
+            base = tiny_formal_point(point, arch).contract()
             contract = dataclasses.replace(base, reset=reset)
             options = {"lanes": lanes if contract.width % lanes == 0 else 1} \
                 if arch == "stream" else {}
