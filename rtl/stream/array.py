@@ -245,10 +245,9 @@ class RvsmStreamArray(wiring.Component):
         pipe = Pipeline(m, advance, self.geometry.LEVELS_PER_STAGE, name="sum")
         sums, stage_q = self._window_sums(pipe, slabs, centre)
         tail = self._position_pipeline(m, pipe, advance, clear, centre, stage_q)
-        lanes = self._state_and_output(m, advance, sums, tail)
+        lanes, thr_memories = self._state_and_output(m, advance, sums, tail)
         self.probes = StreamProbes(advance, clear, tail.rd_addr, advance & tail.rd_valid,
-                                   tail.wr_en, tail.wr_addr, lanes,
-                                   self._threshold_memories)
+                                   tail.wr_en, tail.wr_addr, lanes, thr_memories)
         pipe.emit()
         return m
 
@@ -417,9 +416,12 @@ class RvsmStreamArray(wiring.Component):
                      valid[tail], out_row, out_group, out_last)
 
     def _state_and_output(self, m: Module, advance: Signal, sums: list[list[Timed]],
-                          tail: _Tail) -> list[list[dict[str, Value]]]:
+                          tail: _Tail
+                          ) -> tuple[list[list[dict[str, Value]]], list[BankedMemory]]:
         """Per scale the threshold and accumulator memories, then the tail: add,
-        compare/saturate, fire/reset, write back; spikes and position on the output."""
+        compare/saturate, fire/reset, write back; spikes and position on the output.
+        Returns what :class:`StreamProbes` needs: the lanes' tail registers (per scale)
+        and the threshold memories."""
         c, geo = self.contract, self.geometry
         p, words, wa = geo.lanes, geo.beats_per_frame, c.accumulator_bits
         rd_addr, bank_q, fresh_q, wr_addr, wr_en = (tail.rd_addr, tail.bank_q, tail.fresh_q,
@@ -444,8 +446,7 @@ class RvsmStreamArray(wiring.Component):
         tail_stmts = []
         pos_bits, neg_bits = [], []
         probes: list[list[dict[str, Value]]] = []
-        thr_memories = []
-        self._threshold_memories = thr_memories
+        thr_memories: list[BankedMemory] = []
         for s in range(c.num_scales):
             after_lanes = []
             probes.append([])
@@ -525,4 +526,4 @@ class RvsmStreamArray(wiring.Component):
         with m.If(advance):
             m.d.sync += tail_stmts
         m.d.sync += self.spikes.valid.eq(wr_en)
-        return probes
+        return probes, thr_memories
