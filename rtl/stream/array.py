@@ -94,6 +94,7 @@ from rvsm.rtl.stream.signatures import (
     spike_beat_signature,
     threshold_word_bits,
     threshold_write_signature,
+    top_threshold_word,
 )
 
 __all__ = ["RvsmStreamArray"]
@@ -450,9 +451,8 @@ class RvsmStreamArray(wiring.Component):
         for s in range(c.num_scales):
             after_lanes = []
             probes.append([])
-            top = (1 << tw) - 1  # no spike until loaded (see the module docstring)
             thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True,
-                                   init_word=sum(top << (i * tw) for i in range(p)))
+                                   init_word=top_threshold_word(tw, p))  # module docstring
             m.submodules[f"thr_s{s}"] = thr_mem
             thr_memories.append(thr_mem)
             m.d.comb += [thr_mem.advance.eq(advance), thr_mem.read_addr.eq(rd_addr),

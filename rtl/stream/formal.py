@@ -72,7 +72,7 @@ from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.array import RvsmArray
 from rvsm.rtl.stream.array import RvsmStreamArray, StreamProbes
 from rvsm.rtl.stream.geometry import StreamGeometry
-from rvsm.rtl.stream.signatures import threshold_word_bits
+from rvsm.rtl.stream.signatures import threshold_word_bits, top_threshold_word
 
 __all__ = ["PROPERTY_GROUPS", "StreamEquivalence", "StreamProperties", "stream_check",
            "stream_equivalence"]
@@ -257,7 +257,7 @@ class StreamProperties(_StreamHarness):
         m.d.comb += watch.eq(AnyConst(len(watch)))
         self.check(m, "assume.watch_word", watch < words,
                    "the watched word exists", "assume")
-        top_word = sum(((1 << tw) - 1) << (i * tw) for i in range(p))
+        top_word = top_threshold_word(tw, p)
         bus = dut.thr
         reads = taken & self._beats(m, dut, geo.threshold_lag)
         read_pos = self._counter(m, "thr_read_pos", clear, reads, words)
@@ -426,8 +426,7 @@ class StreamEquivalence(_StreamHarness):
                           & (word < words) & (lane < p)),
                    "thresholds (1 .. 2**(W-1)-1) are written only while no beat was "
                    "accepted since the last clear", "assume")
-        top = (1 << tw) - 1
-        shadow = [Array(Signal(p * tw, init=sum(top << (i * tw) for i in range(p)),
+        shadow = [Array(Signal(p * tw, init=top_threshold_word(tw, p),
                                name=f"thr_shadow_s{s}_w{w}") for w in range(words))
                   for s in range(c.num_scales)]
         word_now = Signal(p * tw, name="thr_word_now")

@@ -61,6 +61,13 @@ def threshold_word_bits(words: int) -> int:
     return field_bits(words - 1)
 
 
+def top_threshold_word(threshold_bits: int, lanes: int) -> int:
+    """A threshold word with every lane at the top rail ``2**(W-1)-1``: what the
+    threshold memories hold at configuration (no spike until thresholds are loaded)."""
+    top = (1 << threshold_bits) - 1
+    return sum(top << (i * threshold_bits) for i in range(lanes))
+
+
 def threshold_write_signature(num_scales: int, words: int, lanes: int,
                               threshold_bits: int) -> ThresholdWriteSignature:
     """The shared threshold-write bus with one memory word (P thresholds) per write:
