@@ -195,6 +195,45 @@ class FixedIntegrator:
         return spikes
 
 
+class ContractStream:
+    """The integer contract run chunk by chunk: state carried from one call to the next.
+
+    :meth:`run` takes consecutive chunks of ADC codes ``(B, H, W)`` and returns their
+    spikes ``(B, S, H, W) int8``, exactly those of one :func:`run_integer_array` call on
+    the concatenated codes (steps are computed in blocks of ``block_steps``, which does
+    not change the spikes); :meth:`clear` is the RTL's ``clear`` (every accumulator back
+    to 0, thresholds kept). This is how long co-simulation runs get their expectation
+    with bounded memory.
+    """
+
+    def __init__(self, weights: Sequence[np.ndarray], shift: int, thresholds: np.ndarray,
+                 accumulator_bits: int, signed: bool, reset: str = "zero",
+                 block_steps: int = 32):
+        self.weights = list(weights)
+        self.shift = int(shift)
+        self.block_steps = max(1, int(block_steps))
+        self.integrator = FixedIntegrator(thresholds, accumulator_bits, signed, reset)
+
+    def clear(self) -> None:
+        """Every accumulator back to 0 (thresholds kept)."""
+        self.integrator.acc[...] = 0
+
+    def run(self, codes: np.ndarray) -> np.ndarray:
+        """Spikes ``(B, S, H, W) int8`` of the next ``B`` steps, codes ``(B, H, W)``."""
+        codes = np.asarray(codes)
+        if codes.ndim != 3:
+            raise RvsmError(f"ADC codes must be (T, H, W), got shape {codes.shape}")
+        t_total = codes.shape[0]
+        spikes = np.zeros((t_total, len(self.weights)) + codes.shape[1:], dtype=np.int8)
+        for t0 in range(0, t_total, self.block_steps):
+            t1 = min(t0 + self.block_steps, t_total)
+            sums = arithmetic_shift(integer_receptive_sums(codes[t0:t1], self.weights),
+                                    self.shift)
+            for b in range(t1 - t0):
+                spikes[t0 + b] = self.integrator.step(sums[b])
+        return spikes
+
+
 def run_integer_array(
     codes: np.ndarray,
     weights: Sequence[np.ndarray],
@@ -209,18 +248,8 @@ def run_integer_array(
 
     This is the bit-accurate model the RTL is checked against.
     """
-    codes = np.asarray(codes)
-    if codes.ndim != 3:
-        raise RvsmError(f"ADC codes must be (T, H, W), got shape {codes.shape}")
-    integrator = FixedIntegrator(thresholds, accumulator_bits, signed, reset)
-    t_total = codes.shape[0]
-    spikes = np.zeros((t_total, len(weights)) + codes.shape[1:], dtype=np.int8)
-    for t0 in range(0, t_total, block_steps):
-        t1 = min(t0 + block_steps, t_total)
-        sums = arithmetic_shift(integer_receptive_sums(codes[t0:t1], weights), shift)
-        for b in range(t1 - t0):
-            spikes[t0 + b] = integrator.step(sums[b])
-    return spikes
+    return ContractStream(weights, shift, thresholds, accumulator_bits, signed, reset,
+                          block_steps).run(codes)
 
 
 @dataclass(frozen=True)
@@ -283,3 +312,8 @@ class ArrayContract:
             for a, b in zip(bounds[:-1], bounds[1:], strict=True)
         ]
         return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=0)
+
+    def stream(self, thresholds: np.ndarray) -> ContractStream:
+        """This contract run chunk by chunk from a cleared array (:class:`ContractStream`)."""
+        return ContractStream(self.weight_arrays, self.shift, thresholds,
+                              self.accumulator_bits, self.signed, self.reset)

@@ -20,8 +20,21 @@ from rvsm.model.fixed.core import (
     integer_receptive_sums,
 )
 from rvsm.model.fixed.design_point import DesignPoint
+from rvsm.model.noise.sensor import NoiseSource
 from rvsm.model.sampling.config import DEFAULT_BLOCK_STEPS
 from rvsm.model.scene.scene import Scene
+
+
+def step_codes(scene: Scene, point: DesignPoint, noise: NoiseSource | None, t0: int,
+               t1: int) -> np.ndarray:
+    """ADC codes ``(t1 - t0, H, W) int64`` of steps ``t0 .. t1 - 1``: the scene's
+    brightness plus ``noise``'s dark current (``point.noise_source()``, or None) through
+    the point's ADC."""
+    analog = scene.brightness(t0, t1)
+    if noise is not None:
+        analog += noise.dark_current_at(t0, t1 - t0)
+    return adc_codes(analog, point.adc_bits, point.adc_full_scale, point.adc_rounding,
+                     point.adc_clip)
 
 
 class NumpyFixedTwin:
@@ -58,11 +71,7 @@ class NumpyFixedTwin:
 
     def _codes(self, t0: int, t1: int) -> np.ndarray:
         """ADC codes ``(t1 - t0, H, W) int64`` of steps ``t0 .. t1 - 1``."""
-        p = self.point
-        analog = self.scene.brightness(t0, t1)
-        if self.noise is not None:
-            analog += self.noise.dark_current_at(t0, t1 - t0)
-        return adc_codes(analog, p.adc_bits, p.adc_full_scale, p.adc_rounding, p.adc_clip)
+        return step_codes(self.scene, self.point, self.noise, t0, t1)
 
     def run(self, t0: int, t1: int, out: np.ndarray | None = None) -> np.ndarray:
         """Spikes ``(t1 - t0, S, H, W) int8`` of steps ``t0 .. t1 - 1``."""

@@ -37,6 +37,7 @@ import numpy as np
 
 __all__ = [
     "OutputBeats",
+    "StreamChecker",
     "StreamSchedule",
     "check_beats",
     "pack_lanes",
@@ -235,3 +236,119 @@ def check_beats(schedule: StreamSchedule, expected: np.ndarray, got: OutputBeats
         "first_mismatch": listed[0] if listed else None,
         "mismatch_list": listed,
     }
+
+
+class StreamChecker:
+    """:func:`check_beats` for a run too long to hold: expected spikes are given a chunk
+    of steps at a time (:meth:`expect`), received beats are checked as they arrive
+    (:meth:`receive`) and dropped, and :meth:`result` has :func:`check_beats`'s keys.
+
+    A ``clear`` restarts the positions (:meth:`restart`): beats still expected then are
+    missing. Memory is bounded by the beats in flight. Entries of ``mismatch_list`` also
+    give ``cycle`` (the clock cycle the beat was presented in, when :meth:`receive` is
+    given them); ``beat`` counts output beats from the start of the run.
+    """
+
+    def __init__(self, schedule: StreamSchedule, max_listed: int = 50):
+        self.schedule = schedule
+        self.max_listed = int(max_listed)
+        self.listed: list[dict] = []
+        self.mismatches = 0
+        self.compared = 0
+        self.beats = 0  # beats received in the whole run
+        self._pending: list[np.ndarray] = []  # expected beats (n, S, P), in order
+        self._pending_beats = 0
+        self._segment_beats = 0  # beats received since the last restart
+        self._segment_step0 = 0  # the run's step at which this segment starts
+        self._scales = 0
+
+    def expect(self, spikes: np.ndarray) -> None:
+        """Append the expected spikes ``(B, S, H, W)`` of the next ``B`` steps."""
+        beats = self.schedule.expected_beats(spikes)
+        self._scales = beats.shape[1]
+        self._pending.append(beats)
+        self._pending_beats += beats.shape[0]
+
+    def _take(self, n: int) -> np.ndarray:
+        """The next ``n`` expected beats (``n`` <= pending), removed from the queue."""
+        parts, need = [], n
+        while need:
+            head = self._pending[0]
+            if head.shape[0] <= need:
+                parts.append(self._pending.pop(0))
+                need -= head.shape[0]
+            else:
+                parts.append(head[:need])
+                self._pending[0] = head[need:]
+                need = 0
+        self._pending_beats -= n
+        return np.concatenate(parts) if parts else np.zeros((0, self._scales,
+                                                             self.schedule.lanes), np.int8)
+
+    def _note(self, entry: dict) -> None:
+        if len(self.listed) < self.max_listed:
+            self.listed.append(entry)
+
+    def receive(self, got: OutputBeats, cycles: np.ndarray | None = None) -> None:
+        """Check the next received beats (in order) against the expectation."""
+        n_got = got.spikes.shape[0]
+        n = min(n_got, self._pending_beats)
+        sched, lanes = self.schedule, self.schedule.lanes
+        exp = self._take(n)
+        if n_got > n:
+            extra = n_got - n
+            self.mismatches += extra * max(self._scales, 1) * lanes
+            self._note({"beat": self.beats + n, "error": f"{extra} output beat(s) more "
+                        "than the stimulus releases", **self._cycle(cycles, n)})
+        idx = self._segment_beats + np.arange(n)
+        p = idx % sched.beats_per_frame
+        rows, groups = p // sched.groups, p % sched.groups
+        last = (rows == sched.height - 1) & (groups == sched.groups - 1)
+        bad_pos = np.flatnonzero((got.rows[:n] != rows) | (got.groups[:n] != groups)
+                                 | (got.last[:n] != last))
+        self.mismatches += len(bad_pos)
+        for k in bad_pos[: self.max_listed]:
+            self._note({"beat": self.beats + int(k), "error": (
+                f"position (row {int(got.rows[k])}, group {int(got.groups[k])}, last "
+                f"{bool(got.last[k])}), expected (row {int(rows[k])}, group "
+                f"{int(groups[k])}, last {bool(last[k])})"), **self._cycle(cycles, k)})
+        diff = np.argwhere(got.spikes[:n] != exp)
+        self.mismatches += len(diff)
+        for k, s, i in diff[: self.max_listed]:
+            self._note({"beat": self.beats + int(k),
+                        "step": self._segment_step0 + int(idx[k] // sched.beats_per_frame),
+                        "scale": int(s), "row": int(rows[k]),
+                        "column": int(groups[k] * lanes + i),
+                        "expected": int(exp[k, s, i]), "got": int(got.spikes[k, s, i]),
+                        **self._cycle(cycles, k)})
+        self.compared += int(exp.size)
+        self.beats += n_got
+        self._segment_beats += n
+
+    @staticmethod
+    def _cycle(cycles: np.ndarray | None, k: int) -> dict:
+        if cycles is None or not len(cycles):
+            return {}
+        return {"cycle": int(cycles[min(int(k), len(cycles) - 1)])}
+
+    def restart(self, step: int) -> None:
+        """A ``clear`` before the run's step ``step``: beats still expected are missing."""
+        self._flush_missing()
+        self._segment_beats = 0
+        self._segment_step0 = int(step)
+
+    def _flush_missing(self) -> None:
+        if self._pending_beats:
+            missing = self._pending_beats
+            self.mismatches += missing * self._scales * self.schedule.lanes
+            self._note({"beat": self.beats, "error": f"{missing} expected output beat(s) "
+                        "never came"})
+            self._take(missing)
+
+    def result(self) -> dict:
+        """:func:`check_beats`'s result so far (beats still expected count as missing)."""
+        self._flush_missing()
+        listed = sorted(self.listed, key=lambda e: e["beat"])
+        return {"compared": self.compared, "mismatches": int(self.mismatches),
+                "beats": self.beats, "first_mismatch": listed[0] if listed else None,
+                "mismatch_list": listed}

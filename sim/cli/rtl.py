@@ -68,6 +68,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--work", default="build/verify",
                    help="work folder: shared build cache (builds/) and one new folder per "
                    "run (runs/)")
+    p.add_argument("--harness", choices=("cycle", "chunk"), default="cycle",
+                   help="cycle: Python drives every clock cycle (protocol tests, both "
+                   "architectures); chunk: the long-run harness, where the simulator runs "
+                   "the cycles and the twin is produced and checked a chunk of steps at "
+                   "a time in bounded memory (streaming array; docs/long-runs.md). "
+                   "Default cycle")
+    p.add_argument("--chunk-steps", type=int, default=8, metavar="N",
+                   help="with --harness chunk: steps produced and streamed at a time "
+                   "(default 8)")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress bar (--harness chunk)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_arch_arguments(p)
     p.set_defaults(func=_verify)
@@ -152,6 +163,12 @@ def _verify(args: argparse.Namespace) -> int:
     if args.steps is not None and args.steps < 1:
         raise RvsmError(f"--steps must be >= 1, got {args.steps}")
     arch, options = args.arch, arch_options(args)
+    if args.chunk_steps < 1:
+        raise RvsmError(f"--chunk-steps must be >= 1, got {args.chunk_steps}")
+    long_run = {"harness": args.harness}
+    if args.harness == "chunk":
+        long_run.update(progress=not (args.quiet or args.json),
+                        chunk_steps=args.chunk_steps)
     if args.recompute_expected and not args.stimulus:
         raise RvsmError("--recompute-expected applies to --stimulus FILE only (the other "
                         "ways compute the expectation from the fixed twin anyway)")
@@ -164,7 +181,7 @@ def _verify(args: argparse.Namespace) -> int:
                             "stimulus file holds the scene's codes and the contract")
         r = replay(args.stimulus, args.sim, steps=args.steps, waves=args.waves,
                    work_dir=args.work, arch=arch,
-                   recompute_expected=args.recompute_expected, **options)
+                   recompute_expected=args.recompute_expected, **long_run, **options)
     elif args.random is not None:
         given = [n for n, v in (("SCENE", args.scene), *_scene_shaping(args)) if v is not None]
         if given:
@@ -177,7 +194,7 @@ def _verify(args: argparse.Namespace) -> int:
                             "e.g. --random 1 --fixed point.toml --size 4x4 --steps 200")
         r = random_verify(args.fixed, args.random, args.steps, args.sim, waves=args.waves,
                           size=parse_size_arg(args.size), work_dir=args.work, arch=arch,
-                          **options)
+                          **long_run, **options)
     else:
         if args.scene is None or args.fixed is None:
             raise RvsmError("rvsm verify needs SCENE --fixed POINT.toml, --stimulus FILE, "
@@ -187,7 +204,7 @@ def _verify(args: argparse.Namespace) -> int:
         point, scene = SceneRequest.from_args(args).load_for_point(
             load_design_point(args.fixed))
         r = verify(scene, args.fixed, args.sim, steps=args.steps, waves=args.waves,
-                   size=point.shape, work_dir=args.work, arch=arch, **options)
+                   size=point.shape, work_dir=args.work, arch=arch, **long_run, **options)
     if args.json:
         r = dict(r)
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]
@@ -206,8 +223,13 @@ def _verify(args: argparse.Namespace) -> int:
             f = r["first_mismatch"] or {}
             print("first mismatch: " + ", ".join(f"{k}={v}" for k, v in f.items()))
         if r.get("cycles_per_second"):
+            how = ", long-run harness" if r.get("harness") == "chunk" else ""
             print(f"stream: {r['lanes']} lane(s), {r['cycles']} cycles at "
-                  f"{r['cycles_per_second']:.0f} cycles/s (build {r['build_seconds']:.0f} s)")
+                  f"{r['cycles_per_second']:.0f} cycles/s{how} (build "
+                  f"{r['build_seconds']:.0f} s)")
+        if r.get("wave_window_cycles"):
+            lo, hi = r["wave_window_cycles"]
+            print(f"waveform window: clock cycles {lo}..{hi} around the first mismatch")
         if r["waves"]:
             at = r.get("first_mismatch_time_ns")
             jump = f"; first mismatch at {at} ns" if r["mismatches"] and at is not None else ""

@@ -19,6 +19,7 @@ from the architecture registry (:mod:`rvsm.rtl.architectures`) through one funct
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import hashlib
 import json
@@ -41,6 +42,13 @@ from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.digest import rtl_digest
 from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.verilog import GeneratedVerilog, write_outputs
+from rvsm.sim.cosim.chunk_harness import (
+    HARNESS_TOP,
+    HARNESS_VERSION,
+    LONG_RUN_TESTBENCHES,
+    HarnessLayout,
+    harness_verilog,
+)
 from rvsm.sim.cosim.cocotb_adapter import build_args, check_simulator, cocotb_build, cxx_opt
 
 __all__ = ["CosimDesign", "SimBuild", "build", "build_key", "cosim_design", "new_run_dir",
@@ -99,6 +107,17 @@ class SimBuild:
     waves: bool = False
     arch: str = DEFAULT_ARCHITECTURE
     options: dict[str, int] = field(default_factory=dict)  # the architecture's options
+    harness: bool = False  # built inside the long-run harness (:mod:`.chunk_harness`)
+
+    @property
+    def ports_json(self) -> Path:
+        """The array's port map ``<array top>.ports.json`` beside its Verilog."""
+        return self.verilog.with_suffix(".ports.json")
+
+    @property
+    def hdl_top(self) -> str:
+        """The simulation's top module: the harness's, or the array's own."""
+        return HARNESS_TOP if self.harness else self.top
 
 
 @functools.cache
@@ -135,7 +154,7 @@ def build_key(contract: ArrayContract, sim: str, top: str, traced: bool,
         "recipe": _BUILD_VERSION, "rtl": design.digest(contract),
         "sim": sim, "top": top,
         "traced": traced, "build_args": build_args(sim, traced),
-        "cxx_opt": cxx_opt() if sim == "verilator" else "",
+        "cxx_opt": cxx_opt("harness" in extra) if sim == "verilator" else "",
         "versions": tool_versions(sim), "extra": list(extra),
     }
     text = json.dumps(fields, sort_keys=True)
@@ -145,7 +164,8 @@ def build_key(contract: ArrayContract, sim: str, top: str, traced: bool,
 def build(
     contract: ArrayContract, sim: str, build_root: str | os.PathLike,
     top: str | None = None, waves: bool = False,
-    arch: str | Architecture = DEFAULT_ARCHITECTURE, **options: int | None,
+    arch: str | Architecture = DEFAULT_ARCHITECTURE, harness: bool = False,
+    **options: int | None,
 ) -> SimBuild:
     """Generate (or reuse) the Verilog and build it for ``sim``; cached per :func:`build_key`.
 
@@ -158,17 +178,26 @@ def build(
     still match (:func:`_cached`); a damaged one is rebuilt. The Verilog of a contract
     already generated for another build is reused, not regenerated. ``arch`` and
     ``options`` (e.g. ``lanes=8``) name the architecture (:func:`cosim_design`).
+    ``harness`` builds the array inside the long-run harness (:mod:`.chunk_harness`,
+    for architectures in :data:`~.chunk_harness.LONG_RUN_TESTBENCHES`), run by the
+    long-run testbench; Verilator builds of it always carry ``--trace-fst`` so a
+    mismatch's waveform window needs no second build.
     """
     check_simulator(sim)
     design = cosim_design(arch, top, **options)
     top = design.top
-    traced = waves or sim == "icarus"
+    if harness and design.arch.name not in LONG_RUN_TESTBENCHES:
+        raise RvsmError(f"the long-run harness drives {', '.join(LONG_RUN_TESTBENCHES)} "
+                        f"only, not the {design.arch.name} architecture")
+    traced = waves or (sim == "icarus" and not harness) or (harness and sim == "verilator")
     digest = design.digest(contract)
-    key, key_fields = build_key(contract, sim, top, traced, design=design)
-    suffix = "-trace" if (traced and sim == "verilator") else ""
+    extra = ["harness", HARNESS_VERSION] if harness else []
+    key, key_fields = build_key(contract, sim, top, traced, extra, design=design)
+    suffix = ("-trace" if (traced and sim == "verilator") else "") + ("-chunks" if harness
+                                                                       else "")
     base = Path(build_root).resolve()
     final = base / f"{sim}-{digest}-{top}{suffix}-{key[:8]}"
-    cached = _cached(final, sim, top, traced, key, design)
+    cached = _cached(final, sim, top, traced, key, design, harness)
     if cached is not None:
         return cached
     root = final.with_name(f"{final.name}.tmp{os.getpid()}")
@@ -191,13 +220,21 @@ def build(
         paths, gen = (_reuse_verilog(base, digest, top, stage)
                       or design.write(contract, stage))
         t0 = time.perf_counter()
-        ports = [p["name"] for p in json.loads(paths["ports_json"].read_text())["ports"]]
-        cocotb_build(sim, paths["verilog"], top, ports, stage / "sim_build", traced, log)
+        port_map = json.loads(paths["ports_json"].read_text())
+        sources, hdl_top = [paths["verilog"]], top
+        ports = [p["name"] for p in port_map["ports"]]
+        if harness:
+            layout = HarnessLayout.from_ports(port_map)
+            sources.append(stage / f"{HARNESS_TOP}.v")
+            sources[-1].write_text(harness_verilog(layout))
+            hdl_top, ports = HARNESS_TOP, layout.ports
+        cocotb_build(sim, sources, hdl_top, ports, stage / "sim_build", traced, log,
+                     long_run=harness)
         build_seconds = time.perf_counter() - t0
-        files = _checksums(stage, _build_files(sim, top))
+        files = _checksums(stage, _build_files(sim, top, harness))
         if files is None:
             raise ToolFailure(f"{sim} build", 0, log, "finished without its outputs "
-                              f"{', '.join(_build_files(sim, top))}")
+                              f"{', '.join(_build_files(sim, top, harness))}")
         (stage / "build.json").write_text(json.dumps({
             "generate_seconds": gen.seconds, "build_seconds": build_seconds,
             "key": key, "key_fields": key_fields, "files": files}, indent=1))
@@ -219,18 +256,19 @@ def build(
     except OSError:  # another process finished the same build first
         shutil.rmtree(root, ignore_errors=True)
     (base / f"{final.name}.failed.log").unlink(missing_ok=True)  # an older failure's log
-    done = _cached(final, sim, top, traced, key, design)
+    done = _cached(final, sim, top, traced, key, design, harness)
     if done is None:
         raise ToolError(f"{sim} build folder {final} vanished or is damaged")
-    return SimBuild(sim, done.build_dir, top, done.verilog, gen.seconds, build_seconds,
-                    False, design.testbench, traced, design.arch.name, design.options)
+    return dataclasses.replace(done, generate_seconds=gen.seconds,
+                               build_seconds=build_seconds, cached=False)
 
 
-def _build_files(sim: str, top: str) -> list[str]:
+def _build_files(sim: str, top: str, harness: bool = False) -> list[str]:
     """Files (relative to a build folder) whose checksums a cached build records: the
     Verilog it was built from and the binary the simulation runs."""
-    binary = "sim_build/sim.vvp" if sim == "icarus" else f"sim_build/{top}"
-    return [f"{top}.v", binary]
+    hdl_top = HARNESS_TOP if harness else top
+    binary = "sim_build/sim.vvp" if sim == "icarus" else f"sim_build/{hdl_top}"
+    return [f"{top}.v", *([f"{HARNESS_TOP}.v"] if harness else []), binary]
 
 
 def _checksums(root: Path, names: Sequence[str]) -> dict[str, str] | None:
@@ -249,7 +287,7 @@ def _checksums(root: Path, names: Sequence[str]) -> dict[str, str] | None:
 
 
 def _cached(root: Path, sim: str, top: str, traced: bool, key: str,
-            design: CosimDesign) -> SimBuild | None:
+            design: CosimDesign, harness: bool = False) -> SimBuild | None:
     """The finished build in ``root`` if its ``build.json`` records ``key`` and the
     checksums of its files still match; a damaged build is moved away (and rebuilt)."""
     if not root.exists():
@@ -275,9 +313,10 @@ def _cached(root: Path, sim: str, top: str, traced: bool, key: str,
             os.rename(root, stale)
         shutil.rmtree(stale, ignore_errors=True)
         return None
+    testbench = LONG_RUN_TESTBENCHES[design.arch.name] if harness else design.testbench
     return SimBuild(sim, root / "sim_build", top, root / f"{top}.v",
-                    meta["generate_seconds"], meta["build_seconds"], True, design.testbench,
-                    traced, design.arch.name, design.options)
+                    meta["generate_seconds"], meta["build_seconds"], True, testbench,
+                    traced, design.arch.name, design.options, harness)
 
 
 def _reuse_verilog(

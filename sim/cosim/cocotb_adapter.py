@@ -50,8 +50,8 @@ from rvsm.rtl.verilog import verilator_env
 from rvsm.sim.cosim import SIMULATORS
 from rvsm.sim.cosim.cocotb_job import safe_path
 
-__all__ = ["VERILATOR_BUILD_ARGS", "VERILATOR_CXX_OPT", "build_args", "check_simulator",
-           "cocotb_build", "cocotb_test", "cxx_opt", "public_ports_control"]
+__all__ = ["LONG_RUN_CXX_OPT", "VERILATOR_BUILD_ARGS", "VERILATOR_CXX_OPT", "build_args",
+           "check_simulator", "cocotb_build", "cocotb_test", "cxx_opt", "public_ports_control"]
 
 #: Verilator flags for Amaranth's netlist (warnings are the lint's job, not the build's)
 #: and no cocotb ``--public-flat-rw`` (the ports are public by ``public.vlt``).
@@ -63,6 +63,10 @@ VERILATOR_BUILD_ARGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style", "-O2",
 #: dominate, so -O0 is the default. Override with the environment variable
 #: RVSM_VERILATOR_CXX_OPT, e.g. "-O2" for long runs.
 VERILATOR_CXX_OPT = "-O0"
+#: The same for builds in the long-run harness (:mod:`.chunk_harness`): their runs are
+#: long, so the simulation's speed wins. At 250x400 dog4 with 40 lanes -O2 builds in
+#: 117-145 s (-O0: 57 s) and simulates 122,000 cycles/s (-O0: 26,000) (docs/long-runs.md).
+LONG_RUN_CXX_OPT = "-O2"
 #: Both simulators' time unit and precision.
 TIMESCALE = ("1ns", "1ps")
 
@@ -85,9 +89,12 @@ def check_simulator(sim: str) -> None:
                             "`apt-get install build-essential`")
 
 
-def cxx_opt() -> str:
-    """The g++ optimisation of Verilator builds (``RVSM_VERILATOR_CXX_OPT``, checked)."""
-    opt = os.environ.get("RVSM_VERILATOR_CXX_OPT", VERILATOR_CXX_OPT)
+def cxx_opt(long_run: bool = False) -> str:
+    """The g++ optimisation of Verilator builds: ``RVSM_VERILATOR_CXX_OPT`` (checked), else
+    :data:`LONG_RUN_CXX_OPT` for the long-run harness (``long_run``) or
+    :data:`VERILATOR_CXX_OPT`."""
+    opt = os.environ.get("RVSM_VERILATOR_CXX_OPT",
+                         LONG_RUN_CXX_OPT if long_run else VERILATOR_CXX_OPT)
     if not re.fullmatch(r"-O[0-3sgz]|-Ofast", opt):
         raise RvsmError(f"RVSM_VERILATOR_CXX_OPT must be a gcc optimisation flag such as "
                         f"-O0 or -O2, got {opt!r}")
@@ -111,14 +118,16 @@ def public_ports_control(top: str, ports: Sequence[str]) -> str:
         f'public_flat_rw -module "{top}" -var "{name}"\n' for name in ports)
 
 
-def cocotb_build(sim: str, verilog: Path, top: str, ports: Sequence[str], build_dir: Path,
-                 traced: bool, log: Path) -> None:
-    """Build ``verilog`` (top module ``top``, whose ``ports`` the testbench uses) for
-    ``sim`` in ``build_dir``, with tracing when ``traced``; the tools' output goes to
-    ``log``. Raises :class:`~rvsm.model.infra.tools.ToolFailure` naming the failing
-    command."""
+def cocotb_build(sim: str, verilog: Path | Sequence[Path], top: str, ports: Sequence[str],
+                 build_dir: Path, traced: bool, log: Path, long_run: bool = False) -> None:
+    """Build ``verilog`` (one file or several; top module ``top``, whose ``ports`` the
+    testbench uses) for ``sim`` in ``build_dir``, with tracing when ``traced``; the tools'
+    output goes to ``log``; ``long_run`` picks the long-run C++ optimisation
+    (:func:`cxx_opt`). Raises :class:`~rvsm.model.infra.tools.ToolFailure` naming the
+    failing command."""
     build_dir.mkdir(parents=True, exist_ok=True)
-    sources = [str(verilog)]
+    sources = ([str(verilog)] if isinstance(verilog, (str, Path))
+               else [str(v) for v in verilog])
     if sim == "verilator":
         control = build_dir / "public.vlt"
         control.write_text(public_ports_control(top, ports))
@@ -126,7 +135,8 @@ def cocotb_build(sim: str, verilog: Path, top: str, ports: Sequence[str], build_
     _run_job(sim, "build", {
         "sources": sources, "hdl_toplevel": top, "build_dir": str(build_dir),
         "build_args": build_args(sim, traced), "waves": traced, "timescale": TIMESCALE,
-        "always": True, "log_file": str(log)}, cwd=build_dir.parent, log=log)
+        "always": True, "log_file": str(log)}, cwd=build_dir.parent, log=log,
+        long_run=long_run)
 
 
 def cocotb_test(sim: str, build_dir: Path, top: str, test_module: str, test_dir: Path,
@@ -144,18 +154,19 @@ def cocotb_test(sim: str, build_dir: Path, top: str, test_module: str, test_dir:
         cwd=test_dir, log=log)
 
 
-def _job_env(sim: str) -> dict[str, str]:
+def _job_env(sim: str, long_run: bool = False) -> dict[str, str]:
     """The child's environment: ours, the simulator's, an absolute ``PYTHONPATH``."""
     env = verilator_env() if sim == "verilator" else dict(os.environ)
     if sim == "verilator":
-        opt = cxx_opt()
+        opt = cxx_opt(long_run)
         env["MAKEFLAGS"] += f" OPT_FAST={opt} OPT_SLOW={opt} OPT_GLOBAL={opt}"
     env.pop("PYTEST_CURRENT_TEST", None)
     env["PYTHONPATH"] = os.pathsep.join(safe_path(sys.path))
     return env
 
 
-def _run_job(sim: str, action: str, args: dict, cwd: Path, log: Path) -> None:
+def _run_job(sim: str, action: str, args: dict, cwd: Path, log: Path,
+             long_run: bool = False) -> None:
     phase = "build" if action == "build" else "simulation"
     outcome_path = log.with_name(f"{log.name}.outcome.json")
     outcome_path.unlink(missing_ok=True)
@@ -163,7 +174,7 @@ def _run_job(sim: str, action: str, args: dict, cwd: Path, log: Path) -> None:
     safe = ["-P"] if sys.version_info >= (3, 11) else []
     job = run_tool([sys.executable, *safe, "-m", "rvsm.sim.cosim.cocotb_job",
                     json.dumps(spec)], tool=f"{sim} {phase} (cocotb runner)", cwd=cwd,
-                   env=_job_env(sim), capture=True, check=False)
+                   env=_job_env(sim, long_run), capture=True, check=False)
     try:
         outcome = json.loads(outcome_path.read_text())
         outcome_path.unlink()

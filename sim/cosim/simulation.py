@@ -10,13 +10,14 @@ from __future__ import annotations
 import json
 import os
 import time
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.sim.cosim.build_cache import SimBuild
 from rvsm.sim.cosim.cocotb_adapter import cocotb_test
 
-__all__ = ["run_testbench"]
+__all__ = ["run_cocotb", "run_testbench"]
 
 
 def run_testbench(
@@ -33,6 +34,17 @@ def run_testbench(
     when the simulator fails or is killed, :class:`ToolError` when the testbench ends
     without a result or its cocotb verdict contradicts the result (both: exit status 3).
     """
+    return run_cocotb(sb, {"RVSM_STIMULUS": str(Path(stimulus).resolve())}, test_dir,
+                      waves=waves, test_module=test_module)
+
+
+def run_cocotb(
+    sb: SimBuild, inputs: Mapping[str, str], test_dir: str | os.PathLike,
+    waves: bool = False, test_module: str | None = None, plusargs: Sequence[str] = (),
+) -> dict:
+    """Run a testbench on ``sb`` with ``inputs`` (``RVSM_*`` variables, besides
+    ``RVSM_RESULT`` and ``RVSM_PORTS`` which this sets) and ``plusargs``; the checked
+    result as :func:`run_testbench`."""
     from cocotb_tools.check_results import get_results
 
     if waves and not sb.waves:
@@ -42,15 +54,16 @@ def run_testbench(
     result_path = test_dir / "result.json"
     result_path.unlink(missing_ok=True)
     wave_path = test_dir / ("waves.fst" if sb.sim == "icarus" else "dump.fst")
-    plusargs = [f"+dumpfile_path={wave_path}"] if (waves and sb.sim == "icarus") else []
+    plusargs = [*plusargs, *([f"+dumpfile_path={wave_path}"]
+                             if (waves and sb.sim == "icarus") else [])]
     log = test_dir / "sim.log"
     results_xml = test_dir / "results.xml"
-    extra = {"RVSM_STIMULUS": str(Path(stimulus).resolve()), "RVSM_RESULT": str(result_path),
-             "RVSM_PORTS": str((sb.verilog.parent / f"{sb.top}.ports.json").resolve())}
+    extra = {**inputs, "RVSM_RESULT": str(result_path),
+             "RVSM_PORTS": str(sb.ports_json.resolve())}
     test_module = test_module or sb.test_module
     t0 = time.perf_counter()
-    cocotb_test(sb.sim, sb.build_dir, sb.top, test_module, test_dir, extra, waves, plusargs,
-                results_xml, log)
+    cocotb_test(sb.sim, sb.build_dir, sb.hdl_top, test_module, test_dir, extra, waves,
+                plusargs, results_xml, log)
     wall = time.perf_counter() - t0
     tb = test_module.rsplit(".", 1)[-1]
     try:
@@ -72,4 +85,5 @@ def run_testbench(
     result["sim_wall_seconds"] = wall
     result["waves"] = str(wave_path) if waves and wave_path.exists() else None
     result["cocotb_tests"], result["cocotb_failed"] = tests, failed
+    result["log"] = str(log)
     return result

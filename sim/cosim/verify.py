@@ -21,16 +21,24 @@ import numpy as np
 
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.stimulus import Stimulus, load_stimulus, save_stimulus
+from rvsm.model.fixed.stimulus_chunks import StimulusChunks
 from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.scene import Scene
 from rvsm.rtl.architecture import Architecture
 from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.sim.cosim.build_cache import SimBuild, build, new_run_dir
+from rvsm.sim.cosim.chunk_harness import LONG_RUN_TESTBENCHES
 from rvsm.sim.cosim.cocotb_adapter import check_simulator
+from rvsm.sim.cosim.long_run import DEFAULT_CHUNK_STEPS, check_chunks
 from rvsm.sim.cosim.simulation import run_testbench
 
-__all__ = ["check_stimulus", "random_verify", "replay", "run_rtl", "verify"]
+#: The testbenches ``rvsm verify --harness`` chooses: per cycle from Python, or the
+#: long-run harness (the simulator runs the cycles; streaming array only).
+HARNESSES = ("cycle", "chunk")
+
+__all__ = ["HARNESSES", "check_harness", "check_stimulus", "random_verify", "replay",
+           "run_rtl", "verify"]
 
 DEFAULT_WORK = Path("build") / "verify"
 
@@ -158,6 +166,9 @@ def replay(
     work_dir: str | os.PathLike = DEFAULT_WORK,
     arch: str | Architecture = DEFAULT_ARCHITECTURE,
     recompute_expected: bool = False,
+    harness: str = "cycle",
+    progress: bool = False,
+    chunk_steps: int = DEFAULT_CHUNK_STEPS,
     **options: int | None,
 ) -> dict:
     """Replay a stimulus file (``rvsm stimulus -o FILE``) on the RTL, spike for spike.
@@ -166,17 +177,19 @@ def replay(
     its expected spikes do not follow from its own codes, thresholds and contract
     (a hand-edited or damaged file) it is a bad stimulus (:class:`RvsmError`, exit 2,
     naming the first inconsistent step and accumulator), unless ``recompute_expected``
-    takes the expectation from its codes instead. Returns :func:`check_stimulus`'s result
-    plus ``stimulus``, ``height``, ``width`` and ``expectation`` (``"file"`` or
-    ``"recomputed"``).
+    takes the expectation from its codes instead. ``harness`` and ``progress`` as
+    :func:`verify`. Returns :func:`check_stimulus`'s result plus ``stimulus``,
+    ``height``, ``width`` and ``expectation`` (``"file"`` or ``"recomputed"``).
     """
     check_simulator(sim)
+    check_harness(harness, arch)
     stim = load_stimulus(stimulus)
     c = stim.contract
     _resolve(arch, options, c)
     if steps is not None and steps > stim.num_steps:
         raise RvsmError(f"--steps {steps}: {stimulus} holds {stim.num_steps} steps; ask for "
                         f"at most {stim.num_steps}")
+    whole_file = steps is None or steps == stim.num_steps
     if steps is not None and steps < stim.num_steps:
         stim = stim.first_steps(steps)
     if recompute_expected:
@@ -187,8 +200,17 @@ def replay(
             raise RvsmError(f"{stimulus} is a bad stimulus, not an RTL failure: {problem}; "
                             f"fix the file, or replay it with --recompute-expected to take "
                             f"the expectation from its codes")
-    result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
-                            name=Path(stimulus).stem or "stimulus", arch=arch, **options)
+    name = Path(stimulus).stem or "stimulus"
+    if harness == "chunk":
+        source = StimulusChunks.from_stimulus(
+            stim, str(Path(stimulus).resolve())
+            if whole_file and not recompute_expected else None)
+        result = check_chunks(source, sim, work_dir=work_dir, name=name, arch=arch,
+                              waves=waves, progress=progress, chunk_steps=chunk_steps,
+                              **options)
+    else:
+        result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=name,
+                                arch=arch, **options)
     result.update(stimulus=str(stimulus), height=c.height, width=c.width,
                   coverage=_coverage(stim),
                   expectation="recomputed" if recompute_expected else "file")
@@ -204,6 +226,9 @@ def verify(
     size: tuple[int, int] | None = None,
     work_dir: str | os.PathLike = DEFAULT_WORK,
     arch: str | Architecture = DEFAULT_ARCHITECTURE,
+    harness: str = "cycle",
+    progress: bool = False,
+    chunk_steps: int = DEFAULT_CHUNK_STEPS,
     **options: int | None,
 ) -> dict:
     """Verify the RTL of design point ``fixed`` (TOML) on ``scene``, spike for spike.
@@ -213,15 +238,20 @@ def verify(
 
     ``size = (H, W)`` overrides the point's array size (a scene name or path is rendered
     or cropped to it; a :class:`Scene`, shaped by the caller, must have it); ``steps``
-    keeps the first steps. Returns :func:`check_stimulus`'s result plus
-    ``scene`` and ``point``. Raises :class:`RvsmError` on user errors (not on
-    mismatches: check ``result["mismatches"]``).
+    keeps the first steps. ``harness``: ``"cycle"``, the per-cycle testbench
+    (:func:`check_stimulus`), or ``"chunk"``, the long-run harness
+    (:func:`~.long_run.check_chunks`: streaming array only, the twin run chunk by
+    chunk, bounded memory, no coverage for scene runs; ``progress`` shows a bar).
+    Returns :func:`check_stimulus`'s result plus ``scene`` and ``point``. Raises
+    :class:`RvsmError` on user errors (not on mismatches: check
+    ``result["mismatches"]``).
     """
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.model.fixed.stimulus import make_stimulus
     from rvsm.model.scene.loaders import load_scene
 
     check_simulator(sim)
+    check_harness(harness, arch)
     point = load_design_point(fixed)
     if size is not None:
         point = point.with_size(*size)
@@ -229,6 +259,17 @@ def verify(
     _resolve(arch, options, point.contract())
     if not isinstance(scene, Scene):
         scene = load_scene(scene, size=(h, w))
+    if harness == "chunk":
+        if steps is not None and steps > scene.num_steps:
+            raise RvsmError(f"--steps {steps} is more than the {scene.num_steps} steps of "
+                            f"scene {scene.name!r}; ask for at most {scene.num_steps}")
+        source = StimulusChunks.from_scene(scene, point, steps)
+        result = check_chunks(source, sim, work_dir=work_dir, name=scene.name or "scene",
+                              arch=arch, waves=waves, progress=progress, chunk_steps=chunk_steps,
+                              **options)
+        result.update(scene=scene.source or scene.name, point=str(fixed), height=h,
+                      width=w, coverage=None)
+        return result
     stim = make_stimulus(scene, point, num_steps=steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
                             name=scene.name or "scene", arch=arch, **options)
@@ -246,6 +287,9 @@ def random_verify(
     size: tuple[int, int] | None = None,
     work_dir: str | os.PathLike = DEFAULT_WORK,
     arch: str | Architecture = DEFAULT_ARCHITECTURE,
+    harness: str = "cycle",
+    progress: bool = False,
+    chunk_steps: int = DEFAULT_CHUNK_STEPS,
     **options: int | None,
 ) -> dict:
     """Verify the RTL of design point ``fixed`` on a seeded random and corner stimulus
@@ -259,17 +303,35 @@ def random_verify(
     from rvsm.model.fixed.point_toml import load_design_point
 
     check_simulator(sim)
+    check_harness(harness, arch)
     point = load_design_point(fixed)
     if size is not None:
         point = point.with_size(*size)
     _resolve(arch, options, point.contract())
     stim = corner_stimulus(point.contract(), seed, steps)
     stim.point = point
-    result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=f"random{seed}",
-                            arch=arch, **options)
+    if harness == "chunk":
+        result = check_chunks(StimulusChunks.from_stimulus(stim), sim, work_dir=work_dir,
+                              name=f"random{seed}", arch=arch, waves=waves,
+                              progress=progress, chunk_steps=chunk_steps,
+                              **options)
+    else:
+        result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
+                                name=f"random{seed}", arch=arch, **options)
     result.update(seed=seed, point=str(fixed), height=point.height, width=point.width,
                   coverage=coverage(stim))
     return result
+
+
+def check_harness(harness: str, arch: str | Architecture) -> None:
+    """Refuse (:class:`RvsmError`) an unknown harness, or the long-run one for an
+    architecture it does not drive."""
+    if harness not in HARNESSES:
+        raise RvsmError(f"unknown harness {harness!r}; choose one of {', '.join(HARNESSES)}")
+    name = get_architecture(arch).name
+    if harness == "chunk" and name not in LONG_RUN_TESTBENCHES:
+        raise RvsmError(f"--harness chunk drives the {', '.join(LONG_RUN_TESTBENCHES)} "
+                        f"architecture only; use --harness cycle for --arch {name}")
 
 
 def _coverage(stim: Stimulus) -> list[dict]:

@@ -1,0 +1,154 @@
+"""Stimulus a chunk of steps at a time: what a long co-simulation run drives and expects,
+in bounded memory.
+
+A :class:`StimulusChunks` gives the ADC codes ``(B, H, W) uint16`` and the expected spikes
+``(B, S, H, W) int8`` of consecutive step ranges, plus the thresholds and clears: the
+content of a :class:`~.stimulus.Stimulus` without ever holding all of it. Two sources:
+
+* :meth:`StimulusChunks.from_stimulus`: slices of a stimulus in memory (a file);
+* :meth:`StimulusChunks.from_scene`: a scene through a design point, produced on demand:
+  brightness of the chunk's steps (+ the point's dark current, same streams as the
+  twins), its ADC codes (:func:`~.numpy_engine.step_codes`), and the expectation from
+  the fixed twin run chunk by chunk: the fused engine (:class:`~.fused.FusedFixedTwin`,
+  default: 0.1 ms per step at 250x400 against 20 ms) or ``engine="numpy"``, the integer
+  contract itself on those codes (:class:`~.core.ContractStream`, the arithmetic of
+  :meth:`ArrayContract.run`). Both give the same spikes (the twins' oracle tests, and
+  this module's own).
+
+A run crosses process boundaries as a small JSON description (:meth:`spec`,
+:func:`open_stimulus_chunks`): a stimulus file, or a scene argument, a design point's
+TOML text and a number of steps.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.design_point import DesignPoint
+from rvsm.model.fixed.fused import FusedFixedTwin
+from rvsm.model.fixed.numpy_engine import step_codes
+from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
+from rvsm.model.fixed.stimulus import Stimulus, load_stimulus
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.scene.scene import Scene
+
+__all__ = ["StimulusChunk", "StimulusChunks", "open_stimulus_chunks"]
+
+
+@dataclass(frozen=True)
+class StimulusChunk:
+    """Steps ``t0 .. t0 + B - 1``: ``codes (B, H, W) uint16``, expected ``spikes (B, S, H,
+    W) int8``; ``clear`` when the array is cleared before step ``t0``."""
+
+    t0: int
+    codes: np.ndarray
+    spikes: np.ndarray
+    clear: bool = False
+
+    @property
+    def num_steps(self) -> int:
+        """B, the steps of this chunk."""
+        return int(self.codes.shape[0])
+
+
+@dataclass
+class StimulusChunks:
+    """A run's ``contract``, ``thresholds (S, H, W) int64``, ``num_steps``, the steps
+    ``clear_before`` which the array restarts from zero, and its chunks (:meth:`chunks`).
+    ``spec`` describes how to open it again (:func:`open_stimulus_chunks`)."""
+
+    contract: ArrayContract
+    thresholds: np.ndarray
+    num_steps: int
+    clear_before: tuple[int, ...] = ()
+    spec: dict = field(default_factory=dict)
+    _stimulus: Stimulus | None = field(default=None, repr=False)
+    _scene: Scene | None = field(default=None, repr=False)
+    _point: DesignPoint | None = field(default=None, repr=False)
+    _engine: str = field(default="fused", repr=False)
+
+    @classmethod
+    def from_stimulus(cls, stim: Stimulus, path: str | None = None) -> StimulusChunks:
+        """Chunks of ``stim`` (``path``: the file it was read from, for :attr:`spec`)."""
+        spec = {"kind": "stimulus", "path": path} if path else {}
+        return cls(stim.contract, np.asarray(stim.thresholds, dtype=np.int64),
+                   stim.num_steps, tuple(stim.clear_before), spec, _stimulus=stim)
+
+    @classmethod
+    def from_scene(cls, scene: Scene, point: DesignPoint, num_steps: int | None = None,
+                   engine: str = "fused") -> StimulusChunks:
+        """The first ``num_steps`` (default all) steps of ``scene`` through ``point``
+        (sized to the scene), no clears; ``engine`` (``"fused"`` or ``"numpy"``) makes
+        the expectation."""
+        if engine not in ("fused", "numpy"):
+            raise RvsmError(f"engine must be 'fused' or 'numpy', got {engine!r}")
+        if scene.shape != point.shape:
+            point = point.with_size(*scene.shape)
+        steps = scene.num_steps if num_steps is None else int(num_steps)
+        if not 1 <= steps <= scene.num_steps:
+            raise RvsmError(f"number of steps must be 1..{scene.num_steps} for scene "
+                            f"{scene.name!r}, got {num_steps!r}")
+        spec = {}
+        if scene.source is not None:
+            spec = {"kind": "scene", "scene": scene.source, "size": list(scene.shape),
+                    "num_frames": scene.num_frames,
+                    "steps_per_frame": scene.steps_per_frame, "hold": scene.hold,
+                    "point": design_point_toml(point), "steps": steps, "engine": engine}
+        thresholds = point.integer_thresholds(point.noise_source())
+        return cls(point.contract(), thresholds, steps, (), spec, _scene=scene,
+                   _point=point, _engine=engine)
+
+    def chunks(self, chunk_steps: int) -> Iterator[StimulusChunk]:
+        """Consecutive chunks of at most ``chunk_steps`` steps, never across a clear."""
+        if chunk_steps < 1:
+            raise RvsmError(f"chunk steps must be >= 1, got {chunk_steps}")
+        cuts = sorted({t for t in self.clear_before if 0 < t < self.num_steps})
+        bounds = [0, *cuts, self.num_steps]
+        stream = twin = None
+        if self._stimulus is None and self._engine == "numpy":
+            stream = self.contract.stream(self.thresholds)
+        elif self._stimulus is None:
+            assert self._scene is not None and self._point is not None
+            if cuts:
+                raise RvsmError("the fused engine runs scenes without clears")
+            twin = FusedFixedTwin(self._scene, self._point, self.thresholds, ranges=False)
+        noise = self._point.noise_source() if self._point is not None else None
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+            if stream is not None and a:
+                stream.clear()
+            for t0 in range(a, b, chunk_steps):
+                t1 = min(t0 + chunk_steps, b)
+                if self._stimulus is not None:
+                    codes = self._stimulus.codes[t0:t1]
+                    spikes = self._stimulus.spikes[t0:t1]
+                else:
+                    assert self._scene is not None and self._point is not None
+                    codes = step_codes(self._scene, self._point, noise, t0, t1)
+                    spikes = (twin.run(t0, t1) if twin is not None
+                              else stream.run(codes))  # type: ignore[union-attr]
+                yield StimulusChunk(t0, np.asarray(codes, dtype=np.uint16),
+                                    np.asarray(spikes, dtype=np.int8),
+                                    clear=bool(t0 == a and a > 0))
+
+
+def open_stimulus_chunks(spec: dict | str) -> StimulusChunks:
+    """A :class:`StimulusChunks` from its :attr:`~StimulusChunks.spec` (dict or JSON)."""
+    from rvsm.model.scene.loaders import load_scene
+
+    d = json.loads(spec) if isinstance(spec, str) else dict(spec)
+    kind = d.get("kind")
+    if kind == "stimulus":
+        return StimulusChunks.from_stimulus(load_stimulus(d["path"]), d["path"])
+    if kind == "scene":
+        h, w = d["size"]
+        scene = load_scene(d["scene"], size=(int(h), int(w)), num_frames=d["num_frames"],
+                           steps_per_frame=d["steps_per_frame"], hold=d["hold"])
+        point = parse_design_point(d["point"], "stimulus spec")
+        return StimulusChunks.from_scene(scene, point, int(d["steps"]),
+                                         d.get("engine", "fused"))
+    raise RvsmError(f"not a stimulus description: {d!r}")

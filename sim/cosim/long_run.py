@@ -1,0 +1,162 @@
+"""Long co-simulation runs: the streaming array in the long-run harness, chunk by chunk,
+in bounded memory, with a waveform window around the first mismatch.
+
+:func:`check_chunks` builds (cached) the array inside :mod:`.chunk_harness` and runs the
+long-run testbench (:mod:`.tb_stream_chunks`) on a :class:`StimulusChunks`: the twin's
+codes and expectation are produced in the simulator's process a chunk at a time, so a
+one-second run (40,000 steps of 250x400) never holds more than a chunk. A progress bar
+follows the steps done.
+
+**The waveform window.** A full trace of a long run is too large (gigabytes per
+thousand steps at sensor size), so a failing run is simulated a second time from the
+start with the harness's dump switched on only for clock cycles ``C - before .. C +
+after`` around the cycle ``C`` of the first mismatching output beat; ``before``
+defaults to two frames of beats plus the lag (:func:`window_cycles`), so the window holds
+the two earlier updates of every accumulator on the mismatching row, and the re-run
+stops at the end of the window. ``waves=True`` dumps the whole run instead. Icarus
+writes VCD, Verilator FST (the build's trace format).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import threading
+from pathlib import Path
+
+from rvsm.model.fixed.stimulus import save_stimulus
+from rvsm.model.fixed.stimulus_chunks import StimulusChunks
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.progress import progress_bar
+from rvsm.rtl.architecture import Architecture
+from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
+from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.sim.cosim.build_cache import SimBuild, build, new_run_dir
+from rvsm.sim.cosim.simulation import run_cocotb
+
+__all__ = ["DEFAULT_CHUNK_STEPS", "check_chunks", "window_cycles"]
+
+#: Steps the testbench produces and streams at a time.
+DEFAULT_CHUNK_STEPS = 8
+#: Cycles the waveform window runs past the first mismatching beat.
+WINDOW_AFTER = 64
+
+
+def window_cycles(geo: StreamGeometry) -> int:
+    """Cycles the waveform window reaches back before the first mismatch: two frames of
+    beats plus the lag (each accumulator of the row is updated twice in it)."""
+    return 2 * geo.beats_per_frame + geo.lag
+
+
+def _wave_name(sim: str) -> str:
+    return "window.vcd" if sim == "icarus" else "window.fst"
+
+
+def _source_inputs(source: StimulusChunks, run_dir: Path, chunk_steps: int) -> dict:
+    spec = source.spec
+    if not spec:
+        if source._stimulus is None:  # noqa: SLF001 - a scene made in code
+            raise RvsmError("a long run needs a scene it can load again (a built-in name or "
+                            "a path), not a scene made in code")
+        path = run_dir / "stimulus.npz"
+        save_stimulus(path, source._stimulus)  # noqa: SLF001
+        spec = {"kind": "stimulus", "path": str(path)}
+    return {"RVSM_SOURCE": json.dumps(spec), "RVSM_CHUNK_STEPS": str(int(chunk_steps))}
+
+
+def _run_with_progress(sb: SimBuild, inputs: dict, run_dir: Path, total: int, desc: str,
+                       progress: bool, plusargs: list[str], waves: bool) -> dict:
+    """One testbench run; a thread follows ``progress.txt`` into a progress bar."""
+    progress_file = run_dir / "progress.txt"
+    inputs = {**inputs, "RVSM_PROGRESS": str(progress_file)}
+    stop = threading.Event()
+    bar = progress_bar(total, desc, progress)
+
+    def follow() -> None:
+        done = 0
+        while not stop.wait(0.5):
+            try:
+                now = int(progress_file.read_text().split("/")[0])
+            except (OSError, ValueError):
+                continue
+            if now > done:
+                bar.update(now - done)
+                done = now
+
+    thread = threading.Thread(target=follow, daemon=True) if progress else None
+    if thread is not None:
+        thread.start()
+    try:
+        return run_cocotb(sb, inputs, run_dir, waves=False, plusargs=plusargs)
+    finally:
+        stop.set()
+        if thread is not None:
+            thread.join()
+        bar.close()
+
+
+def check_chunks(
+    source: StimulusChunks,
+    sim: str = "verilator",
+    work_dir: str | os.PathLike = Path("build") / "verify",
+    name: str = "run",
+    build_root: str | os.PathLike | None = None,
+    arch: str | Architecture = DEFAULT_ARCHITECTURE,
+    chunk_steps: int = DEFAULT_CHUNK_STEPS,
+    waves: bool = False,
+    progress: bool = False,
+    **options: int | None,
+) -> dict:
+    """Run ``source`` through the RTL in the long-run harness; compare every spike.
+
+    Returns the testbench result (:func:`~.simulation.run_testbench`'s keys, plus
+    ``harness``, ``chunks``, ``beats_streamed``, ``seconds`` per phase of the
+    testbench: ``twin``, ``encode``, ``simulate``, ``decode``, ``check``) with
+    ``build_seconds``, ``run_dir`` and ``waves``: on a mismatch, the window around it
+    (module docstring); with ``waves``, the whole run.
+    """
+    a = get_architecture(arch)
+    resolved = a.resolve(options)
+    a.check(source.contract, **resolved)
+    if chunk_steps < 1:
+        raise RvsmError(f"--chunk-steps must be >= 1, got {chunk_steps}")
+    work = Path(work_dir)
+    root = work / "builds" if build_root is None else Path(build_root)
+    sb = build(source.contract, sim, root, arch=a, harness=True, **resolved)
+    run_dir = new_run_dir(work, f"{name}-{sim}")
+    geo = StreamGeometry(source.contract, int(resolved["lanes"]))
+    try:
+        inputs = _source_inputs(source, run_dir, chunk_steps)
+        plusargs = []
+        if waves:
+            plusargs = [f"+rvsm_dump_file={run_dir / _wave_name(sim)}", "+rvsm_dump_from=0",
+                        f"+rvsm_dump_to={2**62}"]
+        result = _run_with_progress(sb, inputs, run_dir, source.num_steps,
+                                    f"{sim} {a.name} {name}", progress, plusargs, waves)
+        result["waves"] = str(run_dir / _wave_name(sim)) if waves else None
+        first = result.get("first_mismatch") or {}
+        if result["mismatches"] and not waves and "cycle" in first:
+            result.update(_window(sb, inputs, run_dir, int(first["cycle"]), geo))
+    except KeyboardInterrupt:  # an interrupted run leaves no half-written run folder
+        shutil.rmtree(run_dir, ignore_errors=True)
+        raise
+    result.update(build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
+                  build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),
+                  arch=a.name, options=resolved, lanes=resolved.get("lanes"),
+                  chunk_steps=int(chunk_steps))
+    return result
+
+
+def _window(sb: SimBuild, inputs: dict, run_dir: Path, cycle: int,
+            geo: StreamGeometry) -> dict:
+    """Re-run up to the window's end with the dump on for the window only."""
+    lo = max(0, cycle - window_cycles(geo))
+    hi = cycle + WINDOW_AFTER
+    again = run_dir / "failure"
+    wave = again / _wave_name(sb.sim)
+    plusargs = [f"+rvsm_dump_file={wave}", f"+rvsm_dump_from={lo}", f"+rvsm_dump_to={hi}"]
+    inputs = {**inputs, "RVSM_STOP_AFTER_CYCLE": str(hi)}
+    run_cocotb(sb, inputs, again, plusargs=plusargs)
+    return {"waves": str(wave) if wave.exists() else None,
+            "wave_window_cycles": [lo, hi]}
