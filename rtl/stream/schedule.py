@@ -345,9 +345,11 @@ class StreamChecker:
                         "never came"})
             self._take(missing)
 
-    def result(self) -> dict:
-        """:func:`check_beats`'s result so far (beats still expected count as missing)."""
-        self._flush_missing()
+    def result(self, finished: bool = True) -> dict:
+        """:func:`check_beats`'s result so far; when the run ``finished``, beats still
+        expected count as missing (a run stopped early leaves them unchecked)."""
+        if finished:
+            self._flush_missing()
         listed = sorted(self.listed, key=lambda e: e["beat"])
         return {"compared": self.compared, "mismatches": int(self.mismatches),
                 "beats": self.beats, "first_mismatch": listed[0] if listed else None,

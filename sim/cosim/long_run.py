@@ -13,8 +13,8 @@ start with the harness's dump switched on only for clock cycles ``C - before .. 
 after`` around the cycle ``C`` of the first mismatching output beat; ``before``
 defaults to two frames of beats plus the lag (:func:`window_cycles`), so the window holds
 the two earlier updates of every accumulator on the mismatching row, and the re-run
-stops at the end of the window. ``waves=True`` dumps the whole run instead. Icarus
-writes VCD, Verilator FST (the build's trace format).
+stops at the end of the window. ``waves=True`` dumps the whole run instead. Both
+simulators write FST.
 """
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ def window_cycles(geo: StreamGeometry) -> int:
 
 
 def _wave_name(sim: str) -> str:
-    return "window.vcd" if sim == "icarus" else "window.fst"
+    return "window.fst"
 
 
 def _source_inputs(source: StimulusChunks, run_dir: Path, chunk_steps: int) -> dict:
@@ -88,7 +88,7 @@ def _run_with_progress(sb: SimBuild, inputs: dict, run_dir: Path, total: int, de
     if thread is not None:
         thread.start()
     try:
-        return run_cocotb(sb, inputs, run_dir, waves=False, plusargs=plusargs)
+        return run_cocotb(sb, inputs, run_dir, plusargs=plusargs, hdl_dumps=waves)
     finally:
         stop.set()
         if thread is not None:
@@ -157,6 +157,6 @@ def _window(sb: SimBuild, inputs: dict, run_dir: Path, cycle: int,
     wave = again / _wave_name(sb.sim)
     plusargs = [f"+rvsm_dump_file={wave}", f"+rvsm_dump_from={lo}", f"+rvsm_dump_to={hi}"]
     inputs = {**inputs, "RVSM_STOP_AFTER_CYCLE": str(hi)}
-    run_cocotb(sb, inputs, again, plusargs=plusargs)
+    run_cocotb(sb, inputs, again, plusargs=plusargs, hdl_dumps=True)
     return {"waves": str(wave) if wave.exists() else None,
             "wave_window_cycles": [lo, hi]}

@@ -41,10 +41,13 @@ def run_testbench(
 def run_cocotb(
     sb: SimBuild, inputs: Mapping[str, str], test_dir: str | os.PathLike,
     waves: bool = False, test_module: str | None = None, plusargs: Sequence[str] = (),
+    hdl_dumps: bool = False,
 ) -> dict:
     """Run a testbench on ``sb`` with ``inputs`` (``RVSM_*`` variables, besides
     ``RVSM_RESULT`` and ``RVSM_PORTS`` which this sets) and ``plusargs``; the checked
-    result as :func:`run_testbench`."""
+    result as :func:`run_testbench`. ``hdl_dumps`` lets the design's own ``$dumpvars``
+    write (cocotb runs Icarus with its dumps suppressed unless it keeps waves itself);
+    ``waves`` keeps cocotb's whole-run waveform."""
     from cocotb_tools.check_results import get_results
 
     if waves and not sb.waves:
@@ -62,8 +65,8 @@ def run_cocotb(
              "RVSM_PORTS": str(sb.ports_json.resolve())}
     test_module = test_module or sb.test_module
     t0 = time.perf_counter()
-    cocotb_test(sb.sim, sb.build_dir, sb.hdl_top, test_module, test_dir, extra, waves,
-                plusargs, results_xml, log)
+    cocotb_test(sb.sim, sb.build_dir, sb.hdl_top, test_module, test_dir, extra,
+                waves or hdl_dumps, plusargs, results_xml, log)
     wall = time.perf_counter() - t0
     tb = test_module.rsplit(".", 1)[-1]
     try:

@@ -197,8 +197,9 @@ async def stream_long_run(dut: object) -> None:
     stream_seconds = time.perf_counter() - t0
     stray = int(h["stray"].value)
     overflow = int(h["overflow"].value)
-    result = checker.result()
-    if stopped_early or (checker.mismatches and steps_done < source.num_steps):
+    ended = not stopped_early and item is None
+    result = checker.result(finished=ended)
+    if not ended:
         result["stopped_at_step"] = steps_done
     if stray or overflow:
         result["mismatches"] += stray + overflow
@@ -216,7 +217,7 @@ async def stream_long_run(dut: object) -> None:
         "accumulators": scales * c.height * c.width,
         "expected_spikes": expected_spikes,
         "lanes": lanes,
-        "harness": "chunks",
+        "harness": "chunk",
         "chunks": chunks,
         "beats_streamed": beats_sent,
         "cycles": cycles_total,

@@ -130,3 +130,18 @@ def test_contract_run_clear_before_restarts_from_zero():
 def test_bit_lengths():
     v = np.array([0, 1, -1, 2, 3, -4, 255, 256, -(2**40)])
     assert list(bit_lengths(v)) == [0, 1, 1, 2, 2, 3, 8, 9, 41]
+
+
+def test_contract_stream_in_chunks_equals_one_run(small_contract) -> None:
+    """:class:`ContractStream` over chunks of any size (and a clear) gives the spikes of
+    :meth:`ArrayContract.run` on the whole run."""
+    c = small_contract("dog3", 5, 6, acc_bits=9)
+    rng = np.random.default_rng(4)
+    codes = rng.integers(0, 16, (40, 5, 6))
+    thr = rng.integers(1, 60, (c.num_scales, 5, 6))
+    whole = c.run(codes, thr, clear_before=(25,))
+    stream = c.stream(thr)
+    parts = [stream.run(codes[a:b]) for a, b in ((0, 1), (1, 13), (13, 25))]
+    stream.clear()
+    parts.append(stream.run(codes[25:]))
+    assert np.array_equal(np.concatenate(parts), whole)

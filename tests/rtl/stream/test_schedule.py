@@ -7,6 +7,7 @@ import pytest
 
 from rvsm.rtl.stream.schedule import (
     OutputBeats,
+    StreamChecker,
     StreamSchedule,
     check_beats,
     pack_lanes,
@@ -108,3 +109,56 @@ def test_checker_passes_and_catches(sched: StreamSchedule) -> None:
     short = OutputBeats(good.rows[:-1], good.groups[:-1], good.last[:-1], good.spikes[:-1])
     res = check_beats(sched, spikes, short)
     assert res["mismatches"] == 2 * 2 and "received 17 beats" in res["mismatch_list"][0]["error"]
+
+
+def test_stream_checker_matches_check_beats_in_any_chunking() -> None:
+    """:class:`StreamChecker` fed in random pieces (expectations and received beats
+    split independently) gives :func:`check_beats`'s verdict, missing and wrong beats
+    included; a restart (a clear) restarts the positions."""
+    rng = np.random.default_rng(11)
+    sched = StreamSchedule(3, 4, 2, lag=5)
+    spikes = rng.integers(-1, 2, (7, 2, 3, 4)).astype(np.int8)
+    beats = sched.expected_beats(spikes)
+    rows, groups = sched.positions(len(beats))
+    last = (rows == 2) & (groups == 1)
+    for corrupt in (False, True):
+        got_spikes = beats.copy()
+        got_rows = rows.copy()
+        n_got = len(beats)
+        if corrupt:
+            got_spikes[9, 1, 0] = -got_spikes[9, 1, 0] or 1
+            got_rows[20] = (got_rows[20] + 1) % 3
+            n_got -= 2  # two beats never come
+        got = OutputBeats(got_rows[:n_got], groups[:n_got], last[:n_got],
+                          got_spikes[:n_got])
+        whole = check_beats(sched, spikes, got)
+        checker = StreamChecker(sched)
+        cuts = np.sort(rng.choice(np.arange(1, 7), 2, replace=False))
+        for part in np.split(spikes, cuts):
+            checker.expect(part)
+        k = 0
+        for size in (3, 1, 10, 100):
+            piece = OutputBeats(got.rows[k:k + size], got.groups[k:k + size],
+                                got.last[k:k + size], got.spikes[k:k + size])
+            checker.receive(piece)
+            k += size
+        streamed = checker.result()
+        for key in ("compared", "mismatches", "beats"):
+            assert streamed[key] == whole[key], (corrupt, key)
+        assert (streamed["mismatches"] > 0) == corrupt
+        want = [{k: v for k, v in e.items() if k != "error"} for e in whole["mismatch_list"]]
+        have = [{k: v for k, v in e.items() if k != "error"}
+                for e in streamed["mismatch_list"]]
+        assert [e["beat"] for e in have] == sorted(e["beat"] for e in want)
+    # two segments (a clear before step 3): positions restart, steps are the run's
+    checker = StreamChecker(sched)
+    checker.expect(spikes[:3])
+    checker.receive(OutputBeats(rows[:18], groups[:18], last[:18], beats[:18]))
+    checker.restart(3)
+    checker.expect(spikes[3:5])
+    seg = beats[18:30].copy()
+    seg[7, 0, 1] = 1 - seg[7, 0, 1] if seg[7, 0, 1] != 1 else 0
+    checker.receive(OutputBeats(rows[:12], groups[:12], last[:12], seg))
+    r = checker.result()
+    assert r["mismatches"] == 1 and r["first_mismatch"]["step"] == 3 + 7 // 6
+    assert r["first_mismatch"]["beat"] == 18 + 7
