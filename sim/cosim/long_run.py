@@ -9,7 +9,9 @@ follows the steps done.
 
 **The waveform window.** A full trace of a long run is too large (gigabytes per
 thousand steps at sensor size), so a failing run is simulated a second time from the
-start with the harness's dump switched on only for clock cycles ``C - before .. C +
+start (on Verilator, with a second build that can trace: tracing is 11 of the 18 MB of
+C++ of the full sensor, so only failing runs pay for it) with the harness's dump
+switched on only for clock cycles ``C - before .. C +
 after`` around the cycle ``C`` of the first mismatching output beat; ``before``
 defaults to two frames of beats plus the lag (:func:`window_cycles`), so the window holds
 the two earlier updates of every accumulator on the mismatching row, and the re-run
@@ -123,7 +125,8 @@ def check_chunks(
         raise RvsmError(f"--chunk-steps must be >= 1, got {chunk_steps}")
     work = Path(work_dir)
     root = work / "builds" if build_root is None else Path(build_root)
-    sb = build(source.contract, sim, root, arch=a, harness=True, **resolved)
+    sb = build(source.contract, sim, root, arch=a, harness=True,
+               waves=waves and sim == "verilator", **resolved)
     run_dir = new_run_dir(work, f"{name}-{sim}")
     geo = StreamGeometry(source.contract, int(resolved["lanes"]))
     try:
@@ -137,7 +140,9 @@ def check_chunks(
         result["waves"] = str(run_dir / _wave_name(sim)) if waves else None
         first = result.get("first_mismatch") or {}
         if result["mismatches"] and not waves and "cycle" in first:
-            result.update(_window(sb, inputs, run_dir, int(first["cycle"]), geo))
+            traced = sb if sim == "icarus" else build(
+                source.contract, sim, root, arch=a, harness=True, waves=True, **resolved)
+            result.update(_window(traced, inputs, run_dir, int(first["cycle"]), geo))
     except KeyboardInterrupt:  # an interrupted run leaves no half-written run folder
         shutil.rmtree(run_dir, ignore_errors=True)
         raise

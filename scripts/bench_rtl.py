@@ -1,0 +1,139 @@
+#!/usr/bin/env python3
+"""Co-simulation throughput and memory (`make bench-rtl`, issue 17): every figure with
+the command that produced it, against its target.
+
+Each case runs the CLI in a fresh work folder (so the Verilog generation and the
+simulator build are included where a target says so) as a child of a small wrapper that
+reports the peak resident memory of the largest process it waited for (the simulator,
+which runs cocotb and the twin). Cases:
+
+* ``full-1k``: 250x400 dog4 default point, P=40, Verilator, 1,000 steps, long-run
+  harness: wall time including generation and build (target <= 5 min), sustained
+  cycles/s of the run (target >= 40,000);
+* ``medium``: 64x96 dog4, P=8, Verilator, 2,000 steps (target >= 150,000 cycles/s);
+* ``icarus``: 64x64 dog4, P=4, Icarus, 40 steps (target >= 5,000 cycles/s);
+* ``one-second`` (unless ``--quick``): 250x400, P=40, Verilator, 40,000 steps of a
+  4,001-frame scene: wall time including build (target <= 60 min), peak RSS (<= 4 GB);
+* ``simulate`` (unless ``--quick``): ``rvsm simulate`` of that scene to ``.h5``: peak
+  RSS (target <= 1.5 GB).
+
+The exit status is 0 when every case ran (targets missed are printed, not failed: a
+benchmark reports, it does not judge) and 3 when a case failed to run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RVSM = str(Path(sys.executable).with_name("rvsm"))
+_WRAP = ("import resource, subprocess, sys; r = subprocess.run(sys.argv[1:]); "
+         "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, file=sys.stderr); "
+         "sys.exit(r.returncode)")
+
+
+def run(argv: list[str], cwd: Path) -> tuple[float, int, str]:
+    """Run ``argv`` in ``cwd``; wall seconds, peak RSS (kB) of its largest process, stdout."""
+    t0 = time.perf_counter()
+    p = subprocess.run([sys.executable, "-c", _WRAP, *argv], cwd=cwd, capture_output=True,
+                       text=True)
+    wall = time.perf_counter() - t0
+    if p.returncode != 0:
+        tail = (p.stderr or p.stdout).strip().splitlines()[-3:]
+        raise SystemExit(f"bench-rtl: {shlex.join(argv)} failed ({p.returncode}): "
+                         + " | ".join(tail))
+    rss = int(p.stderr.strip().splitlines()[-1])
+    return wall, rss, p.stdout
+
+
+def verify_case(tmp: Path, name: str, size: str, lanes: int, sim: str, steps: int,
+                frames: int, steps_per_frame: int = 10) -> dict:
+    work = tmp / name
+    argv = [RVSM, "verify", "flyball", "--fixed", str(tmp / "point.toml"), "--size", size,
+            "--lanes", str(lanes), "--sim", sim, "--harness", "chunk", "--steps",
+            str(steps), "--frames", str(frames), "--steps-per-frame", str(steps_per_frame),
+            "--work", str(work), "--json"]
+    wall, rss, out = run(argv, tmp)
+    r = json.loads(out)
+    if r["mismatches"]:
+        raise SystemExit(f"bench-rtl: {name}: {r['mismatches']} mismatches")
+    shown = [a if a != str(tmp / "point.toml") else "point.toml" for a in argv]
+    shown = [a if not a.startswith(str(tmp)) else Path(a).name for a in shown]
+    return {"case": name, "command": "rvsm " + shlex.join(shown[1:]), "wall": wall,
+            "rss_mb": rss / 1024, "cycles_per_second": r["cycles_per_second"],
+            "build": r["build_seconds"], "generate": r["generate_seconds"],
+            "stream": r["stream_seconds"], "seconds": r["seconds"], "steps": r["steps"],
+            "compared": r["compared"]}
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true",
+                        help="leave out the one-second run and the simulate memory case")
+    parser.add_argument("--keep", action="store_true", help="keep the work folders")
+    args = parser.parse_args()
+    tmp = Path(tempfile.mkdtemp(prefix="rvsm-bench-rtl-"))
+    rows: list[tuple[str, str, str, str]] = []
+    try:
+        subprocess.run([RVSM, "config", "new", "-o", str(tmp / "point.toml")], check=True,
+                       capture_output=True)
+        cases = [("full-1k", "250x400", 40, "verilator", 1000, 101),
+                 ("medium", "64x96", 8, "verilator", 2000, 201),
+                 ("icarus", "64x64", 4, "icarus", 40, 5)]
+        if not args.quick:
+            cases.append(("one-second", "250x400", 40, "verilator", 40000, 4001))
+        for name, size, lanes, sim, steps, frames in cases:
+            r = verify_case(tmp, name, size, lanes, sim, steps, frames)
+            print(f"{name}: {r['command']}", flush=True)
+            phases = ", ".join(f"{k} {v:.1f} s" for k, v in r["seconds"].items())
+            print(f"  wall {r['wall']:.0f} s (generate {r['generate']:.0f} s, build "
+                  f"{r['build']:.0f} s, stream {r['stream']:.0f} s: {phases}); "
+                  f"{r['cycles_per_second']:,.0f} cycles/s; peak RSS {r['rss_mb']:,.0f} MB; "
+                  f"{r['compared']:,} spikes, 0 mismatches", flush=True)
+            cps = r["cycles_per_second"]
+            if name == "full-1k":
+                rows += [("250x400 P=40 Verilator sustained", f"{cps:,.0f} cycles/s",
+                          ">= 40,000", "met" if cps >= 40000 else "MISSED"),
+                         ("250x400, 1,000 steps incl. build", f"{r['wall'] / 60:.1f} min",
+                          "<= 5 min", "met" if r["wall"] <= 300 else "MISSED")]
+            elif name == "medium":
+                rows.append(("64x96 P=8 Verilator", f"{cps:,.0f} cycles/s", ">= 150,000",
+                             "met" if cps >= 150000 else "MISSED"))
+            elif name == "icarus":
+                rows.append(("64x64 P=4 Icarus", f"{cps:,.0f} cycles/s", ">= 5,000",
+                             "met" if cps >= 5000 else "MISSED"))
+            else:
+                rows += [("250x400, 40,000 steps incl. build", f"{r['wall'] / 60:.1f} min",
+                          "<= 60 min", "met" if r["wall"] <= 3600 else "MISSED"),
+                         ("  its peak RSS", f"{r['rss_mb'] / 1024:.2f} GB", "<= 4 GB",
+                          "met" if r["rss_mb"] <= 4096 else "MISSED")]
+        if not args.quick:
+            argv = [RVSM, "simulate", "flyball", "--size", "250x400", "--model", "dog4",
+                    "--noise", "--frames", "4001", "--steps-per-frame", "10", "-o",
+                    str(tmp / "s.h5")]
+            wall, rss, _ = run(argv, tmp)
+            print(f"simulate: rvsm {shlex.join(argv[1:-1])} s.h5\n  wall {wall:.0f} s; "
+                  f"peak RSS {rss / 1024:,.0f} MB", flush=True)
+            rows.append(("rvsm simulate 4,001 frames to .h5", f"{rss / 1024 ** 2:.2f} GB",
+                         "<= 1.5 GB", "met" if rss <= 1.5 * 1024 ** 2 else "MISSED"))
+    finally:
+        if not args.keep:
+            shutil.rmtree(tmp, ignore_errors=True)
+    print()
+    width = max(len(r[0]) for r in rows)
+    for what, got, target, verdict in rows:
+        print(f"{what:<{width}}  {got:>16}  target {target:<12} {verdict}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
