@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress formal formal-equivalence mutate fuzz bench bench-sweep lint clean
+.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep lint clean
 
 setup: $(STAMP)
 
@@ -27,8 +27,16 @@ test: setup
 
 regress: setup
 	$(BIN)/python -m pytest -n $(JOBS) -q -m "slow or not slow"
+	$(MAKE) long-run
 	$(MAKE) formal
 	$(MAKE) mutate
+
+# one second of camera time (40,000 steps) through the full-sensor RTL on Verilator, in
+# the long-run harness, every spike checked against the fixed twin (docs/long-runs.md)
+long-run: setup
+	$(BIN)/rvsm config new -o $(OUT)/long-run-point.toml --force > /dev/null
+	$(BIN)/rvsm verify flyball --fixed $(OUT)/long-run-point.toml --lanes 40 --sim verilator \
+	  --harness chunk --frames 4001 --steps 40000 --work build/long-run
 
 # Every formal check at the tiny configurations, both reset modes (docs/formal.md):
 # the parallel array (prove and cover); the streaming array's property checks at 3x4,
@@ -63,6 +71,11 @@ fuzz: setup
 
 bench: setup
 	$(BIN)/python scripts/benchmark.py
+
+# co-simulation throughput and memory against issue 17's targets (docs/long-runs.md);
+# about an hour with the one-second run, QUICK=1 leaves it out (about 8 minutes)
+bench-rtl: setup
+	$(BIN)/python scripts/bench_rtl.py $(if $(QUICK),--quick)
 
 # sweep speed-up 1 -> 2 workers on sweeps/example.toml (about 4 minutes per round)
 bench-sweep: setup
