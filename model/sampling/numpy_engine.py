@@ -28,17 +28,21 @@ def iter_step_drives(
     every accumulator at step ``t`` (receptive-field sum of brightness plus filtered dark
     current). The array is a reused buffer: consume it before the next iteration.
 
-    Frames are filtered once; a step between frames is ``(1 - a) KF[f] + a KF[f+1]``
-    (SPEC section 1's interpolation applied after the linear filter). Dark current is
-    drawn and filtered in blocks of ``block_steps``. This is the numpy reference engine.
+    Per block of ``block_steps`` steps, the frames the block touches are read
+    (:meth:`Scene.frame_range`) and filtered; a step between frames is
+    ``(1 - a) KF[f] + a KF[f+1]`` (SPEC section 1's interpolation applied after the
+    linear filter, frame by frame, so the block length changes no value). Dark current is
+    drawn and filtered per block too. This is the numpy reference engine.
     """
     kernels = config.spec.kernels()
-    filtered = orbit_receptive_sums(scene.frames, kernels)  # (F, S, H, W)
     noise = NoiseSource(config.noise, scene.shape, len(kernels)) if config.noise else None
-    buf = np.empty(filtered.shape[1:])
+    buf = np.empty((len(kernels),) + scene.shape)
     tmp = np.empty_like(buf)
     for t0, t1 in scene.blocks(block_steps):
         f, a = scene.frame_weights(t0, t1)
+        first, end = scene.frame_span(t0, t1)
+        filtered = orbit_receptive_sums(scene.frame_range(first, end), kernels)  # (F', S, H, W)
+        f = f - first
         dark = (
             orbit_receptive_sums(noise.dark_current(t1 - t0), kernels)
             if noise is not None else None
