@@ -177,8 +177,8 @@ class DecodedStream:
 
     Made by decoding every frame once (count, sizes, content); a range then reads forward
     from the reader's position, restarting it only for a range that begins before it.
-    The last frame read is kept, so consecutive ranges that share their boundary frame
-    decode it once.
+    The last two frames read are kept, so consecutive ranges that share their boundary
+    frame, or a per-step reader asking for the same pair again, decode nothing twice.
     """
 
     def __init__(self, path: Path, what: str) -> None:
@@ -255,7 +255,8 @@ class DecodedStream:
                 out[f - f0] = self._next()
                 f += 1
         if len(out):
-            self._last = (f1 - 1, out[-1:].copy())
+            keep = min(len(out), 2)
+            self._last = (f1 - keep, out[-keep:].copy())
         return out
 
     def close(self) -> None:
