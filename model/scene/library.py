@@ -371,6 +371,9 @@ def _check_size(size: tuple[int, int], num_frames: int) -> tuple[tuple[int, int]
 #: or a range at a time, so both give the same frames bit for bit.
 RENDER_BATCH = 16
 
+#: Batch-sized float64 arrays a renderer holds at once, at most (its temporaries).
+RENDER_WORKING_ARRAYS = 12
+
 #: Bytes of rendered batches kept for reuse (least recently used dropped first).
 RENDER_CACHE_BYTES = 96 << 20
 
@@ -485,8 +488,12 @@ def builtin_scene(
 ) -> Scene:
     """Built-in scene ``name`` as a :class:`Scene` (``size`` is ``(H, W)`` pixels) whose
     frames are rendered on demand, a range at a time (:class:`RenderedFrames`)."""
+    from rvsm.model.infra.memory import require_memory
+
     _check_name(name)
     size, num_frames = _check_size(size, num_frames)
+    require_memory(RENDER_WORKING_ARRAYS * 8 * min(RENDER_BATCH, num_frames) * size[0] * size[1],
+                   f"rendering scene {name!r} at {size[0]}x{size[1]}", "ask for a smaller --size")
     return Scene(name, RenderedFrames(name, size, num_frames), steps_per_frame, hold,
                  source=name)
 
