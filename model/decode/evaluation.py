@@ -37,7 +37,7 @@ def warmup_steps(scene_or_truth: Scene | np.ndarray, phi: float | Sequence[float
     """
     phi_max = float(np.max(np.atleast_1d(np.asarray(phi, dtype=np.float64))))
     if isinstance(scene_or_truth, Scene):
-        first = scene_or_truth.frames[0]
+        first = scene_or_truth.frame_range(0, 1)[0]
     else:
         first = np.asarray(scene_or_truth, dtype=np.float64)[0]
     b = max(float(np.percentile(first, WARMUP_PERCENTILE)), 1.0)

@@ -145,10 +145,10 @@ def _first_steps(scene: Scene, steps: int) -> Scene:
     """A scene whose steps are the first ``steps`` of ``scene`` (same brightness)."""
     m = scene.steps_per_frame
     if scene.hold:
-        frames = scene.frames[: -(-steps // m)]
+        frames = scene.frame_range(0, -(-steps // m))
         out = Scene(scene.name, frames, m, True, scene.source)
     else:
-        frames = scene.frames[: -(-steps // m) + 1]
+        frames = scene.frame_range(0, -(-steps // m) + 1)
         out = Scene(scene.name, frames, m, False, scene.source)
     if out.num_steps == steps:
         return out

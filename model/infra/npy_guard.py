@@ -9,6 +9,7 @@ import os
 import tokenize
 import zipfile
 import zlib
+from dataclasses import dataclass
 from pathlib import Path
 from typing import BinaryIO
 
@@ -26,9 +27,10 @@ MAX_DEFLATE_RATIO = 1100
 MAX_HEADER_BYTES = 1 << 16
 
 
-def _header(handle: BinaryIO, source: str,
-            available: int | None = None) -> tuple[tuple[int, ...], np.dtype, int]:
-    """``(shape, dtype, header bytes)`` of the ``.npy`` stream at ``handle`` (seekable),
+def _header(handle: BinaryIO, source: str, available: int | None = None
+            ) -> tuple[tuple[int, ...], np.dtype, int, bool]:
+    """``(shape, dtype, header bytes, fortran order)`` of the ``.npy`` stream at ``handle``
+    (seekable),
     ``available`` bytes long; a header length beyond the data (or over
     :data:`MAX_HEADER_BYTES`) is refused before numpy reads it."""
     try:
@@ -45,22 +47,29 @@ def _header(handle: BinaryIO, source: str,
     try:
         version = npformat.read_magic(handle)
         if version == (1, 0):
-            shape, _, dtype = npformat.read_array_header_1_0(handle)
+            shape, fortran, dtype = npformat.read_array_header_1_0(handle)
         else:
-            shape, _, dtype = npformat.read_array_header_2_0(handle)
+            shape, fortran, dtype = npformat.read_array_header_2_0(handle)
     except (ValueError, OSError, EOFError, SyntaxError, tokenize.TokenError, TypeError,
             KeyError, zipfile.BadZipFile, zlib.error) as exc:
         raise RvsmError(f"{source}: cannot load .npy data, bad array header ({exc})") from None
-    return tuple(int(v) for v in shape), np.dtype(dtype), handle.tell()
+    return tuple(int(v) for v in shape), np.dtype(dtype), handle.tell(), bool(fortran)
 
 
-def _check(shape: tuple[int, ...], dtype: np.dtype, data_bytes: int, source: str) -> int:
+def _check_size(shape: tuple[int, ...], dtype: np.dtype, data_bytes: int, source: str) -> int:
+    """Refuse pickles and a shape larger than the bytes that follow the header; returns
+    the array's bytes."""
     if dtype.hasobject:
         raise RvsmError(f"{source}: holds Python objects (pickles), which rvsm never loads")
     nbytes = math.prod(shape) * dtype.itemsize
     if nbytes > data_bytes:
         raise RvsmError(f"{source}: header claims shape {shape} ({nbytes} bytes) but only "
                         f"{data_bytes} bytes follow; the file is truncated or corrupt")
+    return nbytes
+
+
+def _check(shape: tuple[int, ...], dtype: np.dtype, data_bytes: int, source: str) -> int:
+    nbytes = _check_size(shape, dtype, data_bytes, source)
     require_memory(nbytes, f"{source} (shape {shape}, {dtype})",
                    "use a smaller file or a machine with more memory")
     return nbytes
@@ -70,9 +79,33 @@ def check_npy_file(path: str | os.PathLike) -> tuple[int, ...]:
     """Check an ``.npy`` file's header against its size and the memory; returns the shape."""
     p = Path(path)
     with open(p, "rb") as handle:
-        shape, dtype, offset = _header(handle, str(p), p.stat().st_size)
+        shape, dtype, offset, _ = _header(handle, str(p), p.stat().st_size)
     _check(shape, dtype, p.stat().st_size - offset, str(p))
     return shape
+
+
+@dataclass(frozen=True)
+class NpyLayout:
+    """Where an ``.npy`` file's array lies: ``shape``, ``dtype``, the data's byte
+    ``offset`` and ``fortran_order``."""
+
+    shape: tuple[int, ...]
+    dtype: np.dtype
+    offset: int
+    fortran_order: bool
+
+
+def npy_layout(path: str | os.PathLike) -> NpyLayout:
+    """Check an ``.npy`` file's header against its size (not against the memory: for a
+    file that is memory-mapped, not loaded) and return its :class:`NpyLayout`."""
+    p = Path(path)
+    try:
+        with open(p, "rb") as handle:
+            shape, dtype, offset, fortran = _header(handle, str(p), p.stat().st_size)
+    except OSError as exc:
+        raise RvsmError(f"{p}: cannot load .npy data ({exc.strerror or exc})") from None
+    _check_size(shape, dtype, p.stat().st_size - offset, str(p))
+    return NpyLayout(shape, dtype, offset, fortran)
 
 
 def check_npz_members(path: str | os.PathLike, ndims: dict[str, int | None]) -> None:
@@ -99,7 +132,7 @@ def check_npz_members(path: str | os.PathLike, ndims: dict[str, int | None]) -> 
                                 f"{info.compress_size} compressed; the archive is corrupt")
             try:
                 with zf.open(info) as handle:
-                    shape, dtype, offset = _header(handle, source, info.file_size)
+                    shape, dtype, offset, _ = _header(handle, source, info.file_size)
             except (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError,
                     NotImplementedError, RuntimeError) as exc:
                 raise RvsmError(f"{source}: unreadable member, the archive is damaged "

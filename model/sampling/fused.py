@@ -31,12 +31,12 @@ DEFAULT_TILE_ROWS = 16
 
 def chunk_frames(scene: Scene, t0: int, t1: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """What a fused kernel needs for steps ``t0 .. t1 - 1``: the scene's frames the chunk
-    touches ``(F, H, W)``, each step's first frame as an index into them ``(T,) int64``
-    and its interpolation weight ``(T,) float64`` (:meth:`Scene.frame_weights`)."""
+    touches ``(F, H, W)`` (read on demand, :meth:`Scene.frame_range`), each step's first
+    frame as an index into them ``(T,) int64`` and its interpolation weight
+    ``(T,) float64`` (:meth:`Scene.frame_weights`)."""
     f, a = scene.frame_weights(t0, t1)
-    first = int(f[0])
-    last = min(int(f[-1]) + 1, scene.num_frames - 1)
-    return (scene.frames[first:last + 1], (f - first).astype(np.int64),
+    first, end = scene.frame_span(t0, t1)
+    return (scene.frame_range(first, end), (f - first).astype(np.int64),
             np.ascontiguousarray(a, dtype=np.float64))
 
 

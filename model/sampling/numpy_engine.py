@@ -11,7 +11,7 @@ filtered per step. Filtering uses the fixed float order of
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 
@@ -28,17 +28,24 @@ def iter_step_drives(
     every accumulator at step ``t`` (receptive-field sum of brightness plus filtered dark
     current). The array is a reused buffer: consume it before the next iteration.
 
-    Frames are filtered once; a step between frames is ``(1 - a) KF[f] + a KF[f+1]``
-    (SPEC section 1's interpolation applied after the linear filter). Dark current is
-    drawn and filtered in blocks of ``block_steps``. This is the numpy reference engine.
+    Per block of ``block_steps`` steps, the frames the block touches are read
+    (:meth:`Scene.frame_range`) and filtered, each frame once (:func:`_filtered_window`); a
+    step between frames is ``(1 - a) KF[f] + a KF[f+1]`` (SPEC section 1's interpolation
+    applied after the linear filter, frame by frame, so the block length changes no
+    value). Dark current is drawn and filtered per block too. This is the numpy
+    reference engine.
     """
     kernels = config.spec.kernels()
-    filtered = orbit_receptive_sums(scene.frames, kernels)  # (F, S, H, W)
     noise = NoiseSource(config.noise, scene.shape, len(kernels)) if config.noise else None
-    buf = np.empty(filtered.shape[1:])
+    buf = np.empty((len(kernels),) + scene.shape)
     tmp = np.empty_like(buf)
+    window = (0, np.empty((0, len(kernels)) + scene.shape))
     for t0, t1 in scene.blocks(block_steps):
         f, a = scene.frame_weights(t0, t1)
+        first, end = scene.frame_span(t0, t1)
+        window = _filtered_window(scene, kernels, first, end, window)
+        filtered = window[1][first - window[0]:]  # (F', S, H, W) from frame `first`
+        f = f - first
         dark = (
             orbit_receptive_sums(noise.dark_current(t1 - t0), kernels)
             if noise is not None else None
@@ -55,6 +62,21 @@ def iter_step_drives(
                 np.add(drive, dark[b], out=buf)
                 drive = buf
             yield t0 + b, drive
+
+
+def _filtered_window(
+    scene: Scene, kernels: Sequence[np.ndarray], first: int, end: int,
+    window: tuple[int, np.ndarray],
+) -> tuple[int, np.ndarray]:
+    """Receptive sums of frames ``first .. end - 1`` as ``(start, (n, S, H, W) float64)``
+    with ``start <= first``, reusing ``window`` (the previous one): frames it holds from
+    ``first`` on are kept, only the frames after it are read and filtered."""
+    start, held = window
+    if start <= first and end <= start + len(held):
+        return window
+    keep = held[first - start:] if start <= first < start + len(held) else held[:0]
+    new = orbit_receptive_sums(scene.frame_range(first + len(keep), end), kernels)
+    return first, (np.concatenate([keep, new]) if len(keep) else new)
 
 
 class Integrator:

@@ -35,12 +35,11 @@ def reference_sample(scene: Scene, config: SamplerConfig) -> np.ndarray:
     m = scene.steps_per_frame
     for t in range(scene.num_steps):
         if scene.hold:
-            image = scene.frames[t // m].copy()
+            image = scene.frame_range(t // m, t // m + 1)[0].copy()
         else:
             f, a = t // m, (t % m) / m
-            image = scene.frames[f].copy() if a == 0 else (
-                (1 - a) * scene.frames[f] + a * scene.frames[f + 1]
-            )
+            pair = scene.frame_range(f, f + 1 if a == 0 else f + 2)
+            image = pair[0].copy() if a == 0 else (1 - a) * pair[0] + a * pair[1]
         if noise is not None:
             image = image + noise.dark_current(1)[0]
         for s, kernel in enumerate(kernels):

@@ -17,14 +17,17 @@ Conventions
   view, scaled (uniform scale ``s = max(250 / H, 400 / W)``); textures are low-pass filtered
   before minification to avoid aliasing. Motions are bounded or periodic, so any number of
   frames works; the per-frame motion does not depend on ``num_frames``.
-- Results are cached (``functools.lru_cache`` keyed by name, size, frames) and returned as
-  read-only arrays.
+- Scenes are rendered on demand, a batch of frames at a time (:class:`RenderedFrames`);
+  batches are cached up to a byte budget and returned as read-only arrays.
 """
 
 from __future__ import annotations
 
 import functools
+import threading
+from collections import OrderedDict
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
@@ -364,25 +367,101 @@ def _check_size(size: tuple[int, int], num_frames: int) -> tuple[tuple[int, int]
 
 #: Frames rendered per batch: every renderer works frame by frame, so batches bound the
 #: rendering's temporary memory (about a dozen batch-sized arrays) without changing a value.
+#: Batches always start at multiples of ``RENDER_BATCH``, whether a scene is rendered whole
+#: or a range at a time, so both give the same frames bit for bit.
 RENDER_BATCH = 16
 
+#: Batch-sized float64 arrays a renderer holds at once, at most (its temporaries).
+RENDER_WORKING_ARRAYS = 12
 
-@functools.lru_cache(maxsize=32)
-def _render_cached(name: str, size: tuple[int, int], num_frames: int) -> np.ndarray:
-    out = np.empty((num_frames, *size), dtype=np.float64)
-    for f0 in range(0, num_frames, RENDER_BATCH):
-        n = min(RENDER_BATCH, num_frames - f0)
+#: Bytes of rendered batches kept for reuse (least recently used dropped first).
+RENDER_CACHE_BYTES = 96 << 20
+
+
+class _BatchCache:
+    """Rendered batches ``(n, H, W) float64`` (read-only) keyed by ``(name, size, first
+    frame, n)``, at most ``limit`` bytes, least recently used dropped first; thread-safe."""
+
+    def __init__(self, limit: int) -> None:
+        self.limit = limit
+        self._items: OrderedDict[tuple, np.ndarray] = OrderedDict()
+        self._bytes = 0
+        self._lock = threading.Lock()
+
+    def get(self, key: tuple, make: Callable[[], np.ndarray]) -> np.ndarray:
+        with self._lock:
+            hit = self._items.get(key)
+            if hit is not None:
+                self._items.move_to_end(key)
+                return hit
+        value = make()
+        with self._lock:
+            if key not in self._items:
+                self._items[key] = value
+                self._bytes += value.nbytes
+            while self._bytes > self.limit and len(self._items) > 1:
+                _, old = self._items.popitem(last=False)
+                self._bytes -= old.nbytes
+        return value
+
+    def clear(self) -> None:
+        with self._lock:
+            self._items.clear()
+            self._bytes = 0
+
+
+_BATCHES = _BatchCache(RENDER_CACHE_BYTES)
+
+
+def _render_batch(name: str, size: tuple[int, int], f0: int, n: int) -> np.ndarray:
+    """Frames ``f0 .. f0 + n - 1`` of scene ``name``: ``(n, H, W) float64``, read-only."""
+    def make() -> np.ndarray:
         g = _Grid(size, n, first=f0)
-        out[f0:f0 + n] = _to_brightness(np.broadcast_to(_RENDERERS[name](g), (n, *size)))
-    out.setflags(write=False)
-    return out
+        out = np.ascontiguousarray(
+            _to_brightness(np.broadcast_to(_RENDERERS[name](g), (n, *size))),
+            dtype=np.float64)
+        out.setflags(write=False)
+        return out
+
+    return _BATCHES.get((name, size, f0, n), make)
+
+
+@dataclass(frozen=True)
+class RenderedFrames:
+    """Built-in scene ``name`` at ``size = (H, W)`` with ``num_frames`` frames, rendered a
+    range at a time (whole batches of :data:`RENDER_BATCH` frames, cached up to
+    :data:`RENDER_CACHE_BYTES`): a :class:`~.frames.FrameSource`. Compares by its fields.
+    """
+
+    name: str
+    size: tuple[int, int]
+    num_frames: int
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        """``(F, H, W)``."""
+        return (self.num_frames, *self.size)
+
+    def frame_range(self, f0: int, f1: int) -> np.ndarray:
+        """Frames ``f0 .. f1 - 1``: ``(f1 - f0, H, W) float64`` brightness in [16, 240],
+        read-only when it is one batch's view."""
+        if f1 <= f0:
+            return np.empty((0, *self.size))
+        b0 = f0 // RENDER_BATCH * RENDER_BATCH
+        parts = [
+            _render_batch(self.name, self.size, b, min(RENDER_BATCH, self.num_frames - b))
+            for b in range(b0, f1, RENDER_BATCH)
+        ]
+        stack = parts[0] if len(parts) == 1 else np.concatenate(parts)
+        return stack[f0 - b0:f1 - b0]
 
 
 def render_frames(
     name: str, size: tuple[int, int] = DEFAULT_SIZE, num_frames: int = DEFAULT_FRAMES
 ) -> np.ndarray:
     """Render built-in scene ``name``: ``(num_frames, H, W) float64`` brightness in 8-bit
-    units within [16, 240]. Deterministic and cached; the returned array is read-only."""
+    units within [16, 240]. Deterministic and cached; the returned array is read-only. The
+    whole stack at once: runs use :func:`builtin_scene`, which renders a range at a time."""
     from rvsm.model.infra.memory import require_memory
 
     _check_name(name)
@@ -393,6 +472,13 @@ def render_frames(
     return _render_cached(name, size, num_frames)
 
 
+@functools.lru_cache(maxsize=32)
+def _render_cached(name: str, size: tuple[int, int], num_frames: int) -> np.ndarray:
+    out = np.array(RenderedFrames(name, size, num_frames).frame_range(0, num_frames))
+    out.setflags(write=False)
+    return out
+
+
 def builtin_scene(
     name: str,
     size: tuple[int, int] = DEFAULT_SIZE,
@@ -400,8 +486,15 @@ def builtin_scene(
     steps_per_frame: int = DEFAULT_STEPS_PER_FRAME,
     hold: bool = False,
 ) -> Scene:
-    """Built-in scene ``name`` as a :class:`Scene` (``size`` is ``(H, W)`` pixels)."""
-    return Scene(name, render_frames(name, size, num_frames), steps_per_frame, hold,
+    """Built-in scene ``name`` as a :class:`Scene` (``size`` is ``(H, W)`` pixels) whose
+    frames are rendered on demand, a range at a time (:class:`RenderedFrames`)."""
+    from rvsm.model.infra.memory import require_memory
+
+    _check_name(name)
+    size, num_frames = _check_size(size, num_frames)
+    require_memory(RENDER_WORKING_ARRAYS * 8 * min(RENDER_BATCH, num_frames) * size[0] * size[1],
+                   f"rendering scene {name!r} at {size[0]}x{size[1]}", "ask for a smaller --size")
+    return Scene(name, RenderedFrames(name, size, num_frames), steps_per_frame, hold,
                  source=name)
 
 

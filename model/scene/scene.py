@@ -6,7 +6,8 @@ Brightness is in 8-bit units (0..255, float). With ``steps_per_frame = m``:
   and ``I_t = (1 - a) frames[f] + a frames[f+1]``;
 - hold: ``T = F m`` steps and ``I_t = frames[t // m]``.
 
-Ground truth for step ``t`` is ``I_t``.
+Ground truth for step ``t`` is ``I_t``. A scene's frames come from a
+:class:`~rvsm.model.scene.frames.FrameSource`, read a range at a time.
 """
 
 from __future__ import annotations
@@ -17,77 +18,87 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.scene.frames import ArrayFrames, FrameSource, validate_frames
+
+__all__ = ["DEFAULT_STEPS_PER_FRAME", "Scene", "interpolate", "validate_frames"]
 
 DEFAULT_STEPS_PER_FRAME = 10
 
 
-def validate_frames(frames: np.ndarray, source: str = "scene") -> np.ndarray:
-    """Check a frame stack and return it as ``(F, H, W) float64`` brightness.
-
-    Refuses (with :class:`RvsmError`) a wrong number of dimensions, an empty array, NaN or
-    infinite values and negative brightness. ``uint8`` input is taken as 8-bit brightness.
-    """
-    arr = np.asarray(frames)
-    if arr.dtype == object or not (
-        np.issubdtype(arr.dtype, np.number) or arr.dtype == bool
-    ) or np.issubdtype(arr.dtype, np.complexfloating):
-        raise RvsmError(f"{source}: frames must be real numeric values, got dtype {arr.dtype}")
-    if arr.ndim == 2:
-        arr = arr[None]
-    if arr.ndim != 3:
-        raise RvsmError(
-            f"{source}: frames must have shape (F, H, W), got shape {arr.shape}; "
-            "convert colour video to grey first"
-        )
-    if min(arr.shape) == 0:
-        raise RvsmError(f"{source}: frames are empty (shape {arr.shape})")
-    out = arr.astype(np.float64)
-    if not np.all(np.isfinite(out)):
-        raise RvsmError(f"{source}: frames contain NaN or infinite values")
-    if out.min() < 0:
-        raise RvsmError(
-            f"{source}: brightness must be >= 0 (8-bit units), found {out.min():g}"
-        )
-    return out
-
-
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Scene:
-    """Frames ``(F, H, W) float64`` in 8-bit brightness units and how they become steps.
+    """Frames ``(F, H, W)`` in 8-bit brightness units and how they become steps.
 
+    ``frames`` given to the constructor is either a stack (validated and kept in memory
+    as ``float64``, read-only) or a :class:`~.frames.FrameSource` read on demand (a file,
+    a rendered built-in scene). Runs read only the frames a chunk of steps touches
+    (:meth:`frame_range`, :meth:`brightness`); :attr:`frames` is the whole stack.
     ``source`` is what loads the scene again (a built-in name or a path, as given to
     :func:`rvsm.model.scene.loaders.load_scene`); ``None`` for a scene made in code.
+    Compares field by field, the frames as their source does (an in-memory stack as a
+    numpy array).
     """
 
     name: str
-    frames: np.ndarray = field(repr=False)
+    frame_source: FrameSource = field(repr=False)
     steps_per_frame: int = DEFAULT_STEPS_PER_FRAME
     hold: bool = False
     source: str | None = None
 
-    def __post_init__(self) -> None:
-        frames = validate_frames(self.frames, self.name)
-        frames.setflags(write=False)
-        object.__setattr__(self, "frames", frames)
-        m = self.steps_per_frame
+    def __init__(self, name: str, frames: np.ndarray | FrameSource,
+                 steps_per_frame: int = DEFAULT_STEPS_PER_FRAME, hold: bool = False,
+                 source: str | None = None) -> None:
+        if not isinstance(frames, FrameSource) or isinstance(frames, np.ndarray):
+            stack = validate_frames(frames, name)
+            stack.setflags(write=False)
+            frames = ArrayFrames(stack)
+        m = steps_per_frame
         if isinstance(m, bool) or not isinstance(m, (int, np.integer)) or m < 1:
             raise RvsmError(f"steps_per_frame must be an integer >= 1, got {m!r}")
-        object.__setattr__(self, "steps_per_frame", int(m))
-        if not self.hold and frames.shape[0] < 2:
+        if not hold and frames.shape[0] < 2:
             raise RvsmError(
-                f"{self.name}: linear interpolation needs at least 2 frames, got 1; "
+                f"{name}: linear interpolation needs at least 2 frames, got 1; "
                 "use --hold for a still image"
             )
+        for key, value in (("name", name), ("frame_source", frames),
+                           ("steps_per_frame", int(m)), ("hold", hold), ("source", source)):
+            object.__setattr__(self, key, value)
+
+    @property
+    def frames(self) -> np.ndarray:
+        """Every frame ``(F, H, W) float64``, read-only: an in-memory scene's own stack; a
+        lazy scene's frames all read at once (refused when they would not fit in memory).
+        Runs use :meth:`frame_range` and :meth:`brightness` instead."""
+        src = self.frame_source
+        if isinstance(src, ArrayFrames):
+            return src.array
+        from rvsm.model.infra.memory import require_memory
+
+        f, h, w = src.shape
+        require_memory(8 * f * h * w, f"all {f} frames of scene {self.name!r} ({h}x{w})",
+                       "read them a range at a time (Scene.frame_range)")
+        out = np.array(src.frame_range(0, f), dtype=np.float64)
+        out.setflags(write=False)
+        return out
+
+    def frame_range(self, f0: int, f1: int) -> np.ndarray:
+        """Frames ``f0 .. f1 - 1``: ``(f1 - f0, H, W) float64``, possibly a read-only view
+        (never write into it)."""
+        if not 0 <= f0 <= f1 <= self.num_frames:
+            raise RvsmError(f"frame range {f0}..{f1} outside 0..{self.num_frames}")
+        if f0 == f1:
+            return np.empty((0, *self.shape))
+        return self.frame_source.frame_range(int(f0), int(f1))
 
     @property
     def shape(self) -> tuple[int, int]:
         """``(H, W)`` in pixels."""
-        return self.frames.shape[1], self.frames.shape[2]
+        return self.frame_source.shape[1], self.frame_source.shape[2]
 
     @property
     def num_frames(self) -> int:
         """F, the number of video frames."""
-        return self.frames.shape[0]
+        return self.frame_source.shape[0]
 
     @property
     def num_steps(self) -> int:
@@ -106,13 +117,24 @@ class Scene:
         a = np.zeros(t.shape) if self.hold else (t % m) / m
         return f, a
 
+    def frame_span(self, t0: int, t1: int) -> tuple[int, int]:
+        """The frames steps ``t0..t1-1`` (``t0 < t1``) read: ``(first, last + 1)``, the
+        frame after the last step's included (clamped to ``F``)."""
+        m = self.steps_per_frame
+        first, last = t0 // m, (t1 - 1) // m
+        return first, min(last + 2, self.num_frames)
+
     def brightness(self, t0: int = 0, t1: int | None = None) -> np.ndarray:
-        """Per-step brightness for steps ``t0..t1-1``: ``(B, H, W) float64``."""
+        """Per-step brightness for steps ``t0..t1-1``: ``(B, H, W) float64``; reads only
+        the frames those steps touch."""
         t1 = self.num_steps if t1 is None else t1
         if not 0 <= t0 <= t1 <= self.num_steps:
             raise RvsmError(f"step range {t0}..{t1} outside 0..{self.num_steps}")
+        if t0 == t1:
+            return np.empty((0, *self.shape))
         f, a = self.frame_weights(t0, t1)
-        return interpolate(self.frames, f, a)
+        first, end = self.frame_span(t0, t1)
+        return interpolate(self.frame_range(first, end), f - first, a)
 
     def blocks(self, block_steps: int) -> Iterator[tuple[int, int]]:
         """Yield ``(t0, t1)`` step ranges of at most ``block_steps`` covering ``0..T``."""

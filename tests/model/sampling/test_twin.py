@@ -137,3 +137,31 @@ def test_meta_says_how_to_reload_the_scene():
     again = load_scene(meta["scene_arg"], size=(meta["height"], meta["width"]),
                        num_frames=meta["num_frames"], steps_per_frame=meta["steps_per_frame"])
     assert np.array_equal(again.frames, scene.frames)
+
+
+def test_lazy_scene_chunked_equals_eager_scene_whole():
+    """A built-in scene rendered a range at a time, run in chunks of any length on any
+    engine and thread count, gives the spikes of its whole in-memory frames run at once."""
+    import numba
+
+    from rvsm.model.sampling.twin import stream_float
+    from rvsm.model.scene.library import builtin_scene, render_frames
+    from rvsm.model.spikes.sinks import ArraySink
+
+    size, count, m = (21, 26), 9, 5
+    lazy = builtin_scene("flyball", size, count, steps_per_frame=m)
+    eager = Scene("flyball", render_frames("flyball", size, count), m)
+    config = SamplerConfig(model="dog4", phi=150.0, noise=NoiseParams(k=2.0, seed=8))
+    whole = sample(eager, config).spikes
+    assert whole.shape[0] == (count - 1) * m and np.count_nonzero(whole) > 0
+    before = numba.get_num_threads()
+    try:
+        for threads in (1, numba.config.NUMBA_NUM_THREADS):
+            numba.set_num_threads(threads)
+            for engine, chunk in (("fused", 1), ("fused", 7), ("fused", 13), ("numpy", 6)):
+                sink = ArraySink()
+                stream_float(lazy, config, sink, chunk_steps=chunk, engine=engine,
+                             block_steps=4)
+                np.testing.assert_array_equal(sink.spikes, whole, err_msg=f"{engine} {chunk}")
+    finally:
+        numba.set_num_threads(before)

@@ -45,6 +45,7 @@ def test_small_render_deterministic(name: str) -> None:
     assert f.std() > 8.0
     assert np.abs(np.diff(f, axis=0)).sum() > 0
     lib._render_cached.cache_clear()
+    lib._BATCHES.clear()
     g = lib.render_frames(name, SMALL, 12)
     assert g is not f
     np.testing.assert_array_equal(f, g)
@@ -72,3 +73,33 @@ def test_black_scene() -> None:
     assert not sc.brightness(0, 3).any()
     with pytest.raises(RvsmError, match="steps"):
         lib.black_scene((10, 10), 0)
+
+
+@pytest.mark.parametrize("name", lib.SCENE_NAMES)
+def test_rendering_in_ranges_equals_the_whole_render(name: str) -> None:
+    """Oracle: every frame is the same bit for bit rendered whole, a range at a time, or in
+    renderer batches of any length and start (no renderer couples frames)."""
+    size, count = (30, 44), 37
+    lib._BATCHES.clear()
+    whole = lib._to_brightness(
+        np.broadcast_to(lib._RENDERERS[name](lib._Grid(size, count)), (count, *size)))
+    np.testing.assert_array_equal(lib.render_frames(name, size, count), whole)
+    for batch in (1, 5):
+        parts = [lib._to_brightness(np.broadcast_to(
+            lib._RENDERERS[name](lib._Grid(size, min(batch, count - f0), first=f0)),
+            (min(batch, count - f0), *size))) for f0 in range(0, count, batch)]
+        np.testing.assert_array_equal(np.concatenate(parts), whole)
+    lazy = lib.RenderedFrames(name, size, count)
+    rng = np.random.default_rng(3)
+    for _ in range(12):
+        f0, f1 = sorted(int(v) for v in rng.integers(0, count + 1, 2))
+        np.testing.assert_array_equal(lazy.frame_range(f0, f1), whole[f0:f1])
+
+
+def test_render_cache_is_bounded(monkeypatch) -> None:
+    cache = lib._BatchCache(limit=3 * lib.RENDER_BATCH * 8 * 10 * 12)
+    monkeypatch.setattr(lib, "_BATCHES", cache)
+    frames = lib.RenderedFrames("flyball", (10, 12), 10 * lib.RENDER_BATCH)
+    for f0 in range(0, frames.num_frames, 7):
+        frames.frame_range(f0, min(f0 + 7, frames.num_frames))
+    assert cache._bytes <= cache.limit and len(cache._items) == 3

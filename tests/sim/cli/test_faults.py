@@ -388,13 +388,20 @@ def test_more_rendered_frames_than_memory_are_refused(capsys, tmp_path):
 
 
 def test_npy_scene_header_is_checked_before_loading(tmp_path, capsys, monkeypatch):
+    """An ``.npy`` scene is memory-mapped, never loaded whole: one larger than the memory
+    streams into ``.h5``; a header claiming more than the file holds is refused."""
     from rvsm.model.infra import memory
 
     scene = tmp_path / "scene.npy"
     np.save(scene, np.full((4, 16, 24), 100.0))
     monkeypatch.setattr(memory, "available_bytes", lambda: 4096)
+    code, _, err = _run(capsys, "simulate", scene, "-o", tmp_path / "s.h5")
+    assert code == 0, err
     code, _, err = _run(capsys, "simulate", scene, "-o", tmp_path / "s.npz")
-    assert code == 2 and "shape (4, 16, 24)" in _one_line(err) and "of memory" in err
+    assert code == 2 and "spikes needs" in _one_line(err) and "of memory" in err
+    scene.write_bytes(scene.read_bytes()[:-100])
+    code, _, err = _run(capsys, "simulate", scene, "-o", tmp_path / "t.h5")
+    assert code == 2 and "shape (4, 16, 24)" in _one_line(err) and "truncated" in err
 
 
 def test_non_finite_analogue_values_are_never_cast(capsys):
