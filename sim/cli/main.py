@@ -20,6 +20,7 @@ from rvsm.sim.cli import (
     formal,
     fpga,
     mutate,
+    regress,
     rtl,
     sampling,
     scenes,
@@ -29,8 +30,8 @@ from rvsm.sim.cli import (
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
 #: co-simulation, formal checks, FPGA timing and area, paper studies, the demo, design sweeps.
-FAMILIES: tuple[ModuleType, ...] = (sampling, scenes, fixed, rtl, formal, mutate, fpga, studies,
-                                    demo, sweep)
+FAMILIES: tuple[ModuleType, ...] = (sampling, scenes, fixed, rtl, regress, formal, mutate,
+                                    fpga, studies, demo, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -191,7 +191,7 @@ def parse_sweep(
     for key in data:
         if key not in SECTIONS:
             raise RvsmError(f"{source}: unknown section [{key}]; valid: {', '.join(SECTIONS)}")
-    base = _parse_base(data.get("base"), source, Path(base_dir or "."))
+    base = parse_base_point(data.get("base"), source, Path(base_dir or "."))
     axes = _parse_axes(data.get("axes", {}), source)
     run = _parse_run(data.get("run"), source)
     hardware = _parse_hardware(data.get("hardware", {}), source)
@@ -199,7 +199,9 @@ def parse_sweep(
     return dataclasses.replace(spec, designs=tuple(_expand(spec)))
 
 
-def _parse_base(raw: Any, source: str, base_dir: Path) -> DesignPoint:
+def parse_base_point(raw: Any, source: str, base_dir: Path) -> DesignPoint:
+    """A ``[base]`` table (or file name): the default point, a design point file, and
+    per-section overrides; errors name ``source`` and the field."""
     if raw is None:
         return default_design_point()
     if isinstance(raw, str):

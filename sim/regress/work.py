@@ -1,0 +1,65 @@
+"""One regression run as a work item an executor runs (:mod:`rvsm.sim.sweep.executors`).
+
+:class:`RegressionWork` runs its :class:`~.plan.RunSpec` with ``rvsm verify``'s
+functions (a scene through the fixed twin, or a seeded random and corner stimulus), in
+a work folder whose build cache every worker shares, and returns a record: ``status``
+``"pass"``, ``"fail"`` (the RTL disagrees with the twin) or ``"error"`` (a tool or the
+environment failed: the run is retried by the next ``rvsm regress``), with the figures.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+from rvsm.model.infra.atomic import write_text_atomic
+from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.model.infra.tools import ToolFailure
+from rvsm.sim.regress.plan import RunSpec
+
+__all__ = ["RegressionWork"]
+
+
+@dataclass(frozen=True)
+class RegressionWork:
+    """Run ``spec`` with ``work_dir`` as the shared work folder (builds and run folders)."""
+
+    spec: RunSpec
+    work_dir: str
+    priority: ClassVar[int] = 0
+
+    @property
+    def key(self) -> str:
+        """Unique Dask key."""
+        return f"rg-{self.spec.key}"
+
+    def run(self) -> dict[str, Any]:
+        """The run's record (never raises for a tool failure: ``status`` is ``"error"``)."""
+        from rvsm.sim.cosim.verify import random_verify, verify
+
+        s = self.spec
+        work = Path(self.work_dir)
+        point = work / "points" / f"{s.key}.toml"
+        point.parent.mkdir(parents=True, exist_ok=True)
+        write_text_atomic(point, s.point_toml)
+        options = {"lanes": s.lanes} if s.lanes else {}
+        kind, _, what = s.stimulus.partition(":")
+        t0 = time.perf_counter()
+        try:
+            if kind == "scene":
+                r = verify(what, point, s.sim, steps=s.steps, size=s.size, work_dir=work,
+                           arch=s.arch, harness=s.harness, **options)
+            else:
+                r = random_verify(point, int(what), s.steps, s.sim, size=s.size,
+                                  work_dir=work, arch=s.arch, harness=s.harness, **options)
+        except (ToolError, ToolFailure, RvsmError, OSError) as exc:
+            return {"status": "error", "error": str(exc).splitlines()[0][:500],
+                    "seconds": time.perf_counter() - t0}
+        return {"status": "fail" if r["mismatches"] else "pass",
+                "mismatches": int(r["mismatches"]), "compared": int(r["compared"]),
+                "first_mismatch": r.get("first_mismatch"), "coverage": r.get("coverage"),
+                "cycles_per_second": r.get("cycles_per_second"),
+                "seconds": time.perf_counter() - t0, "run_dir": r.get("run_dir"),
+                "waves": r.get("waves"), "error": None}
