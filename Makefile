@@ -27,6 +27,8 @@ test: setup
 
 regress: setup
 	$(BIN)/python -m pytest -n $(JOBS) -q -m "slow or not slow"
+	$(BIN)/rvsm regress regressions/nightly.toml -o build/nightly.sqlite \
+	  --junit build/nightly.xml --workers $(JOBS) --work build/regress
 	$(MAKE) long-run
 	$(MAKE) formal
 	$(MAKE) mutate

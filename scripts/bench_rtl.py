@@ -15,7 +15,10 @@ which runs cocotb and the twin). Cases:
 * ``one-second`` (unless ``--quick``): 250x400, P=40, Verilator, 40,000 steps of a
   4,001-frame scene: wall time including build (target <= 60 min), peak RSS (<= 4 GB);
 * ``simulate`` (unless ``--quick``): ``rvsm simulate`` of that scene to ``.h5``: peak
-  RSS (target <= 1.5 GB).
+  RSS (target <= 1.5 GB);
+* ``regress``: ``rvsm regress`` of 64 random seeds (16x16 dog4, P=4, Verilator, 200
+  steps) on 1 and then 2 local Dask workers, builds cached first: the speed-up (target
+  >= 1.7x).
 
 The exit status is 0 when every case ran (targets missed are printed, not failed: a
 benchmark reports, it does not judge) and 3 when a case failed to run.
@@ -74,6 +77,41 @@ def verify_case(tmp: Path, name: str, size: str, lanes: int, sim: str, steps: in
             "compared": r["compared"]}
 
 
+REGRESS_PLAN = """
+[regression]
+name = "bench"
+[run]
+models = ["dog4"]
+size = "16x16"
+lanes = [4]
+simulators = ["verilator"]
+harness = "chunk"
+steps = 200
+seeds = { start = 0, stop = 64 }
+"""
+
+
+def regress_case(tmp: Path) -> tuple[str, str, str, str]:
+    """64 seeds on 1 then 2 workers (the build made once before, by a one-seed plan)."""
+    plan = tmp / "bench.toml"
+    plan.write_text(REGRESS_PLAN)
+    warm = tmp / "warm.toml"
+    warm.write_text(REGRESS_PLAN.replace("stop = 64", "stop = 1"))
+    work = tmp / "regress-work"
+    run([RVSM, "regress", str(warm), "-o", str(tmp / "warm.sqlite"), "--workers", "0",
+         "--no-progress", "--work", str(work)], tmp)
+    walls = {}
+    for workers in (1, 2):
+        walls[workers], _, _ = run([RVSM, "regress", str(plan), "-o",
+                                    str(tmp / f"r{workers}.sqlite"), "--workers",
+                                    str(workers), "--no-progress", "--work", str(work)], tmp)
+        print(f"regress: rvsm regress bench.toml --workers {workers}  (64 seeds, 16x16 dog4 "
+              f"P=4, Verilator, 200 steps)\n  wall {walls[workers]:.0f} s", flush=True)
+    speedup = walls[1] / walls[2]
+    return ("rvsm regress 64 seeds, 2 workers vs 1", f"{speedup:.2f}x", ">= 1.7x",
+            "met" if speedup >= 1.7 else "MISSED")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -128,6 +166,7 @@ def main() -> int:
     finally:
         if not args.keep:
             shutil.rmtree(tmp, ignore_errors=True)
+        rows.append(regress_case(tmp))
     print()
     width = max(len(r[0]) for r in rows)
     for what, got, target, verdict in rows:
