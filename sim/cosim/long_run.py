@@ -51,8 +51,8 @@ def window_cycles(geo: StreamGeometry) -> int:
     return 2 * geo.beats_per_frame + geo.lag
 
 
-def _wave_name(sim: str) -> str:
-    return "window.fst"
+WHOLE_RUN_WAVES = "waves.fst"
+WINDOW_WAVES = "window.fst"
 
 
 def _source_inputs(source: StimulusChunks, run_dir: Path, chunk_steps: int) -> dict:
@@ -133,11 +133,11 @@ def check_chunks(
         inputs = _source_inputs(source, run_dir, chunk_steps)
         plusargs = []
         if waves:
-            plusargs = [f"+rvsm_dump_file={run_dir / _wave_name(sim)}", "+rvsm_dump_from=0",
+            plusargs = [f"+rvsm_dump_file={run_dir / WHOLE_RUN_WAVES}", "+rvsm_dump_from=0",
                         f"+rvsm_dump_to={2**62}"]
         result = _run_with_progress(sb, inputs, run_dir, source.num_steps,
                                     f"{sim} {a.name} {name}", progress, plusargs, waves)
-        result["waves"] = str(run_dir / _wave_name(sim)) if waves else None
+        result["waves"] = str(run_dir / WHOLE_RUN_WAVES) if waves else None
         first = result.get("first_mismatch") or {}
         if result["mismatches"] and not waves and "cycle" in first:
             traced = sb if sim == "icarus" else build(
@@ -159,7 +159,7 @@ def _window(sb: SimBuild, inputs: dict, run_dir: Path, cycle: int,
     lo = max(0, cycle - window_cycles(geo))
     hi = cycle + WINDOW_AFTER
     again = run_dir / "failure"
-    wave = again / _wave_name(sb.sim)
+    wave = again / WINDOW_WAVES
     plusargs = [f"+rvsm_dump_file={wave}", f"+rvsm_dump_from={lo}", f"+rvsm_dump_to={hi}"]
     inputs = {**inputs, "RVSM_STOP_AFTER_CYCLE": str(hi)}
     run_cocotb(sb, inputs, again, plusargs=plusargs, hdl_dumps=True)

@@ -132,6 +132,10 @@ def test_cli_verify_with_the_long_run_harness(tmp_path: Path,
     out = json.loads(capsys.readouterr().out)
     assert out["mismatches"] == 0 and out["harness"] == "chunk" and out["steps"] == 15
     assert out["compared"] == 15 * 2 * 6 * 8
+    assert main(["verify", "coin", "--fixed", str(point), "--steps", "5", "--lanes", "2",
+                 "--harness", "chunk", "--waves", "--json", "--work", work]) == 0
+    waves = Path(json.loads(capsys.readouterr().out)["waves"])
+    assert waves.name == "waves.fst" and waves.stat().st_size > 0  # the whole run
     assert main(["verify", "coin", "--fixed", str(point), "--harness", "chunk", "--arch",
                  "parallel", "--work", work]) == 2
     assert "--harness chunk drives the stream architecture only" in capsys.readouterr().err
