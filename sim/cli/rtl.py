@@ -68,12 +68,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--work", default="build/verify",
                    help="work folder: shared build cache (builds/) and one new folder per "
                    "run (runs/)")
-    p.add_argument("--harness", choices=("cycle", "chunk"), default="cycle",
+    p.add_argument("--harness", choices=("auto", "cycle", "chunk"), default="auto",
                    help="cycle: Python drives every clock cycle (protocol tests, both "
                    "architectures); chunk: the long-run harness, where the simulator runs "
                    "the cycles and the twin is produced and checked a chunk of steps at "
-                   "a time in bounded memory (streaming array; docs/long-runs.md). "
-                   "Default cycle")
+                   "a time in bounded memory (streaming array; docs/long-runs.md); auto "
+                   "(default): chunk for a streaming run of more than 100,000 input "
+                   "beats, else cycle")
     p.add_argument("--chunk-steps", type=int, default=8, metavar="N",
                    help="with --harness chunk: steps produced and streamed at a time "
                    "(default 8)")
@@ -166,7 +167,7 @@ def _verify(args: argparse.Namespace) -> int:
     if args.chunk_steps < 1:
         raise RvsmError(f"--chunk-steps must be >= 1, got {args.chunk_steps}")
     long_run = {"harness": args.harness}
-    if args.harness == "chunk":
+    if args.harness != "cycle":
         long_run.update(progress=not (args.quiet or args.json),
                         chunk_steps=args.chunk_steps)
     if args.recompute_expected and not args.stimulus:

@@ -34,11 +34,16 @@ from rvsm.sim.cosim.long_run import DEFAULT_CHUNK_STEPS, check_chunks
 from rvsm.sim.cosim.simulation import run_testbench
 
 #: The testbenches ``rvsm verify --harness`` chooses: per cycle from Python, or the
-#: long-run harness (the simulator runs the cycles; streaming array only).
-HARNESSES = ("cycle", "chunk")
+#: long-run harness (the simulator runs the cycles; streaming array only); ``auto``
+#: picks the long-run harness for a streaming run of more than :data:`AUTO_CHUNK_BEATS`
+#: input beats, else the per-cycle testbench (:func:`choose_harness`).
+HARNESSES = ("auto", "cycle", "chunk")
+#: Beats above which ``auto`` takes the long-run harness: the per-cycle testbench runs
+#: about 600-15,000 cycles/s, so beyond this a run takes seconds to minutes in it.
+AUTO_CHUNK_BEATS = 100_000
 
-__all__ = ["HARNESSES", "check_harness", "check_stimulus", "random_verify", "replay",
-           "run_rtl", "verify"]
+__all__ = ["AUTO_CHUNK_BEATS", "HARNESSES", "check_harness", "check_stimulus",
+           "choose_harness", "random_verify", "replay", "run_rtl", "verify"]
 
 DEFAULT_WORK = Path("build") / "verify"
 
@@ -201,6 +206,7 @@ def replay(
                             f"fix the file, or replay it with --recompute-expected to take "
                             f"the expectation from its codes")
     name = Path(stimulus).stem or "stimulus"
+    harness = choose_harness(harness, arch, c.height * c.width, stim.num_steps, options)
     if harness == "chunk":
         source = StimulusChunks.from_stimulus(
             stim, str(Path(stimulus).resolve())
@@ -259,6 +265,9 @@ def verify(
     _resolve(arch, options, point.contract())
     if not isinstance(scene, Scene):
         scene = load_scene(scene, size=(h, w))
+    harness = choose_harness(harness, arch, h * w,
+                             scene.num_steps if steps is None else steps, options,
+                             reloadable=scene.source is not None)
     if harness == "chunk":
         if steps is not None and steps > scene.num_steps:
             raise RvsmError(f"--steps {steps} is more than the {scene.num_steps} steps of "
@@ -310,6 +319,7 @@ def random_verify(
     _resolve(arch, options, point.contract())
     stim = corner_stimulus(point.contract(), seed, steps)
     stim.point = point
+    harness = choose_harness(harness, arch, point.height * point.width, steps, options)
     if harness == "chunk":
         result = check_chunks(StimulusChunks.from_stimulus(stim), sim, work_dir=work_dir,
                               name=f"random{seed}", arch=arch, waves=waves,
@@ -321,6 +331,21 @@ def random_verify(
     result.update(seed=seed, point=str(fixed), height=point.height, width=point.width,
                   coverage=coverage(stim))
     return result
+
+
+def choose_harness(harness: str, arch: str | Architecture, pixels: int, steps: int,
+                   options: dict, reloadable: bool = True) -> str:
+    """``harness``, with ``"auto"`` resolved: ``"chunk"`` for the streaming array when
+    ``pixels * steps / lanes`` (input beats) exceeds :data:`AUTO_CHUNK_BEATS` and the
+    stimulus can be opened again in the simulator (``reloadable``), else ``"cycle"``."""
+    if harness != "auto":
+        return harness
+    name = get_architecture(arch).name
+    lanes = int(options.get("lanes") or 1)
+    if name in LONG_RUN_TESTBENCHES and reloadable and pixels * steps // lanes > \
+            AUTO_CHUNK_BEATS:
+        return "chunk"
+    return "cycle"
 
 
 def check_harness(harness: str, arch: str | Architecture) -> None:

@@ -23,7 +23,7 @@ from rvsm.rtl.stream.schedule import pack_lanes
 from rvsm.sim.cli import main
 from rvsm.sim.cosim.chunk_harness import decode_output_beats, encode_input_beats
 from rvsm.sim.cosim.long_run import check_chunks
-from rvsm.sim.cosim.verify import run_rtl
+from rvsm.sim.cosim.verify import AUTO_CHUNK_BEATS, choose_harness, run_rtl
 
 SIMS = ["icarus", "verilator"]
 
@@ -142,3 +142,16 @@ def test_cli_verify_with_the_long_run_harness(tmp_path: Path,
     assert main(["verify", "coin", "--fixed", str(point), "--harness", "chunk",
                  "--chunk-steps", "0", "--work", work]) == 2
     assert "--chunk-steps must be >= 1" in capsys.readouterr().err
+
+
+def test_auto_harness_takes_the_long_run_one_for_long_streams() -> None:
+    """``--harness auto``: the long-run harness beyond AUTO_CHUNK_BEATS input beats of the
+    streaming array (and a reloadable stimulus), the per-cycle testbench otherwise."""
+    big = AUTO_CHUNK_BEATS + 1
+    assert choose_harness("auto", "stream", big, 1, {"lanes": 1}) == "chunk"
+    assert choose_harness("auto", "stream", big, 1, {"lanes": 2}) == "cycle"
+    assert choose_harness("auto", "stream", 250 * 400, 20, {"lanes": 40}) == "cycle"
+    assert choose_harness("auto", "stream", 250 * 400, 1000, {"lanes": 40}) == "chunk"
+    assert choose_harness("auto", "stream", big, 1, {}, reloadable=False) == "cycle"
+    assert choose_harness("auto", "parallel", big, 10, {}) == "cycle"
+    assert choose_harness("cycle", "stream", big, 10, {}) == "cycle"
