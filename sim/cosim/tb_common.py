@@ -9,6 +9,9 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge
 
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.rtl.stream.geometry import StreamGeometry
+
 #: Clock period of both testbenches (ns); inputs are driven on the falling edge.
 CLOCK_NS = 10
 
@@ -43,3 +46,13 @@ async def clock_and_reset(dut: object, idle: tuple[str, ...]) -> None:
     await FallingEdge(clk)
     await FallingEdge(clk)
     dut.rst.value = 0  # type: ignore[attr-defined]
+
+
+def stream_geometry(contract: ArrayContract, ports: dict) -> StreamGeometry:
+    """The streaming array's geometry for ``contract`` with the lanes of the build's port
+    map ``ports``; refuses a build whose timing is not this contract's."""
+    geo = StreamGeometry(contract, int(ports["timing"]["lanes"]))
+    if geo.timing() != ports["timing"]:
+        raise RuntimeError(f"the build's timing {ports['timing']} is not this contract's "
+                           f"{geo.timing()}")
+    return geo

@@ -29,9 +29,8 @@ from cocotb.triggers import FallingEdge
 from rvsm.model.fixed.stimulus import load_stimulus
 from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.stream.drive import threshold_writes
-from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, check_beats, pack_lanes
-from rvsm.sim.cosim.tb_common import clock_and_reset, logic_bits, testbench_arg
+from rvsm.sim.cosim.tb_common import clock_and_reset, logic_bits, stream_geometry, testbench_arg
 
 
 @cocotb.test()
@@ -44,11 +43,8 @@ async def stream_matches_fixed_twin(dut: object) -> None:
     codes = stim.codes.astype(np.int64)
     expected = stim.spikes
     steps, scales, height, width = expected.shape
-    lanes = int(ports["timing"]["lanes"])
-    geo = StreamGeometry(c, lanes)
-    if geo.timing() != ports["timing"]:
-        raise RuntimeError(f"the build's timing {ports['timing']} is not this contract's "
-                           f"{geo.timing()}")
+    geo = stream_geometry(c, ports)
+    lanes = geo.lanes
     sched = geo.schedule
     by_name = {p["name"]: p for p in ports["ports"]}
     fields = {f["name"]: (f["offset"], f["width"])

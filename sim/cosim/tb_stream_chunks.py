@@ -40,7 +40,6 @@ from rvsm.model.fixed.stimulus_chunks import open_stimulus_chunks
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.stream.drive import threshold_writes
-from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, StreamChecker
 from rvsm.sim.cosim.chunk_harness import (
     DEFAULT_DEPTH,
@@ -49,7 +48,7 @@ from rvsm.sim.cosim.chunk_harness import (
     decode_output_beats,
     encode_input_beats,
 )
-from rvsm.sim.cosim.tb_common import CLOCK_NS, clock_and_reset, testbench_arg
+from rvsm.sim.cosim.tb_common import CLOCK_NS, clock_and_reset, stream_geometry, testbench_arg
 
 DEFAULT_CHUNK_STEPS = 8
 
@@ -78,11 +77,8 @@ async def stream_long_run(dut: object) -> None:
     progress = _optional("progress", None)
     stop_after = _optional("stop_after_cycle", None)
     c = source.contract
-    lanes = int(ports["timing"]["lanes"])
-    geo = StreamGeometry(c, lanes)
-    if geo.timing() != ports["timing"]:
-        raise RuntimeError(f"the build's timing {ports['timing']} is not this contract's "
-                           f"{geo.timing()}")
+    geo = stream_geometry(c, ports)
+    lanes = geo.lanes
     sched = geo.schedule
     layout = HarnessLayout.from_ports(ports, depth)
     fields = layout.fields

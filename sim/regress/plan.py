@@ -35,8 +35,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import tomllib
-
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.point_toml import design_point_toml
 from rvsm.model.infra.errors import RvsmError
@@ -45,7 +43,7 @@ from rvsm.model.scene.loaders import is_builtin, parse_size
 from rvsm.rtl.architectures import ARCHITECTURES
 from rvsm.sim.cosim import SIMULATORS
 from rvsm.sim.cosim.verify import HARNESSES
-from rvsm.sim.sweep.spec import parse_base_point
+from rvsm.sim.sweep.spec import parse_base_point, toml_tables
 
 __all__ = ["RegressionPlan", "RunSpec", "load_plan", "parse_plan"]
 
@@ -129,13 +127,7 @@ def _seeds(raw: Any, source: str) -> list[int]:
 def parse_plan(text: str, source: str = "plan",
                base_dir: str | os.PathLike | None = None) -> RegressionPlan:
     """Parse plan TOML text (``base_dir`` resolves a relative ``[base] file``)."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise RvsmError(f"{source}: not valid TOML: {exc}") from None
-    for key in data:
-        if key not in SECTIONS:
-            raise RvsmError(f"{source}: unknown section [{key}]; valid: {', '.join(SECTIONS)}")
+    data = toml_tables(text, source, SECTIONS)
     head = data.get("regression", {})
     name = head.get("name") if isinstance(head, dict) else None
     if not isinstance(name, str) or not name.strip():

@@ -20,6 +20,7 @@ from typing import Any
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.sim.regress.plan import RunSpec
+from rvsm.sim.sweep.store import database_error, open_database
 
 __all__ = ["RegressionStore"]
 
@@ -41,17 +42,13 @@ class RegressionStore:
 
     def __init__(self, path: str | os.PathLike) -> None:
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         try:
-            self.db = sqlite3.connect(self.path, timeout=30)
-            self.db.execute("PRAGMA journal_mode=WAL")
-            self.db.executescript(SCHEMA)
+            self.db = open_database(self.path, SCHEMA)
             self.db.execute("INSERT OR IGNORE INTO meta VALUES ('kind', 'rvsm regression')")
             kind = self.db.execute("SELECT value FROM meta WHERE key='kind'").fetchone()
             self.db.commit()
-        except sqlite3.DatabaseError as exc:
-            raise RvsmError(f"{self.path}: not a regression database ({exc}); choose "
-                            "another -o") from None
+        except sqlite3.Error as exc:
+            raise database_error(exc, self.path, "regression database") from None
         if kind is None or kind[0] != "rvsm regression":
             self.db.close()
             raise RvsmError(f"{self.path} is another kind of database; choose another -o")
@@ -74,6 +71,12 @@ class RegressionStore:
     def write(self, spec: RunSpec, record: dict[str, Any]) -> None:
         """Record one run's outcome under its key (one transaction)."""
         j = json.dumps
+        try:
+            self._insert(spec, record, j)
+        except sqlite3.Error as exc:
+            raise database_error(exc, self.path, "regression database") from None
+
+    def _insert(self, spec: RunSpec, record: dict[str, Any], j: Any) -> None:
         self.db.execute(
             "INSERT OR REPLACE INTO runs VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
             (spec.key, spec.plan, spec.label, spec.stimulus, spec.model,

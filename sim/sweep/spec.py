@@ -184,19 +184,26 @@ def parse_sweep(
     text: str, source: str = "sweep", base_dir: str | os.PathLike | None = None
 ) -> SweepSpec:
     """Parse sweep TOML text (``base_dir`` resolves a relative base file)."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise RvsmError(f"{source}: not valid TOML: {exc}") from None
-    for key in data:
-        if key not in SECTIONS:
-            raise RvsmError(f"{source}: unknown section [{key}]; valid: {', '.join(SECTIONS)}")
+    data = toml_tables(text, source, SECTIONS)
     base = parse_base_point(data.get("base"), source, Path(base_dir or "."))
     axes = _parse_axes(data.get("axes", {}), source)
     run = _parse_run(data.get("run"), source)
     hardware = _parse_hardware(data.get("hardware", {}), source)
     spec = SweepSpec(source, text, base, axes, run, hardware)
     return dataclasses.replace(spec, designs=tuple(_expand(spec)))
+
+
+def toml_tables(text: str, source: str, sections: tuple[str, ...]) -> dict[str, Any]:
+    """TOML ``text`` parsed, refusing (one line naming ``source``) invalid TOML or a
+    top-level table not in ``sections``."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise RvsmError(f"{source}: not valid TOML: {exc}") from None
+    for key in data:
+        if key not in sections:
+            raise RvsmError(f"{source}: unknown section [{key}]; valid: {', '.join(sections)}")
+    return data
 
 
 def parse_base_point(raw: Any, source: str, base_dir: Path) -> DesignPoint:

@@ -73,19 +73,31 @@ def _now() -> str:
     return time.strftime("%Y-%m-%dT%H:%M:%S")
 
 
-def database_error(exc: sqlite3.Error, path: str | os.PathLike) -> RvsmError:
+def database_error(exc: sqlite3.Error, path: str | os.PathLike,
+                   what: str = "sweep database") -> RvsmError:
     """The one-line error for an SQLite failure on ``path``: a full disk or an I/O error
     is a :class:`ToolError` (exit 3); a read-only, unopenable or foreign file an
     :class:`RvsmError` (exit 2)."""
     code = getattr(exc, "sqlite_errorcode", 0) & 0xFF  # primary result code
     if code in (sqlite3.SQLITE_FULL, sqlite3.SQLITE_IOERR):
         why = "disk full" if code == sqlite3.SQLITE_FULL else f"{exc}; disk full?"
-        return ToolError(f"{path}: the sweep database cannot be written ({why}); free "
+        return ToolError(f"{path}: the {what} cannot be written ({why}); free "
                          "space or choose another -o; finished rows are kept")
     if code in (sqlite3.SQLITE_READONLY, sqlite3.SQLITE_CANTOPEN, sqlite3.SQLITE_PERM):
-        return RvsmError(f"{path}: cannot write the sweep database ({exc}); choose a "
+        return RvsmError(f"{path}: cannot write the {what} ({exc}); choose a "
                          "writable -o")
-    return RvsmError(f"{path}: not a usable sweep database: {exc}")
+    return RvsmError(f"{path}: not a usable {what}: {exc}")
+
+
+def open_database(path: Path, schema: str) -> sqlite3.Connection:
+    """``path`` opened (its folder made) in WAL mode with ``schema`` applied; SQLite
+    errors propagate (map them with :func:`database_error`)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    db = sqlite3.connect(path, timeout=30)
+    db.execute("PRAGMA journal_mode=WAL")
+    db.execute("PRAGMA synchronous=NORMAL")
+    db.executescript(schema)
+    return db
 
 
 class SweepStore:
@@ -93,12 +105,8 @@ class SweepStore:
 
     def __init__(self, path: str | os.PathLike) -> None:
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         try:
-            self.db = sqlite3.connect(self.path, timeout=30)
-            self.db.execute("PRAGMA journal_mode=WAL")
-            self.db.execute("PRAGMA synchronous=NORMAL")
-            self.db.executescript(SCHEMA)
+            self.db = open_database(self.path, SCHEMA)
             columns = {r[1] for r in self.db.execute("PRAGMA table_info(results)")}
             if "scene_digest" not in columns:
                 self.db.execute("ALTER TABLE results ADD COLUMN scene_digest TEXT")
