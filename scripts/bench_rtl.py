@@ -118,6 +118,9 @@ def main() -> int:
     parser.add_argument("--quick", action="store_true",
                         help="leave out the one-second run and the simulate memory case")
     parser.add_argument("--keep", action="store_true", help="keep the work folders")
+    parser.add_argument("--only", nargs="+", metavar="CASE",
+                        help="run only these cases: full-1k medium icarus one-second "
+                        "simulate regress")
     args = parser.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="rvsm-bench-rtl-"))
     rows: list[tuple[str, str, str, str]] = []
@@ -129,6 +132,7 @@ def main() -> int:
                  ("icarus", "64x64", 4, "icarus", 40, 5)]
         if not args.quick:
             cases.append(("one-second", "250x400", 40, "verilator", 40000, 4001))
+        cases = [c for c in cases if not args.only or c[0] in args.only]
         for name, size, lanes, sim, steps, frames in cases:
             r = verify_case(tmp, name, size, lanes, sim, steps, frames)
             print(f"{name}: {r['command']}", flush=True)
@@ -154,7 +158,7 @@ def main() -> int:
                           "<= 60 min", "met" if r["wall"] <= 3600 else "MISSED"),
                          ("  its peak RSS", f"{r['rss_mb'] / 1024:.2f} GB", "<= 4 GB",
                           "met" if r["rss_mb"] <= 4096 else "MISSED")]
-        if not args.quick:
+        if not args.quick and (not args.only or "simulate" in args.only):
             argv = [RVSM, "simulate", "flyball", "--size", "250x400", "--model", "dog4",
                     "--noise", "--frames", "4001", "--steps-per-frame", "10", "-o",
                     str(tmp / "s.h5")]
@@ -163,10 +167,11 @@ def main() -> int:
                   f"peak RSS {rss / 1024:,.0f} MB", flush=True)
             rows.append(("rvsm simulate 4,001 frames to .h5", f"{rss / 1024 ** 2:.2f} GB",
                          "<= 1.5 GB", "met" if rss <= 1.5 * 1024 ** 2 else "MISSED"))
+        if not args.only or "regress" in args.only:
+            rows.append(regress_case(tmp))
     finally:
         if not args.keep:
             shutil.rmtree(tmp, ignore_errors=True)
-        rows.append(regress_case(tmp))
     print()
     width = max(len(r[0]) for r in rows)
     for what, got, target, verdict in rows:
