@@ -60,14 +60,16 @@ class StimulusChunk:
 class StimulusChunks:
     """A run's ``contract``, ``thresholds (S, H, W) int64``, ``num_steps``, the steps
     ``clear_before`` which the array restarts from zero, and its chunks (:meth:`chunks`).
-    ``spec`` describes how to open it again (:func:`open_stimulus_chunks`)."""
+    ``spec`` describes how to open it again (:func:`open_stimulus_chunks`; empty when
+    it cannot be: a scene made in code); ``stimulus`` is the whole stimulus when it is
+    held in memory (:meth:`from_stimulus`), else None."""
 
     contract: ArrayContract
     thresholds: np.ndarray
     num_steps: int
     clear_before: tuple[int, ...] = ()
     spec: dict = field(default_factory=dict)
-    _stimulus: Stimulus | None = field(default=None, repr=False)
+    stimulus: Stimulus | None = field(default=None, repr=False)  # when held in memory
     _scene: Scene | None = field(default=None, repr=False)
     _point: DesignPoint | None = field(default=None, repr=False)
     _engine: str = field(default="fused", repr=False)
@@ -77,7 +79,7 @@ class StimulusChunks:
         """Chunks of ``stim`` (``path``: the file it was read from, for :attr:`spec`)."""
         spec = {"kind": "stimulus", "path": path} if path else {}
         return cls(stim.contract, np.asarray(stim.thresholds, dtype=np.int64),
-                   stim.num_steps, tuple(stim.clear_before), spec, _stimulus=stim)
+                   stim.num_steps, tuple(stim.clear_before), spec, stimulus=stim)
 
     @classmethod
     def from_scene(cls, scene: Scene, point: DesignPoint, num_steps: int | None = None,
@@ -110,9 +112,9 @@ class StimulusChunks:
         cuts = sorted({t for t in self.clear_before if 0 < t < self.num_steps})
         bounds = [0, *cuts, self.num_steps]
         stream = twin = None
-        if self._stimulus is None and self._engine == "numpy":
+        if self.stimulus is None and self._engine == "numpy":
             stream = self.contract.stream(self.thresholds)
-        elif self._stimulus is None:
+        elif self.stimulus is None:
             assert self._scene is not None and self._point is not None
             if cuts:
                 raise RvsmError("the fused engine runs scenes without clears")
@@ -123,9 +125,9 @@ class StimulusChunks:
                 stream.clear()
             for t0 in range(a, b, chunk_steps):
                 t1 = min(t0 + chunk_steps, b)
-                if self._stimulus is not None:
-                    codes = self._stimulus.codes[t0:t1]
-                    spikes = self._stimulus.spikes[t0:t1]
+                if self.stimulus is not None:
+                    codes = self.stimulus.codes[t0:t1]
+                    spikes = self.stimulus.spikes[t0:t1]
                 else:
                     assert self._scene is not None and self._point is not None
                     codes = step_codes(self._scene, self._point, noise, t0, t1)

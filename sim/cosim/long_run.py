@@ -58,11 +58,11 @@ WINDOW_WAVES = "window.fst"
 def _source_inputs(source: StimulusChunks, run_dir: Path, chunk_steps: int) -> dict:
     spec = source.spec
     if not spec:
-        if source._stimulus is None:  # noqa: SLF001 - a scene made in code
+        if source.stimulus is None:  # a scene made in code
             raise RvsmError("a long run needs a scene it can load again (a built-in name or "
                             "a path), not a scene made in code")
         path = run_dir / "stimulus.npz"
-        save_stimulus(path, source._stimulus)  # noqa: SLF001
+        save_stimulus(path, source.stimulus)
         spec = {"kind": "stimulus", "path": str(path)}
     return {"RVSM_SOURCE": json.dumps(spec), "RVSM_CHUNK_STEPS": str(int(chunk_steps))}
 
