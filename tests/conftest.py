@@ -12,6 +12,9 @@
 - :func:`formal_point`: a tiny design point with narrow widths (2x2, dog2, 2-bit ADC,
   6-bit accumulators, subtract reset) for the formal checks.
 - :func:`shell_env`: the environment in which documented shell lines run (README, docs).
+- :func:`default_signals`: ``preexec_fn`` for a child a test signals: SIGINT, SIGTERM and
+  SIGHUP back to their defaults, so the test does not depend on how pytest was started
+  (a background job or ``nohup`` ignores SIGINT or SIGHUP, and children inherit that).
 """
 
 from __future__ import annotations
@@ -139,3 +142,11 @@ def shell_env() -> dict[str, str]:
     a shell line is this checkout's console script."""
     return dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}"
                 f"{os.environ.get('PATH', '')}")
+
+
+def default_signals() -> None:
+    """In a child before exec: SIGINT, SIGTERM and SIGHUP at their default dispositions."""
+    import signal
+
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_DFL)

@@ -66,6 +66,8 @@ def _regress(args: argparse.Namespace) -> int:
             print(f"  ERROR {r['label']}: {r['error']}")
     for line in s.closure:
         print(f"coverage {line}")
+    for line in s.code_coverage:
+        print(f"code coverage: {line}")
     if args.junit:
         print(f"wrote {args.junit}")
     if s.count("error"):

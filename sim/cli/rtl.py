@@ -80,6 +80,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "(default 8)")
     p.add_argument("--quiet", action="store_true",
                    help="no progress bar (--harness chunk)")
+    p.add_argument("--code-coverage", action="store_true",
+                   help="Verilator, --harness chunk: build line and toggle code coverage "
+                   "in and keep the run's coverage.dat (docs/regressions.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_arch_arguments(p)
     p.set_defaults(func=_verify)
@@ -169,7 +172,9 @@ def _verify(args: argparse.Namespace) -> int:
     long_run = {"harness": args.harness}
     if args.harness != "cycle":
         long_run.update(progress=not (args.quiet or args.json),
-                        chunk_steps=args.chunk_steps)
+                        chunk_steps=args.chunk_steps, code_coverage=args.code_coverage)
+    elif args.code_coverage:
+        raise RvsmError("--code-coverage needs --harness chunk (or auto) and --sim verilator")
     if args.recompute_expected and not args.stimulus:
         raise RvsmError("--recompute-expected applies to --stimulus FILE only (the other "
                         "ways compute the expectation from the fixed twin anyway)")
@@ -228,6 +233,10 @@ def _verify(args: argparse.Namespace) -> int:
             print(f"stream: {r['lanes']} lane(s), {r['cycles']} cycles at "
                   f"{r['cycles_per_second']:.0f} cycles/s{how} (build "
                   f"{r['build_seconds']:.0f} s)")
+        if r.get("code_coverage"):
+            kinds = ", ".join(f"{k} {hit}/{n}" for k, (hit, n)
+                              in r["code_coverage_summary"].items())
+            print(f"code coverage ({kinds} points hit): {r['code_coverage']}")
         if r.get("wave_window_cycles"):
             lo, hi = r["wave_window_cycles"]
             print(f"waveform window: clock cycles {lo}..{hi} around the first mismatch")

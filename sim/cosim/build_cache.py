@@ -153,7 +153,7 @@ def build_key(contract: ArrayContract, sim: str, top: str, traced: bool,
     fields = {
         "recipe": _BUILD_VERSION, "rtl": design.digest(contract),
         "sim": sim, "top": top,
-        "traced": traced, "build_args": build_args(sim, traced),
+        "traced": traced, "build_args": build_args(sim, traced, "coverage" in extra),
         "cxx_opt": cxx_opt("harness" in extra) if sim == "verilator" else "",
         "versions": tool_versions(sim), "extra": list(extra),
     }
@@ -165,7 +165,7 @@ def build(
     contract: ArrayContract, sim: str, build_root: str | os.PathLike,
     top: str | None = None, waves: bool = False,
     arch: str | Architecture = DEFAULT_ARCHITECTURE, harness: bool = False,
-    **options: int | None,
+    coverage: bool = False, **options: int | None,
 ) -> SimBuild:
     """Generate (or reuse) the Verilog and build it for ``sim``; cached per :func:`build_key`.
 
@@ -183,7 +183,8 @@ def build(
     long-run testbench. Its dumps are the harness's own ``$dumpvars``: Icarus builds need
     nothing for them; Verilator builds need ``waves`` (``--trace-fst``: 11 of the 18 MB
     of C++ at 250x400 with 40 lanes, so a long run builds without it and a failing one
-    builds it for its waveform window).
+    builds it for its waveform window). ``coverage`` (Verilator) builds line and toggle
+    code coverage in: each run writes ``coverage.dat`` (:mod:`.code_coverage`).
     """
     check_simulator(sim)
     design = cosim_design(arch, top, **options)
@@ -193,10 +194,13 @@ def build(
                         f"only, not the {design.arch.name} architecture")
     traced = waves or (sim == "icarus" and not harness)
     digest = design.digest(contract)
-    extra = ["harness", HARNESS_VERSION] if harness else []
+    if coverage and sim != "verilator":
+        raise RvsmError("code coverage needs Verilator (--sim verilator)")
+    extra = (["harness", HARNESS_VERSION] if harness else []) + (["coverage"] if coverage
+                                                                  else [])
     key, key_fields = build_key(contract, sim, top, traced, extra, design=design)
-    suffix = ("-trace" if (traced and sim == "verilator") else "") + ("-chunks" if harness
-                                                                       else "")
+    suffix = (("-trace" if (traced and sim == "verilator") else "")
+              + ("-chunks" if harness else "") + ("-cov" if coverage else ""))
     base = Path(build_root).resolve()
     final = base / f"{sim}-{digest}-{top}{suffix}-{key[:8]}"
     cached = _cached(final, sim, top, traced, key, design, harness)
@@ -231,7 +235,7 @@ def build(
             sources[-1].write_text(harness_verilog(layout))
             hdl_top, ports = HARNESS_TOP, layout.ports
         cocotb_build(sim, sources, hdl_top, ports, stage / "sim_build", traced, log,
-                     long_run=harness)
+                     long_run=harness, coverage=coverage)
         build_seconds = time.perf_counter() - t0
         files = _checksums(stage, _build_files(sim, top, harness))
         if files is None:

@@ -101,11 +101,13 @@ def cxx_opt(long_run: bool = False) -> str:
     return opt
 
 
-def build_args(sim: str, traced: bool) -> list[str]:
-    """Simulator build flags: Verilator's (FST tracing when ``traced``); none for Icarus."""
+def build_args(sim: str, traced: bool, coverage: bool = False) -> list[str]:
+    """Simulator build flags: Verilator's (FST tracing when ``traced``, line and toggle
+    code coverage when ``coverage``); none for Icarus."""
     if sim != "verilator":
         return []
-    return [*VERILATOR_BUILD_ARGS, *(["--trace-fst"] if traced else [])]
+    return [*VERILATOR_BUILD_ARGS, *(["--trace-fst"] if traced else []),
+            *(["--coverage-line", "--coverage-toggle"] if coverage else [])]
 
 
 def public_ports_control(top: str, ports: Sequence[str]) -> str:
@@ -119,12 +121,14 @@ def public_ports_control(top: str, ports: Sequence[str]) -> str:
 
 
 def cocotb_build(sim: str, verilog: Path | Sequence[Path], top: str, ports: Sequence[str],
-                 build_dir: Path, traced: bool, log: Path, long_run: bool = False) -> None:
+                 build_dir: Path, traced: bool, log: Path, long_run: bool = False,
+                 coverage: bool = False) -> None:
     """Build ``verilog`` (one file or several; top module ``top``, whose ``ports`` the
     testbench uses) for ``sim`` in ``build_dir``, with tracing when ``traced``; the tools'
     output goes to ``log``; ``long_run`` picks the long-run C++ optimisation
-    (:func:`cxx_opt`). Raises :class:`~rvsm.model.infra.tools.ToolFailure` naming the
-    failing command."""
+    (:func:`cxx_opt`); ``coverage`` builds Verilator's code coverage (each run then
+    writes ``coverage.dat`` in its folder). Raises
+    :class:`~rvsm.model.infra.tools.ToolFailure` naming the failing command."""
     build_dir.mkdir(parents=True, exist_ok=True)
     sources = ([str(verilog)] if isinstance(verilog, (str, Path))
                else [str(v) for v in verilog])
@@ -134,7 +138,7 @@ def cocotb_build(sim: str, verilog: Path | Sequence[Path], top: str, ports: Sequ
         sources.insert(0, str(control))
     _run_job(sim, "build", {
         "sources": sources, "hdl_toplevel": top, "build_dir": str(build_dir),
-        "build_args": build_args(sim, traced), "waves": traced, "timescale": TIMESCALE,
+        "build_args": build_args(sim, traced, coverage), "waves": traced, "timescale": TIMESCALE,
         "always": True, "log_file": str(log)}, cwd=build_dir.parent, log=log,
         long_run=long_run)
 

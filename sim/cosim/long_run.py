@@ -35,6 +35,7 @@ from rvsm.rtl.architecture import Architecture
 from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.sim.cosim.build_cache import SimBuild, build, new_run_dir
+from rvsm.sim.cosim.code_coverage import read_coverage, summary
 from rvsm.sim.cosim.simulation import run_cocotb
 
 __all__ = ["DEFAULT_CHUNK_STEPS", "check_chunks", "window_cycles"]
@@ -108,6 +109,7 @@ def check_chunks(
     chunk_steps: int = DEFAULT_CHUNK_STEPS,
     waves: bool = False,
     progress: bool = False,
+    code_coverage: bool = False,
     **options: int | None,
 ) -> dict:
     """Run ``source`` through the RTL in the long-run harness; compare every spike.
@@ -116,7 +118,9 @@ def check_chunks(
     ``harness``, ``chunks``, ``beats_streamed``, ``seconds`` per phase of the
     testbench: ``twin``, ``encode``, ``simulate``, ``decode``, ``check``) with
     ``build_seconds``, ``run_dir`` and ``waves``: on a mismatch, the window around it
-    (module docstring); with ``waves``, the whole run.
+    (module docstring); with ``waves``, the whole run. ``code_coverage`` (Verilator)
+    builds line and toggle coverage in and gives ``code_coverage``, the run's
+    ``coverage.dat`` (:mod:`.code_coverage`), and its ``code_coverage_summary``.
     """
     a = get_architecture(arch)
     resolved = a.resolve(options)
@@ -126,7 +130,7 @@ def check_chunks(
     work = Path(work_dir)
     root = work / "builds" if build_root is None else Path(build_root)
     sb = build(source.contract, sim, root, arch=a, harness=True,
-               waves=waves and sim == "verilator", **resolved)
+               waves=waves and sim == "verilator", coverage=code_coverage, **resolved)
     run_dir = new_run_dir(work, f"{name}-{sim}")
     geo = StreamGeometry(source.contract, int(resolved["lanes"]))
     try:
@@ -138,6 +142,10 @@ def check_chunks(
         result = _run_with_progress(sb, inputs, run_dir, source.num_steps,
                                     f"{sim} {a.name} {name}", progress, plusargs, waves)
         result["waves"] = str(run_dir / WHOLE_RUN_WAVES) if waves else None
+        dat = run_dir / "coverage.dat"
+        result["code_coverage"] = str(dat) if code_coverage and dat.exists() else None
+        if result["code_coverage"]:
+            result["code_coverage_summary"] = summary(read_coverage(dat))
         first = result.get("first_mismatch") or {}
         if result["mismatches"] and not waves and "cycle" in first:
             traced = sb if sim == "icarus" else build(

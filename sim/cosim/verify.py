@@ -42,8 +42,9 @@ HARNESSES = ("auto", "cycle", "chunk")
 #: about 600-15,000 cycles/s, so beyond this a run takes seconds to minutes in it.
 AUTO_CHUNK_BEATS = 100_000
 
-__all__ = ["AUTO_CHUNK_BEATS", "HARNESSES", "check_harness", "check_stimulus",
-           "choose_harness", "random_verify", "replay", "run_rtl", "verify"]
+__all__ = ["AUTO_CHUNK_BEATS", "HARNESSES", "check_code_coverage", "check_harness",
+           "check_stimulus", "choose_harness", "random_verify", "replay", "run_rtl",
+           "verify"]
 
 DEFAULT_WORK = Path("build") / "verify"
 
@@ -174,6 +175,7 @@ def replay(
     harness: str = "cycle",
     progress: bool = False,
     chunk_steps: int = DEFAULT_CHUNK_STEPS,
+    code_coverage: bool = False,
     **options: int | None,
 ) -> dict:
     """Replay a stimulus file (``rvsm stimulus -o FILE``) on the RTL, spike for spike.
@@ -207,12 +209,14 @@ def replay(
                             f"the expectation from its codes")
     name = Path(stimulus).stem or "stimulus"
     harness = choose_harness(harness, arch, c.height * c.width, stim.num_steps, options)
+    check_code_coverage(code_coverage, harness, sim)
     if harness == "chunk":
         source = StimulusChunks.from_stimulus(
             stim, str(Path(stimulus).resolve())
             if whole_file and not recompute_expected else None)
         result = check_chunks(source, sim, work_dir=work_dir, name=name, arch=arch,
                               waves=waves, progress=progress, chunk_steps=chunk_steps,
+                              code_coverage=code_coverage,
                               **options)
     else:
         result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=name,
@@ -235,6 +239,7 @@ def verify(
     harness: str = "cycle",
     progress: bool = False,
     chunk_steps: int = DEFAULT_CHUNK_STEPS,
+    code_coverage: bool = False,
     **options: int | None,
 ) -> dict:
     """Verify the RTL of design point ``fixed`` (TOML) on ``scene``, spike for spike.
@@ -268,6 +273,7 @@ def verify(
     harness = choose_harness(harness, arch, h * w,
                              scene.num_steps if steps is None else steps, options,
                              reloadable=scene.source is not None)
+    check_code_coverage(code_coverage, harness, sim)
     if harness == "chunk":
         if steps is not None and steps > scene.num_steps:
             raise RvsmError(f"--steps {steps} is more than the {scene.num_steps} steps of "
@@ -275,6 +281,7 @@ def verify(
         source = StimulusChunks.from_scene(scene, point, steps)
         result = check_chunks(source, sim, work_dir=work_dir, name=scene.name or "scene",
                               arch=arch, waves=waves, progress=progress, chunk_steps=chunk_steps,
+                              code_coverage=code_coverage,
                               **options)
         result.update(scene=scene.source or scene.name, point=str(fixed), height=h,
                       width=w, coverage=None)
@@ -299,6 +306,7 @@ def random_verify(
     harness: str = "cycle",
     progress: bool = False,
     chunk_steps: int = DEFAULT_CHUNK_STEPS,
+    code_coverage: bool = False,
     **options: int | None,
 ) -> dict:
     """Verify the RTL of design point ``fixed`` on a seeded random and corner stimulus
@@ -320,10 +328,12 @@ def random_verify(
     stim = corner_stimulus(point.contract(), seed, steps)
     stim.point = point
     harness = choose_harness(harness, arch, point.height * point.width, steps, options)
+    check_code_coverage(code_coverage, harness, sim)
     if harness == "chunk":
         result = check_chunks(StimulusChunks.from_stimulus(stim), sim, work_dir=work_dir,
                               name=f"random{seed}", arch=arch, waves=waves,
                               progress=progress, chunk_steps=chunk_steps,
+                              code_coverage=code_coverage,
                               **options)
     else:
         result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
@@ -346,6 +356,13 @@ def choose_harness(harness: str, arch: str | Architecture, pixels: int, steps: i
             AUTO_CHUNK_BEATS:
         return "chunk"
     return "cycle"
+
+
+def check_code_coverage(code_coverage: bool, harness: str, sim: str) -> None:
+    """Refuse code coverage outside the long-run harness on Verilator."""
+    if code_coverage and (harness != "chunk" or sim != "verilator"):
+        raise RvsmError("code coverage is built for Verilator runs in the long-run harness: "
+                        "use --sim verilator --harness chunk")
 
 
 def check_harness(harness: str, arch: str | Architecture) -> None:

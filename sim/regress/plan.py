@@ -19,6 +19,7 @@ A plan is TOML with three tables::
     steps = 200                    # steps per run
     scenes = ["coin"]              # scene runs (optional)
     seeds = { start = 0, stop = 8 }  # random and corner stimuli (optional; or a list)
+    code_coverage = false          # Verilator line and toggle coverage, merged (chunk)
 
 Its runs are the product (scenes, then seeds) x models x lanes x simulators, each with
 a key (a digest of everything that makes it) under which the database keeps its result
@@ -49,7 +50,7 @@ __all__ = ["RegressionPlan", "RunSpec", "load_plan", "parse_plan"]
 
 SECTIONS = ("regression", "base", "run")
 RUN_KEYS = ("models", "size", "arch", "lanes", "simulators", "harness", "steps", "scenes",
-            "seeds")
+            "seeds", "code_coverage")
 
 
 @dataclass(frozen=True)
@@ -67,6 +68,7 @@ class RunSpec:
     sim: str
     harness: str
     steps: int
+    code_coverage: bool = False
 
     @property
     def key(self) -> str:
@@ -179,6 +181,12 @@ def parse_plan(text: str, source: str = "plan",
         if not isinstance(sc, str) or not is_builtin(sc):
             raise RvsmError(f"{source}: run.scenes: {sc!r} is not a built-in scene name")
     seeds = _seeds(raw.get("seeds"), source)
+    code_coverage = raw.get("code_coverage", False)
+    if not isinstance(code_coverage, bool):
+        raise RvsmError(f"{source}: run.code_coverage must be true or false")
+    if code_coverage and (harness != "chunk" or set(sims) != {"verilator"}):
+        raise RvsmError(f"{source}: run.code_coverage needs harness = \"chunk\" and "
+                        "simulators = [\"verilator\"]")
     if not scenes and not seeds:
         raise RvsmError(f"{source}: [run] needs scenes or seeds (or both)")
     runs = []
@@ -189,7 +197,7 @@ def parse_plan(text: str, source: str = "plan",
             for p in lanes:
                 for sim in sims:
                     runs.append(RunSpec(name, stimulus, model, design_point_toml(point),
-                                        size, arch, p, sim, harness, steps))
+                                        size, arch, p, sim, harness, steps, code_coverage))
     return RegressionPlan(name, source, tuple(runs))
 
 

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from rvsm.model.infra.progress import progress_bar
+from rvsm.sim.cosim.code_coverage import merge, summary, write_coverage, write_lcov
 from rvsm.sim.regress.plan import RegressionPlan
 from rvsm.sim.regress.report import closure_lines, write_junit
 from rvsm.sim.regress.store import RegressionStore
@@ -33,6 +34,7 @@ class RegressionSummary:
     ran: int = 0
     skipped: int = 0
     closure: list[str] = field(default_factory=list)
+    code_coverage: list[str] = field(default_factory=list)  # lines: merged files, summary
 
     def count(self, status: str) -> int:
         """Runs with ``status`` (``pass``, ``fail``, ``error``)."""
@@ -42,6 +44,25 @@ class RegressionSummary:
     def exit_status(self) -> int:
         """1 if a run mismatched, else 3 if a run failed to complete, else 0."""
         return 1 if self.count("fail") else 3 if self.count("error") else 0
+
+
+def merge_code_coverage(rows: list[dict[str, Any]], db: Path) -> list[str]:
+    """Merge the runs' Verilator ``coverage.dat`` into ``<db>-coverage/merged.dat`` and
+    ``lcov.info``; the report's lines (empty when no run has code coverage)."""
+    files = [r["code_coverage"] for r in rows
+             if r.get("code_coverage") and Path(r["code_coverage"]).exists()]
+    if not files:
+        return []
+    out = db.with_name(f"{db.stem}-coverage")
+    out.mkdir(parents=True, exist_ok=True)
+    points = merge(files)
+    write_coverage(points, out / "merged.dat")
+    write_lcov(points, out / "lcov.info")
+    kinds = ", ".join(f"{k} {hit}/{n} ({100 * hit / max(n, 1):.1f}%)"
+                      for k, (hit, n) in summary(points).items())
+    return [f"{len(files)} run(s) merged: {kinds} points hit",
+            f"{out / 'merged.dat'} (verilator_coverage format), {out / 'lcov.info'} "
+            "(genhtml makes HTML of it)"]
 
 
 def run_regression(plan: RegressionPlan, db: str | os.PathLike,
@@ -68,7 +89,8 @@ def run_regression(plan: RegressionPlan, db: str | os.PathLike,
                     bar.update(1)
             bar.close()
         rows = store.rows({s.key for s in plan.runs})
-    summary = RegressionSummary(rows, ran, len(plan.runs) - len(todo), closure_lines(rows))
+    summary = RegressionSummary(rows, ran, len(plan.runs) - len(todo), closure_lines(rows),
+                                merge_code_coverage(rows, Path(db)))
     if junit is not None:
         write_junit(junit, plan.name, rows)
     return summary

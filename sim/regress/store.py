@@ -3,10 +3,10 @@
 SQLite (WAL), written by the calling process only. ``runs`` holds every run of every
 plan written into the file: its key (:attr:`~.plan.RunSpec.key`), plan, label, the
 run's fields, ``status`` (``pass`` / ``fail`` / ``error``), figures, the first mismatch
-and the functional coverage (JSON), the run folder and waveform. A run is written once
-under its key (``INSERT OR REPLACE``): a killed regression resumes with the runs whose
-status is ``pass`` or ``fail`` skipped, and nothing is counted twice; ``error`` rows are
-retried.
+and the functional coverage (JSON), the run folder, waveform and Verilator coverage
+file. A run is written once under its key (``INSERT OR REPLACE``): a killed regression
+resumes with the runs whose status is ``pass`` or ``fail`` skipped, and nothing is
+counted twice; ``error`` rows are retried.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ CREATE TABLE IF NOT EXISTS runs (
     arch TEXT, lanes INTEGER, sim TEXT, harness TEXT, steps INTEGER, status TEXT,
     mismatches INTEGER, compared INTEGER, first_mismatch TEXT, coverage TEXT,
     cycles_per_second REAL, seconds REAL, run_dir TEXT, waves TEXT, error TEXT,
-    finished TEXT
+    finished TEXT, code_coverage TEXT
 );
 """
 DONE = ("pass", "fail")
@@ -78,14 +78,15 @@ class RegressionStore:
 
     def _insert(self, spec: RunSpec, record: dict[str, Any], j: Any) -> None:
         self.db.execute(
-            "INSERT OR REPLACE INTO runs VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
+            "INSERT OR REPLACE INTO runs VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
             (spec.key, spec.plan, spec.label, spec.stimulus, spec.model,
              f"{spec.size[0]}x{spec.size[1]}", spec.arch, spec.lanes, spec.sim,
              spec.harness, spec.steps, record["status"], record.get("mismatches"),
              record.get("compared"), j(record.get("first_mismatch")),
              j(record.get("coverage")), record.get("cycles_per_second"),
              record.get("seconds"), record.get("run_dir"), record.get("waves"),
-             record.get("error"), datetime.now(timezone.utc).isoformat(timespec="seconds")))
+             record.get("error"), datetime.now(timezone.utc).isoformat(timespec="seconds"),
+             record.get("code_coverage")))
         self.db.commit()
 
     def rows(self, keys: set[str] | None = None) -> list[dict[str, Any]]:

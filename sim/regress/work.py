@@ -44,7 +44,9 @@ class RegressionWork:
         point = work / "points" / f"{s.key}.toml"
         point.parent.mkdir(parents=True, exist_ok=True)
         write_text_atomic(point, s.point_toml)
-        options = {"lanes": s.lanes} if s.lanes else {}
+        options: dict = {"lanes": s.lanes} if s.lanes else {}
+        if s.code_coverage:
+            options["code_coverage"] = True
         kind, _, what = s.stimulus.partition(":")
         t0 = time.perf_counter()
         try:
@@ -62,4 +64,5 @@ class RegressionWork:
                 "first_mismatch": r.get("first_mismatch"), "coverage": r.get("coverage"),
                 "cycles_per_second": r.get("cycles_per_second"),
                 "seconds": time.perf_counter() - t0, "run_dir": r.get("run_dir"),
-                "waves": r.get("waves"), "error": None}
+                "waves": r.get("waves"), "code_coverage": r.get("code_coverage"),
+                "error": None}

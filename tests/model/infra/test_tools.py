@@ -15,6 +15,7 @@ import pytest
 
 from rvsm.model.infra.errors import ToolError
 from rvsm.model.infra.tools import ToolFailure, describe_status, live_groups, run_tool
+from tests.conftest import default_signals
 
 
 def _alive(pid: int) -> bool:
@@ -84,7 +85,7 @@ def test_interrupted_parent_kills_the_tool_group(tmp_path: Path, sig: int) -> No
         except KeyboardInterrupt:
             sys.exit(130)
     """)
-    proc = subprocess.Popen([sys.executable, "-c", script])
+    proc = subprocess.Popen([sys.executable, "-c", script], preexec_fn=default_signals)
     end = time.monotonic() + 20
     while not (pid_file.exists() and pid_file.read_text().strip()):
         assert time.monotonic() < end and proc.poll() is None

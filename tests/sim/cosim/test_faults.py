@@ -32,6 +32,7 @@ from rvsm.model.fixed.point_toml import save_design_point
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.sim.cosim.build_cache import build, build_key
 from rvsm.sim.cosim.simulation import run_testbench
+from tests.conftest import default_signals
 
 RVSM = str(Path(sys.executable).parent / "rvsm")
 IVERILOG = shutil.which("iverilog") or "iverilog"
@@ -133,7 +134,7 @@ def _signal_at(cmd: list[str], sig: int, ready: Callable[[dict[int, str], str], 
 
     with tempfile.TemporaryFile("w+") as errf:
         proc = subprocess.Popen([RVSM, *cmd], stdout=subprocess.DEVNULL, stderr=errf,
-                                env=env)
+                                env=env, preexec_fn=default_signals)
         seen: dict[int, str] = {}
         end = time.monotonic() + timeout
         try:
@@ -214,7 +215,8 @@ def test_compiler_failure_is_exit_3_and_keeps_its_log(tmp_path: Path) -> None:
 def test_real_simulator_killed_mid_run_is_exit_3(tmp_path: Path) -> None:
     work = tmp_path / "w"
     proc = subprocess.Popen([RVSM, *_long_verify_args(_point(tmp_path / "p.toml"), work)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=default_signals)
     end = time.monotonic() + 300
     vvp = None
     while vvp is None:
@@ -471,7 +473,8 @@ def test_verilator_binary_killed_is_exit_3(tmp_path: Path) -> None:
     work = tmp_path / "w"
     cmd = [RVSM, *_long_verify_args(_point(tmp_path / "p.toml"), work), "--sim",
            "verilator"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=default_signals)
     end = time.monotonic() + 900
     sim = None
     while sim is None:

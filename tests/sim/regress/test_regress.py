@@ -65,6 +65,11 @@ def test_plan_expands_and_refuses_bad_fields(tmp_path: Path) -> None:
         parse_plan(TINY.replace('[run]', '[run]\narch = "parallel"'), "p")
     with pytest.raises(RvsmError, match="needs scenes or seeds"):
         parse_plan(TINY.replace('scenes = ["coin"]', "").replace("seeds = [1, 2]", ""), "p")
+    with pytest.raises(RvsmError, match="run.code_coverage needs harness"):
+        parse_plan(TINY.replace("[run]", "[run]\ncode_coverage = true"), "p")
+    with_cov = parse_plan(TINY.replace("[run]", "[run]\ncode_coverage = true")
+                          .replace('"icarus"', '"verilator"'), "p")
+    assert all(r.code_coverage for r in with_cov.runs)
     with pytest.raises(RvsmError, match="unknown key run.colour"):
         parse_plan(TINY.replace("[run]", "[run]\ncolour = 1"), "p")
 
