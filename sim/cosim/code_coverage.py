@@ -23,6 +23,9 @@ from rvsm.model.infra.errors import RvsmError
 __all__ = ["merge", "read_coverage", "summary", "write_coverage", "write_lcov"]
 
 _POINT = re.compile(r"^C '(.*)' (\d+)$")
+#: A build compiles in ``<folder>.tmp<pid>`` and is renamed into place when done
+#: (:func:`rvsm.sim.cosim.build_cache.build`): the sources are in the final folder.
+_STAGING = re.compile(r"\.tmp\d+(?=/)")
 HEADER = "# SystemC::Coverage-3\n"
 
 
@@ -74,13 +77,15 @@ def write_coverage(points: Counter[str], path: str | os.PathLike) -> None:
 
 def write_lcov(points: Counter[str], path: str | os.PathLike) -> None:
     """The line points as an lcov tracefile (``genhtml`` makes HTML of it): per source
-    file, ``DA:<line>,<count>`` with the counts of a line's points summed."""
+    file (its path in the finished build folder), ``DA:<line>,<count>`` with the counts
+    of a line's points summed."""
     per_file: dict[str, Counter[int]] = {}
     for text, count in points.items():
         f = _fields(text)
         if not f.get("page", "").startswith("v_line/") or "f" not in f or "l" not in f:
             continue
-        per_file.setdefault(f["f"], Counter())[int(f["l"])] += count
+        name = _STAGING.sub("", f["f"])
+        per_file.setdefault(name, Counter())[int(f["l"])] += count
     out = ["TN:rvsm\n"]
     for name, lines in sorted(per_file.items()):
         out.append(f"SF:{name}\n")

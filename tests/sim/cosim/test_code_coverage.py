@@ -32,7 +32,7 @@ def _dat(path: Path, points: dict[str, int]) -> Path:
 
 
 def test_merge_summary_and_lcov(tmp_path: Path) -> None:
-    a, b = _point("x.v", 3, "v_line/top"), _point("x.v", 9, "v_line/top")
+    a, b = _point("x.v", 3, "v_line/top"), _point("b/c.tmp123/x.v", 9, "v_line/top")
     t = _point("x.v", 4, "v_toggle/top", "sig")
     one = _dat(tmp_path / "1.dat", {a: 2, b: 0, t: 0})
     two = _dat(tmp_path / "2.dat", {a: 1, b: 0, t: 5})
@@ -43,7 +43,8 @@ def test_merge_summary_and_lcov(tmp_path: Path) -> None:
     assert read_coverage(tmp_path / "m.dat") == points  # round trip
     write_lcov(points, tmp_path / "lcov.info")
     text = (tmp_path / "lcov.info").read_text()
-    assert "SF:x.v\nDA:3,3\nDA:9,0\nLH:1\nLF:2\nend_of_record" in text
+    assert "SF:x.v\nDA:3,3\nLH:1\nLF:1\nend_of_record" in text
+    assert "SF:b/c/x.v\nDA:9,0\nLH:0\nLF:1\nend_of_record" in text  # the final folder
     (tmp_path / "bad.dat").write_text("hello\n")
     with pytest.raises(RvsmError, match="not a Verilator coverage file"):
         read_coverage(tmp_path / "bad.dat")
