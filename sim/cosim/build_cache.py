@@ -142,19 +142,21 @@ def tool_versions(sim: str) -> dict[str, str]:
 
 
 def build_key(contract: ArrayContract, sim: str, top: str, traced: bool,
-              extra: Sequence[str] = (), design: CosimDesign | None = None
-              ) -> tuple[str, dict]:
+              extra: Sequence[str] = (), design: CosimDesign | None = None,
+              harness: bool = False, coverage: bool = False) -> tuple[str, dict]:
     """Digest (16 hex digits) and fields of everything that changes a build's binary:
     the RTL (:meth:`CosimDesign.digest` of ``design``, default :func:`cosim_design`'s),
-    the build recipe, simulator, top, tracing, build flags, the C++ optimisation, the tool
-    versions (:func:`tool_versions`) and ``extra``. Two builds with equal keys are
+    the build recipe, simulator, top, tracing, the long-run harness (its version),
+    code coverage, build flags, the C++ optimisation, the tool versions
+    (:func:`tool_versions`) and ``extra``. Two builds with equal keys are
     interchangeable."""
     design = design or cosim_design()
     fields = {
         "recipe": _BUILD_VERSION, "rtl": design.digest(contract),
         "sim": sim, "top": top,
-        "traced": traced, "build_args": build_args(sim, traced, "coverage" in extra),
-        "cxx_opt": cxx_opt("harness" in extra) if sim == "verilator" else "",
+        "traced": traced, "harness": HARNESS_VERSION if harness else None,
+        "coverage": coverage, "build_args": build_args(sim, traced, coverage),
+        "cxx_opt": cxx_opt(harness) if sim == "verilator" else "",
         "versions": tool_versions(sim), "extra": list(extra),
     }
     text = json.dumps(fields, sort_keys=True)
@@ -196,9 +198,8 @@ def build(
     digest = design.digest(contract)
     if coverage and sim != "verilator":
         raise RvsmError("code coverage needs Verilator (--sim verilator)")
-    extra = (["harness", HARNESS_VERSION] if harness else []) + (["coverage"] if coverage
-                                                                  else [])
-    key, key_fields = build_key(contract, sim, top, traced, extra, design=design)
+    key, key_fields = build_key(contract, sim, top, traced, design=design, harness=harness,
+                                coverage=coverage)
     suffix = (("-trace" if (traced and sim == "verilator") else "")
               + ("-chunks" if harness else "") + ("-cov" if coverage else ""))
     base = Path(build_root).resolve()
