@@ -39,6 +39,7 @@ from cocotb.triggers import FallingEdge, RisingEdge
 from rvsm.model.fixed.stimulus_chunks import open_stimulus_chunks
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.rtl.ports import load_ports_json
+from rvsm.rtl.stream.coverage import BorderCoverage
 from rvsm.rtl.stream.drive import threshold_writes
 from rvsm.rtl.stream.schedule import OutputBeats, StreamChecker
 from rvsm.sim.cosim.chunk_harness import (
@@ -99,6 +100,7 @@ async def stream_long_run(dut: object) -> None:
     h["thr_we"].value = 0
 
     checker = StreamChecker(sched)
+    border = BorderCoverage(c, lanes)
     timings = {"wait_for_twin": 0.0, "encode": 0.0, "simulate": 0.0, "decode": 0.0, "check": 0.0}
     beats_sent = chunks = 0
     steps_done = expected_spikes = 0
@@ -178,6 +180,7 @@ async def stream_long_run(dut: object) -> None:
             h["clear"].value = 0
             checker.restart(chunk.t0)
         checker.expect(chunk.spikes)
+        border.update(chunk.spikes)
         expected_spikes += int(np.count_nonzero(chunk.spikes))
         await send(parts)
         steps_done = chunk.t0 + chunk.num_steps
@@ -212,6 +215,7 @@ async def stream_long_run(dut: object) -> None:
         "steps": steps_done,
         "accumulators": scales * c.height * c.width,
         "expected_spikes": expected_spikes,
+        "lane_coverage": border.bins(),
         "lanes": lanes,
         "harness": "chunk",
         "chunks": chunks,

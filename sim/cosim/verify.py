@@ -222,7 +222,7 @@ def replay(
         result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=name,
                                 arch=arch, **options)
     result.update(stimulus=str(stimulus), height=c.height, width=c.width,
-                  coverage=_coverage(stim),
+                  coverage=with_lane_coverage(_coverage(stim), result),
                   expectation="recomputed" if recompute_expected else "file")
     return result
 
@@ -284,7 +284,7 @@ def verify(
                               code_coverage=code_coverage,
                               **options)
         result.update(scene=scene.source or scene.name, point=str(fixed), height=h,
-                      width=w, coverage=None)
+                      width=w, coverage=result.get("lane_coverage"))
         return result
     stim = make_stimulus(scene, point, num_steps=steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
@@ -339,7 +339,7 @@ def random_verify(
         result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
                                 name=f"random{seed}", arch=arch, **options)
     result.update(seed=seed, point=str(fixed), height=point.height, width=point.width,
-                  coverage=coverage(stim))
+                  coverage=with_lane_coverage(coverage(stim), result))
     return result
 
 
@@ -374,6 +374,17 @@ def check_harness(harness: str, arch: str | Architecture) -> None:
     if harness == "chunk" and name not in LONG_RUN_TESTBENCHES:
         raise RvsmError(f"--harness chunk drives the {', '.join(LONG_RUN_TESTBENCHES)} "
                         f"architecture only; use --harness cycle for --arch {name}")
+
+
+def with_lane_coverage(bins: list[dict], result: dict) -> list[dict]:
+    """The stimulus's coverage ``bins`` per scale plus, for a long run, the lanes'
+    border bins it measured (``lane_coverage``, :mod:`rvsm.rtl.stream.coverage`; its
+    spike counts are already among ``bins``)."""
+    lanes = result.get("lane_coverage")
+    if not lanes:
+        return bins
+    return [{**b, **{k: v for k, v in extra.items() if k not in b}}
+            for b, extra in zip(bins, lanes, strict=True)]
 
 
 def _coverage(stim: Stimulus) -> list[dict]:

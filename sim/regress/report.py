@@ -1,11 +1,13 @@
 """What a regression reports: functional coverage merged over runs with its closure
 (the bins never hit), and JUnit XML with one test case per run.
 
-Coverage bins are those of :func:`rvsm.model.fixed.corner_stimulus.coverage` (per scale:
-codes at 0 and full scale, exact threshold hits of both signs, both saturation rails,
-spikes of both signs, a clear mid-stream); a run contributes when it measured coverage
-(random and corner seeds always; scene runs with the per-cycle testbench). Bins the
-contract cannot reach (``None``) are left out of the closure.
+Coverage bins, per scale, are those of :func:`rvsm.model.fixed.corner_stimulus.coverage`
+(codes at 0 and full scale, exact threshold hits of both signs, both saturation rails,
+spikes of both signs, a clear mid-stream; measured on seed runs and on scene runs with
+the per-cycle testbench) and, for runs in the long-run harness, the lanes at the image
+borders (:class:`rvsm.rtl.stream.coverage.BorderCoverage`: ``top_lane<i>``, ...; a bin
+is named by its lane, so plans with several lane counts close each). Bins a contract
+cannot reach (``None`` in every run) are left out of the closure.
 """
 
 from __future__ import annotations
@@ -29,9 +31,10 @@ def merged_coverage(rows: Sequence[dict[str, Any]]) -> dict[str, list[dict[str, 
         cov = row.get("coverage")
         if not cov:
             continue
-        into = merged.setdefault(row["model"], [dict.fromkeys(b) for b in cov])
+        into = merged.setdefault(row["model"], [{} for _ in cov])
         for scale, bins in enumerate(cov):
             for name, n in bins.items():
+                into[scale].setdefault(name, None)
                 if n is not None:
                     into[scale][name] = (into[scale][name] or 0) + int(n)
     return merged

@@ -131,6 +131,7 @@ def test_cli_verify_with_the_long_run_harness(tmp_path: Path,
                  "--harness", "chunk", "--json", "--work", work]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["mismatches"] == 0 and out["harness"] == "chunk" and out["steps"] == 15
+    assert {"spike_pos", "top_lane0", "bottom_lane1"} <= set(out["coverage"][0])
     assert out["compared"] == 15 * 2 * 6 * 8
     assert main(["verify", "coin", "--fixed", str(point), "--steps", "5", "--lanes", "2",
                  "--harness", "chunk", "--waves", "--json", "--work", work]) == 0

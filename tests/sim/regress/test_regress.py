@@ -81,8 +81,10 @@ def test_regression_runs_resumes_and_reports(tmp_path: Path) -> None:
     db, work, junit = tmp_path / "r.sqlite", tmp_path / "w", tmp_path / "r.xml"
     s = run_regression(plan, db, work, workers=0, junit=junit, progress=False)
     assert (s.ran, s.skipped, s.count("pass"), s.exit_status) == (3, 0, 3, 0)
-    assert any("scale 0:" in line for line in s.closure)
-    assert "1 run(s) measured no functional coverage" in s.closure[-1]
+    scale0 = next(line for line in s.closure if "scale 0:" in line)
+    hit, total = (int(v) for v in scale0.split(":")[1].split()[0].split("/"))
+    assert total > 9 and hit > 0  # the nine stimulus bins and the lanes at the borders
+    assert not any("measured no functional coverage" in line for line in s.closure)
     suite = ET.parse(junit).getroot().find("testsuite")
     assert suite is not None and suite.get("tests") == "3" and suite.get("failures") == "0"
     assert len(suite.findall("testcase")) == 3
