@@ -156,3 +156,20 @@ def test_auto_harness_takes_the_long_run_one_for_long_streams() -> None:
     assert choose_harness("auto", "stream", big, 1, {}, reloadable=False) == "cycle"
     assert choose_harness("auto", "parallel", big, 10, {}) == "cycle"
     assert choose_harness("cycle", "stream", big, 10, {}) == "cycle"
+
+
+@pytest.mark.slow
+def test_full_sensor_long_run(cosim_work: Path, tmp_path: Path,
+                              capsys: pytest.CaptureFixture) -> None:
+    """The default 250x400 dog4 point at P=40 on Verilator, 200 steps in the long-run
+    harness (``--harness auto`` picks it): 0 mismatches (about 2 minutes with the build;
+    the one-second run is `make long-run`)."""
+    point = tmp_path / "p.toml"
+    save_design_point(point, default_design_point())
+    rc = main(["verify", "character", "--fixed", str(point), "--sim", "verilator",
+               "--steps", "200", "--lanes", "40", "--json", "--work", str(cosim_work)])
+    out = json.loads(capsys.readouterr().out)
+    print({k: out[k] for k in ("compared", "mismatches", "cycles_per_second",
+                               "build_seconds", "stream_seconds")})
+    assert rc == 0 and out["mismatches"] == 0 and out["harness"] == "chunk"
+    assert out["compared"] == 200 * 4 * 250 * 400
