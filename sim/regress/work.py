@@ -17,9 +17,20 @@ from typing import Any, ClassVar
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.model.infra.tools import ToolFailure
+from rvsm.model.scene.scene import DEFAULT_STEPS_PER_FRAME, Scene
 from rvsm.sim.regress.plan import RunSpec
 
 __all__ = ["RegressionWork"]
+
+
+def scene_for(spec: RunSpec) -> Scene:
+    """The built-in scene of a scene run, rendered at the run's size with enough frames
+    for its steps (at the default steps per frame)."""
+    from rvsm.model.scene.loaders import load_scene
+
+    name = spec.stimulus.partition(":")[2]
+    frames = -(-spec.steps // DEFAULT_STEPS_PER_FRAME) + 1
+    return load_scene(name, size=spec.size, num_frames=frames)
 
 
 @dataclass(frozen=True)
@@ -51,7 +62,7 @@ class RegressionWork:
         t0 = time.perf_counter()
         try:
             if kind == "scene":
-                r = verify(what, point, s.sim, steps=s.steps, size=s.size, work_dir=work,
+                r = verify(scene_for(s), point, s.sim, steps=s.steps, size=s.size, work_dir=work,
                            arch=s.arch, harness=s.harness, **options)
             else:
                 r = random_verify(point, int(what), s.steps, s.sim, size=s.size,

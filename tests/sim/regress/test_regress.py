@@ -14,6 +14,7 @@ from rvsm.sim.cli import main
 from rvsm.sim.regress.plan import load_plan, parse_plan
 from rvsm.sim.regress.run import run_regression
 from rvsm.sim.regress.store import RegressionStore
+from rvsm.sim.regress.work import scene_for
 
 TINY = """
 [regression]
@@ -124,3 +125,10 @@ def test_regress_exit_statuses(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     bad = _plan(tmp_path, TINY.replace("steps = 40", "steps = -1"))
     assert main(["regress", str(bad), "-o", str(tmp_path / "b.sqlite"), *common]) == 2
     assert "run.steps must be an integer >= 1" in capsys.readouterr().err
+
+
+def test_scene_runs_render_enough_frames() -> None:
+    """A scene run longer than a built-in scene's default length renders more frames."""
+    plan = parse_plan(TINY.replace("steps = 40", "steps = 1234"), "p")
+    scene = scene_for(plan.runs[0])
+    assert scene.num_steps >= 1234 and scene.shape == (6, 8)
