@@ -6,7 +6,8 @@ logic is exercised lane by lane. :class:`BorderCoverage` counts, per scale, the 
 spikes at accumulators ``(s, y, x)`` in each border band of each lane ``i = x % P``
 (bins ``top_lane<i>``, ``bottom_lane<i>`` for the first and last ``R`` rows,
 ``left_lane<i>``, ``right_lane<i>`` for the first and last ``R`` columns; ``None`` where
-no column of lane ``i`` lies in that band), plus ``spike_pos`` and ``spike_neg``. It is
+no column of lane ``i`` lies in that band), plus ``spike_pos`` and ``spike_neg`` (None
+for a scale whose sums cannot go negative, as in every Gauss model). It is
 fed the expected spikes chunk by chunk, so a long run measures it in bounded memory.
 """
 
@@ -37,7 +38,8 @@ class BorderCoverage:
         self.reachable = np.array([[np.any(self.masks[side] & (self.lane == i))
                                     for i in range(self.lanes)] for side in SIDES])
         self.signs = np.zeros((c.num_scales, 2), dtype=np.int64)
-        self.signed = c.signed
+        # a -1 spike needs a signed model and a scale whose sums can go negative
+        self.negative = [c.signed and c.sum_range(s)[0] < 0 for s in range(c.num_scales)]
 
     def update(self, spikes: np.ndarray) -> None:
         """Count the spikes ``(B, S, H, W)`` of the next steps."""
@@ -60,7 +62,7 @@ class BorderCoverage:
         for scale in range(self.counts.shape[0]):
             d: dict[str, int | None] = {
                 "spike_pos": int(self.signs[scale, 0]),
-                "spike_neg": int(self.signs[scale, 1]) if self.signed else None}
+                "spike_neg": int(self.signs[scale, 1]) if self.negative[scale] else None}
             for k, side in enumerate(SIDES):
                 for i in range(self.lanes):
                     d[f"{side}_lane{i}"] = (int(self.counts[scale, k, i])

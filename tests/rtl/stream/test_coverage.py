@@ -41,3 +41,5 @@ def test_border_bins_match_a_slow_count(small_contract) -> None:
     assert any(bins[0][f"left_lane{i}"] is None for i in range(lanes))  # r < lanes
     fsm = small_contract("fsm", 4, 4)
     assert BorderCoverage(fsm, 2).bins()[0]["spike_neg"] is None
+    gauss = small_contract("gauss2", 4, 4)  # non-negative weights: no -1 spike
+    assert all(b["spike_neg"] is None for b in BorderCoverage(gauss, 2).bins())
