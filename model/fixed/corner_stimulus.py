@@ -28,7 +28,7 @@ from rvsm.model.fixed.stimulus import Stimulus
 from rvsm.model.fixed.widths import signed_range, unsigned_max
 from rvsm.model.infra.errors import RvsmError
 
-__all__ = ["BINS", "corner_stimulus", "coverage", "coverage_summary"]
+__all__ = ["BINS", "corner_stimulus", "coverage", "coverage_summary", "min_steps"]
 
 #: Coverage bins, per scale: codes at 0 / full scale (the pixel's own code), an
 #: accumulator exactly at +threshold / -threshold, pre-saturation value above the top /
@@ -63,6 +63,11 @@ def _negative_extreme(contract: ArrayContract, scale: int) -> np.ndarray:
     return img
 
 
+def min_steps(contract: ArrayContract) -> int:
+    """The fewest steps :func:`corner_stimulus` takes for ``contract``."""
+    return max(MIN_STEPS, 2 * (len(_segment_images(contract, level=0)) + 1))
+
+
 def corner_stimulus(contract: ArrayContract, seed: int, steps: int) -> Stimulus:
     """A seeded ``steps``-step random and corner stimulus for ``contract`` (expected
     spikes from :meth:`ArrayContract.run`); same seed, same stimulus.
@@ -75,11 +80,10 @@ def corner_stimulus(contract: ArrayContract, seed: int, steps: int) -> Stimulus:
     """
     c = contract
     h, w, s = c.height, c.width, c.num_scales
-    images = _segment_images(c, level=0)
-    need = 2 * (len(images) + 1)
-    if isinstance(steps, bool) or int(steps) < max(MIN_STEPS, need):
+    need = min_steps(c)
+    if isinstance(steps, bool) or int(steps) < need:
         raise RvsmError(f"a random/corner stimulus for this point needs --steps >= "
-                        f"{max(MIN_STEPS, need)}, got {steps}")
+                        f"{need}, got {steps}")
     rng = np.random.default_rng(seed)
     full = unsigned_max(c.adc_bits)
     top = (1 << c.threshold_bits) - 1

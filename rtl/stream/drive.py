@@ -18,10 +18,11 @@ from rvsm.model.fixed.core import ArrayContract
 from rvsm.rtl.simulation import run_simulation
 from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.protocol import ProtocolScript
 from rvsm.rtl.stream.schedule import OutputBeats, pack_lanes
 from rvsm.rtl.stream.signatures import threshold_word_bits
 
-__all__ = ["BeatCollector", "colliding_threshold_writes", "simulate",
+__all__ = ["BeatCollector", "colliding_threshold_writes", "simulate", "simulate_script",
            "simulate_with_threshold_writes", "threshold_writes", "write_thresholds"]
 
 #: Payload fields of an output beat, in :meth:`OutputBeats.from_words` order.
@@ -177,6 +178,35 @@ def simulate_with_threshold_writes(
 
     run_simulation(dut, bench)
     return out.beats()
+
+
+def simulate_script(script: ProtocolScript, bank_words: int = StreamGeometry.BANK_WORDS,
+                    mutation: str | None = None, vcd_path: str | None = None,
+                    ) -> tuple[OutputBeats, list[int]]:
+    """Drive a :class:`~rvsm.rtl.stream.protocol.ProtocolScript` cycle by cycle; return
+    the output beats and the edge after which each was presented (compare both with
+    :func:`~rvsm.rtl.stream.protocol.check_script`)."""
+    dut = RvsmStreamArray(script.contract, script.lanes, bank_words, mutation=mutation)
+    out = BeatCollector(dut)
+    cycles: list[int] = []
+    payload, addr, data = script.payload_words(), script.thr_addresses(), script.thr_words()
+
+    async def bench(ctx) -> None:  # noqa: ANN001 - SimulatorContext
+        for cyc in range(script.num_cycles):
+            ctx.set(dut.codes.valid, bool(script.valid[cyc]))
+            ctx.set(dut.codes.payload.as_value(), payload[cyc])
+            ctx.set(dut.clear, bool(script.clear[cyc]))
+            ctx.set(dut.thr.we, bool(script.thr_we[cyc]))
+            ctx.set(dut.thr.addr, addr[cyc])
+            ctx.set(dut.thr.data, data[cyc])
+            await ctx.tick()
+            before = len(out.got["row"])
+            out.after_edge(ctx, -1)
+            if len(out.got["row"]) > before:
+                cycles.append(cyc)
+
+    run_simulation(dut, bench, vcd_path)
+    return out.beats(), cycles
 
 
 def colliding_threshold_writes(

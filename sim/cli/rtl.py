@@ -44,7 +44,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Build the generated Verilog on Icarus or Verilator, drive a stimulus, "
         "compare every spike. Either SCENE --fixed POINT.toml (the fixed twin makes the "
         "stimulus), --stimulus FILE (replay a file written by `rvsm stimulus`) or "
-        "--random SEED --fixed POINT.toml (seeded random and corner stimulus). Exit "
+        "--random SEED --fixed POINT.toml (seeded random and corner stimulus) or "
+        "--protocol SEED --fixed POINT.toml (streaming array: a seeded cycle-by-cycle "
+        "script of stalls, clears at any position and threshold writes meeting reads). Exit "
         "status: 0 pass, 1 mismatches, 2 bad input, 3 tool or environment failure, "
         "130 interrupted (docs/cli.md).",
     )
@@ -61,6 +63,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="drive a seeded random and corner stimulus (codes at 0 and full "
                    "scale, exact threshold hits, both saturation rails, clears "
                    "mid-stream) instead of a scene; needs --fixed, --size, --steps")
+    p.add_argument("--protocol", metavar="SEED", type=int,
+                   help="--arch stream: drive a seeded protocol script cycle by cycle "
+                   "(stalls, clears at every kind of position in a frame, threshold writes "
+                   "at the very edge that reads the same word); checks every output beat's "
+                   "cycle too; needs --fixed, --size, --steps (docs/stream-array.md)")
     p.add_argument("--sim", choices=SIMULATORS, default="icarus")
     p.add_argument("--steps", type=int, help="simulate only the first N steps")
     add_scene_arguments(p, positional=False)
@@ -159,7 +166,25 @@ def _scene_shaping(args: argparse.Namespace) -> tuple[tuple[str, object], ...]:
             ("--hold", args.hold))
 
 
+def _check_generated(args: argparse.Namespace) -> None:
+    """Refuse what cannot go with ``--random``/``--protocol`` and ask for what is missing."""
+    flag = "--random" if args.random is not None else "--protocol"
+    given = [n for n, v in (("SCENE", args.scene), *_scene_shaping(args)) if v is not None]
+    if args.random is not None and args.protocol is not None:
+        given.append("--protocol")
+    if given:
+        raise RvsmError(f"{', '.join(given)} cannot be combined with {flag} (the "
+                        "stimulus is generated)")
+    missing = [n for n, v in (("--fixed", args.fixed), ("--size", args.size),
+                              ("--steps", args.steps)) if v is None]
+    if missing:
+        raise RvsmError(f"rvsm verify {flag} SEED also needs {', '.join(missing)}, "
+                        f"e.g. {flag} 1 --fixed point.toml --size 16x16 --steps 40")
+
+
 def _verify(args: argparse.Namespace) -> int:
+    from rvsm.rtl.stream.protocol import protocol_summary
+    from rvsm.sim.cosim.protocol_run import protocol_verify
     from rvsm.sim.cosim.verify import random_verify, replay, verify
 
     check_outputs([Output(args.work, "--work", FOLDER)],
@@ -181,6 +206,7 @@ def _verify(args: argparse.Namespace) -> int:
     if args.stimulus:
         given = [n for n, v in (("SCENE", args.scene), ("--fixed", args.fixed),
                                 ("--size", args.size), ("--random", args.random),
+                                ("--protocol", args.protocol),
                                 *_scene_shaping(args)) if v is not None]
         if given:
             raise RvsmError(f"{', '.join(given)} cannot be combined with --stimulus: the "
@@ -188,19 +214,19 @@ def _verify(args: argparse.Namespace) -> int:
         r = replay(args.stimulus, args.sim, steps=args.steps, waves=args.waves,
                    work_dir=args.work, arch=arch,
                    recompute_expected=args.recompute_expected, **long_run, **options)
-    elif args.random is not None:
-        given = [n for n, v in (("SCENE", args.scene), *_scene_shaping(args)) if v is not None]
-        if given:
-            raise RvsmError(f"{', '.join(given)} cannot be combined with --random (the "
-                            "stimulus is generated)")
-        missing = [n for n, v in (("--fixed", args.fixed), ("--size", args.size),
-                                  ("--steps", args.steps)) if v is None]
-        if missing:
-            raise RvsmError(f"rvsm verify --random SEED also needs {', '.join(missing)}, "
-                            "e.g. --random 1 --fixed point.toml --size 4x4 --steps 200")
-        r = random_verify(args.fixed, args.random, args.steps, args.sim, waves=args.waves,
-                          size=parse_size_arg(args.size), work_dir=args.work, arch=arch,
-                          **long_run, **options)
+    elif args.random is not None or args.protocol is not None:
+        _check_generated(args)
+        if args.protocol is not None:
+            if arch != "stream" or args.harness == "chunk" or args.code_coverage:
+                raise RvsmError("--protocol drives the streaming array cycle by cycle: use "
+                                "--arch stream without --harness chunk or --code-coverage")
+            r = protocol_verify(args.fixed, args.protocol, args.steps, args.sim,
+                                waves=args.waves, size=parse_size_arg(args.size),
+                                work_dir=args.work, lanes=options.get("lanes"))
+        else:
+            r = random_verify(args.fixed, args.random, args.steps, args.sim,
+                              waves=args.waves, size=parse_size_arg(args.size),
+                              work_dir=args.work, arch=arch, **long_run, **options)
     else:
         if args.scene is None or args.fixed is None:
             raise RvsmError("rvsm verify needs SCENE --fixed POINT.toml, --stimulus FILE, "
@@ -216,11 +242,19 @@ def _verify(args: argparse.Namespace) -> int:
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]
         print(json.dumps(r))
     else:
-        print(f"{args.sim}, {_arch_text(r['arch'], r['options'])}: compared "
-              f"{r['compared']} spikes ({r['steps']} steps x "
-              f"{r['accumulators']} accumulators, {r['expected_spikes']} non-zero), "
-              f"{r['mismatches']} mismatches")
-        if r.get("coverage"):
+        if args.protocol is not None:
+            print(f"{args.sim}, {_arch_text(r['arch'], r['options'])}: protocol script "
+                  f"{args.protocol}, {r['cycles']} cycles, {r['beats']} output beats "
+                  f"({r['compared']} spikes, {r['expected_spikes']} non-zero) checked with "
+                  f"their cycles, {r['mismatches']} mismatches")
+            for line in protocol_summary(r["coverage"]):
+                print(f"protocol coverage {line}")
+        else:
+            print(f"{args.sim}, {_arch_text(r['arch'], r['options'])}: compared "
+                  f"{r['compared']} spikes ({r['steps']} steps x "
+                  f"{r['accumulators']} accumulators, {r['expected_spikes']} non-zero), "
+                  f"{r['mismatches']} mismatches")
+        if r.get("coverage") and args.protocol is None:
             from rvsm.model.fixed.corner_stimulus import coverage_summary
 
             for line in coverage_summary(r["coverage"]):

@@ -19,11 +19,14 @@ A plan is TOML with three tables::
     steps = 200                    # steps per run
     scenes = ["coin"]              # scene runs (optional)
     seeds = { start = 0, stop = 8 }  # random and corner stimuli (optional; or a list)
+    protocol_seeds = [0, 1]        # protocol scripts: stalls, clears at any position,
+                                   # colliding threshold writes (stream; per cycle)
     code_coverage = false          # Verilator line and toggle coverage, merged (chunk)
 
-Its runs are the product (scenes, then seeds) x models x lanes x simulators, each with
-a key (a digest of everything that makes it) under which the database keeps its result
-(:mod:`.store`). :func:`load_plan` refuses a bad plan in one line naming the field.
+Its runs are the product (scenes, then seeds, then protocol seeds) x models x lanes x
+simulators, each with a key (a digest of everything that makes it) under which the
+database keeps its result (:mod:`.store`). :func:`load_plan` refuses a bad plan in one
+line naming the field.
 """
 
 from __future__ import annotations
@@ -50,16 +53,16 @@ __all__ = ["RegressionPlan", "RunSpec", "load_plan", "parse_plan"]
 
 SECTIONS = ("regression", "base", "run")
 RUN_KEYS = ("models", "size", "arch", "lanes", "simulators", "harness", "steps", "scenes",
-            "seeds", "code_coverage")
+            "seeds", "protocol_seeds", "code_coverage")
 
 
 @dataclass(frozen=True)
 class RunSpec:
-    """One run of a plan: a ``scene`` name or a random ``seed``, the design point (TOML
-    text, sized), architecture, lanes, simulator, harness and steps."""
+    """One run of a plan: a ``scene`` name, a random ``seed`` or a protocol seed, the
+    design point (TOML text, sized), architecture, lanes, simulator, harness and steps."""
 
     plan: str
-    stimulus: str  # "scene:<name>" or "seed:<n>"
+    stimulus: str  # "scene:<name>", "seed:<n>" or "protocol:<n>"
     model: str
     point_toml: str
     size: tuple[int, int]
@@ -109,20 +112,20 @@ def _list(raw: dict, key: str, default: Any, source: str) -> list:
     return value
 
 
-def _seeds(raw: Any, source: str) -> list[int]:
+def _seeds(raw: Any, source: str, key: str = "seeds") -> list[int]:
     if raw is None:
         return []
     if isinstance(raw, dict):
         if set(raw) - {"start", "stop"} or not all(
                 isinstance(raw.get(k), int) and not isinstance(raw.get(k), bool)
                 for k in ("start", "stop")):
-            raise RvsmError(f"{source}: run.seeds must be a list of integers or "
+            raise RvsmError(f"{source}: run.{key} must be a list of integers or "
                             "{ start = A, stop = B }")
         raw = list(range(raw["start"], raw["stop"]))
     raw = raw if isinstance(raw, list) else [raw]
     for s in raw:
         if isinstance(s, bool) or not isinstance(s, int) or s < 0:
-            raise RvsmError(f"{source}: run.seeds must be integers >= 0, got {s!r}")
+            raise RvsmError(f"{source}: run.{key} must be integers >= 0, got {s!r}")
     return raw
 
 
@@ -187,17 +190,24 @@ def parse_plan(text: str, source: str = "plan",
     if code_coverage and (harness != "chunk" or set(sims) != {"verilator"}):
         raise RvsmError(f"{source}: run.code_coverage needs harness = \"chunk\" and "
                         "simulators = [\"verilator\"]")
-    if not scenes and not seeds:
-        raise RvsmError(f"{source}: [run] needs scenes or seeds (or both)")
+    protocol = _seeds(raw.get("protocol_seeds"), source, "protocol_seeds")
+    if protocol and arch != "stream":
+        raise RvsmError(f"{source}: run.protocol_seeds drive the stream architecture only")
+    if not scenes and not seeds and not protocol:
+        raise RvsmError(f"{source}: [run] needs scenes, seeds or protocol_seeds")
     runs = []
     stimuli = [f"scene:{s}" for s in scenes] + [f"seed:{n}" for n in seeds]
+    stimuli += [f"protocol:{n}" for n in protocol]
     for stimulus in stimuli:
+        per_cycle = stimulus.startswith("protocol:")  # its own per-cycle testbench
         for model in models:
             point = _point(base, model, size, source)
             for p in lanes:
                 for sim in sims:
                     runs.append(RunSpec(name, stimulus, model, design_point_toml(point),
-                                        size, arch, p, sim, harness, steps, code_coverage))
+                                        size, arch, p, sim,
+                                        "cycle" if per_cycle else harness, steps,
+                                        code_coverage and not per_cycle))
     return RegressionPlan(name, source, tuple(runs))
 
 

@@ -1,7 +1,8 @@
 """One regression run as a work item an executor runs (:mod:`rvsm.sim.sweep.executors`).
 
 :class:`RegressionWork` runs its :class:`~.plan.RunSpec` with ``rvsm verify``'s
-functions (a scene through the fixed twin, or a seeded random and corner stimulus), in
+functions (a scene through the fixed twin, a seeded random and corner stimulus, or a
+seeded protocol script: :mod:`rvsm.sim.cosim.protocol_run`), in
 a work folder whose build cache every worker shares, and returns a record: ``status``
 ``"pass"``, ``"fail"`` (the RTL disagrees with the twin) or ``"error"`` (a tool or the
 environment failed: the run is retried by the next ``rvsm regress``), with the figures.
@@ -48,6 +49,7 @@ class RegressionWork:
 
     def run(self) -> dict[str, Any]:
         """The run's record (never raises for a tool failure: ``status`` is ``"error"``)."""
+        from rvsm.sim.cosim.protocol_run import protocol_verify
         from rvsm.sim.cosim.verify import random_verify, verify
 
         s = self.spec
@@ -64,6 +66,9 @@ class RegressionWork:
             if kind == "scene":
                 r = verify(scene_for(s), point, s.sim, steps=s.steps, size=s.size, work_dir=work,
                            arch=s.arch, harness=s.harness, **options)
+            elif kind == "protocol":
+                r = protocol_verify(point, int(what), s.steps, s.sim, size=s.size,
+                                    work_dir=work, lanes=s.lanes)
             else:
                 r = random_verify(point, int(what), s.steps, s.sim, size=s.size,
                                   work_dir=work, arch=s.arch, harness=s.harness, **options)

@@ -64,7 +64,7 @@ def test_plan_expands_and_refuses_bad_fields(tmp_path: Path) -> None:
             parse_plan(text, "p")
     with pytest.raises(RvsmError, match="run.harness"):
         parse_plan(TINY.replace('[run]', '[run]\narch = "parallel"'), "p")
-    with pytest.raises(RvsmError, match="needs scenes or seeds"):
+    with pytest.raises(RvsmError, match="needs scenes, seeds or protocol_seeds"):
         parse_plan(TINY.replace('scenes = ["coin"]', "").replace("seeds = [1, 2]", ""), "p")
     with pytest.raises(RvsmError, match="run.code_coverage needs harness"):
         parse_plan(TINY.replace("[run]", "[run]\ncode_coverage = true"), "p")
@@ -73,6 +73,26 @@ def test_plan_expands_and_refuses_bad_fields(tmp_path: Path) -> None:
     assert all(r.code_coverage for r in with_cov.runs)
     with pytest.raises(RvsmError, match="unknown key run.colour"):
         parse_plan(TINY.replace("[run]", "[run]\ncolour = 1"), "p")
+
+
+def test_protocol_seeds_run_the_protocol_testbench(tmp_path: Path) -> None:
+    """``protocol_seeds`` add per-cycle protocol runs (stream only); they pass and their
+    bins (clears at positions of the frame, threshold writes meeting reads) join the
+    closure report."""
+    text = TINY.replace('scenes = ["coin"]', "").replace("seeds = [1, 2]",
+                                                          "protocol_seeds = [3]")
+    plan = parse_plan(text, "p")
+    assert [(r.stimulus, r.harness, r.code_coverage) for r in plan.runs] == \
+        [("protocol:3", "cycle", False)]
+    with pytest.raises(RvsmError, match="protocol_seeds drive the stream"):
+        parse_plan(text.replace("[run]", '[run]\narch = "parallel"')
+                   .replace('harness = "chunk"', ""), "p")
+    s = run_regression(plan, tmp_path / "r.sqlite", tmp_path / "w", workers=0,
+                       progress=False)
+    assert (s.ran, s.count("pass"), s.exit_status) == (1, 1, 0)
+    cov = s.rows[0]["coverage"]
+    assert cov[0]["thr_write_same_edge"] is not None
+    assert sum(n or 0 for k, n in cov[0].items() if k.startswith("clear_at_")) > 0
 
 
 def test_regression_runs_resumes_and_reports(tmp_path: Path) -> None:
