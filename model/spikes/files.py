@@ -19,8 +19,13 @@ from rvsm.model.spikes.source import SpikeSource, array_source
 
 
 def open_spikes(path: str | os.PathLike) -> SpikeSource:
-    """Open an ``.h5`` (lazily) or ``.npz`` (in memory) spike file for reading."""
+    """Open an ``.h5`` (lazily) or ``.npz`` (in memory) spike file for reading; an HDF5
+    event list (:mod:`rvsm.model.events.event_list`) is read as dense events."""
     if is_h5_path(path):
+        from rvsm.model.events.event_list import is_event_list, open_event_list
+
+        if is_event_list(path):
+            return open_event_list(path)
         return open_h5(path)
     spikes, meta = load_spikes(path)
     src = array_source(spikes, meta)

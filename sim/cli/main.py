@@ -16,6 +16,7 @@ from types import ModuleType
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.sim.cli import (
     demo,
+    events,
     fixed,
     formal,
     fpga,
@@ -30,8 +31,8 @@ from rvsm.sim.cli import (
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
 #: co-simulation, formal checks, FPGA timing and area, paper studies, the demo, design sweeps.
-FAMILIES: tuple[ModuleType, ...] = (sampling, scenes, fixed, rtl, regress, formal, mutate,
-                                    fpga, studies, demo, sweep)
+FAMILIES: tuple[ModuleType, ...] = (sampling, events, scenes, fixed, rtl, regress, formal,
+                                    mutate, fpga, studies, demo, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:

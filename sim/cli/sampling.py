@@ -8,6 +8,7 @@ import json
 import numpy as np
 
 from rvsm.model.decode.reconstruction import MATCH_MODES, METHODS
+from rvsm.model.events.config import DEFAULT_CONTRAST, SENSORS, EventConfig
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.sampling.config import (
     DEFAULT_CHUNK_STEPS,
@@ -43,8 +44,17 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "(streamed chunk by chunk: any length in bounded memory) or .npz "
                        "(in memory, small runs).")
     add_scene_arguments(p)
+    p.add_argument("--sensor", choices=SENSORS, default="spike",
+                   help="spike: the spike camera (default); dvs: an event camera, RVSM-DVS "
+                   "(SPEC section 7): ON/OFF events of the receptive fields applied to the "
+                   "log intensity, --model fsm being the plain DVS (docs/events.md)")
     p.add_argument("--model", default=None,
                    help="fsm, dog1..dog4 or gauss1..gauss4 (default dog4)")
+    p.add_argument("--contrast", type=float, default=None,
+                   help=f"--sensor dvs: contrast threshold C in log-intensity units "
+                   f"(default {DEFAULT_CONTRAST:g})")
+    p.add_argument("--scale-contrast", default=None, metavar="C1,C2,..",
+                   help="--sensor dvs: per-scale contrast thresholds, comma-separated")
     p.add_argument("--phi", type=float, default=None, help=f"threshold (default {DEFAULT_PHI:g})")
     p.add_argument("--scale-phi", default=None, metavar="P1,P2,..",
                    help="per-scale thresholds, comma-separated")
@@ -153,6 +163,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     check_outputs([Output(args.output, "-o", "spike file"),
                    args.dat and Output(args.dat, "--dat", PLAIN)],
                   [args.scene, args.fixed], args.force)
+    _check_sensor_options(args)
     apply_threads(args)
     h5 = is_h5_path(args.output)
     counts = CountSink()
@@ -175,6 +186,14 @@ def run_simulate(args: argparse.Namespace) -> int:
         run_fn = lambda sink: stream_fixed(  # noqa: E731
             scene, point, sink, chunk_steps=args.chunk_steps, engine=args.engine,
             progress=True, ranges=False)
+    elif args.sensor == "dvs":
+        from rvsm.model.events.twin import stream_events
+
+        scene = SceneRequest.from_args(args).load()
+        config = _event_config(args)
+        run_fn = lambda sink: stream_events(  # noqa: E731
+            scene, config, sink, chunk_steps=args.chunk_steps, engine=args.engine,
+            progress=True)
     else:
         scene = SceneRequest.from_args(args).load()
         config = _float_config(args, scene)
@@ -191,9 +210,40 @@ def run_simulate(args: argparse.Namespace) -> int:
     t = counts.steps
     s = len(counts.per_scale)
     h, w = scene.shape
+    what = ("events", "OFF") if args.sensor == "dvs" else ("spikes", "negative")
     print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}, "
-          f"{counts.spikes} spikes ({counts.negative} negative)")
+          f"{counts.spikes} {what[0]} ({counts.negative} {what[1]})")
     return 0
+
+
+def _check_sensor_options(args: argparse.Namespace) -> None:
+    """Refuse options of the other sensor (exit 2)."""
+    if args.sensor == "dvs":
+        given = [f"--{n.replace('_', '-')}" for n in ("phi", "scale_phi", "reset",
+                                                       "thresholds", "fixed", "dat")
+                 if getattr(args, n) is not None]
+        if given:
+            raise RvsmError(f"{', '.join(given)} do(es) not apply to --sensor dvs (its "
+                            "thresholds are --contrast / --scale-contrast; the fixed-point "
+                            "event twin is not built yet)")
+    else:
+        given = [f"--{n.replace('_', '-')}" for n in ("contrast", "scale_contrast")
+                 if getattr(args, n) is not None]
+        if given:
+            raise RvsmError(f"{', '.join(given)} apply to --sensor dvs only")
+
+
+def _event_config(args: argparse.Namespace) -> EventConfig:
+    scale = None
+    if args.scale_contrast:
+        try:
+            scale = tuple(float(v) for v in args.scale_contrast.split(","))
+        except ValueError:
+            raise RvsmError(f"--scale-contrast must be comma-separated numbers, got "
+                            f"{args.scale_contrast!r}") from None
+    return EventConfig(model=args.model or "dog4",
+                       contrast=DEFAULT_CONTRAST if args.contrast is None else args.contrast,
+                       scale_contrast=scale, noise=noise_from_args(args))
 
 
 def run_evaluate(args: argparse.Namespace) -> int:
@@ -204,6 +254,14 @@ def run_evaluate(args: argparse.Namespace) -> int:
     with open_spikes(args.spikes) as source:
         meta = source.meta
         scene = SceneRequest.from_args(args, meta).load()
+        if meta.get("kind") == "events":
+            from rvsm.model.events.reconstruction import evaluate_events
+
+            if args.method != "auto":
+                raise RvsmError("--method applies to spike files; events are decoded by "
+                                "the least-squares inverse of their log responses")
+            result = evaluate_events(source, scene, match=args.match)
+            return _print_evaluation(args, result, meta["model"] + " (dvs)", scene)
         _check_scene_fits(scene, source.shape)
         model = meta.get("model")
         phis = meta.get("phis")
@@ -217,6 +275,11 @@ def run_evaluate(args: argparse.Namespace) -> int:
         else:
             result = evaluate_spikes(source.read(0, source.num_steps), scene, model, phis,
                                      method=args.method, match=args.match)
+    return _print_evaluation(args, result, model, scene)
+
+
+def _print_evaluation(args: argparse.Namespace, result: dict, model: str,
+                      scene: Scene) -> int:
     if args.json:
         print(json.dumps({**result, "model": model, "scene": scene.name}, default=float))
     else:

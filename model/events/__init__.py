@@ -1,0 +1,1 @@
+"""RVSM for event sensors (SPEC section 7): the plain DVS and RVSM-DVS float models."""
