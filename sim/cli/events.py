@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import argparse
+import json
+from pathlib import Path
 
 from rvsm.model.events.event_list import EventListWriter, open_event_list
+from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.spikes.files import copy_source, open_spikes
 from rvsm.model.spikes.h5 import H5SpikeWriter, is_h5_path
 from rvsm.model.spikes.npz import save_spikes
 from rvsm.sim.cli.args import SceneRequest, add_force_argument, add_scene_arguments
-from rvsm.sim.cli.outputs import Output, check_outputs
+from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
+from rvsm.sim.studies.event_claims import DEFAULT_KS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -36,6 +40,23 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument("-o", "--output", required=True, help="output event file (.h5 or .npz)")
     add_force_argument(q)
     q.set_defaults(func=run_import)
+    q = act.add_parser("claims", help="SPEC section 7's claims: a verdict table and figures",
+                       description="Measure the claims of SPEC section 7 (noise events on "
+                       "static scenes vs k, events under a global flicker, reconstructions "
+                       "with noise on the six built-in scenes), judge them by fixed rules "
+                       "(sim/studies/event_claims.py, docs/events.md) and write claims.csv, "
+                       "claims.json, noise.png and verdict.md.")
+    q.add_argument("--size", default="64x96", metavar="HxW",
+                   help="array size (default 64x96)")
+    q.add_argument("--ks", default=",".join(f"{k:g}" for k in DEFAULT_KS),
+                   help="noise intensities of the static-scene runs")
+    q.add_argument("--steps", type=int, default=200,
+                   help="steps of the static and flicker runs (default 200)")
+    q.add_argument("--seed", type=int, default=0)
+    q.add_argument("-o", "--output", default="out/event-claims", help="output folder")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_force_argument(q)
+    q.set_defaults(func=run_claims)
 
 
 def run_export(args: argparse.Namespace) -> int:
@@ -74,4 +95,34 @@ def run_import(args: argparse.Namespace) -> int:
             save_spikes(args.output, source.read(0, source.num_steps), meta)
         t, s, h, w = source.shape
     print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}")
+    return 0
+
+
+def run_claims(args: argparse.Namespace) -> int:
+    """``rvsm events claims``."""
+    from dataclasses import asdict
+
+    from rvsm.sim.cli.studies import parse_floats, save_figure, scored_size
+    from rvsm.sim.studies import event_claims as ec
+
+    check_outputs([Output(args.output, "-o", FOLDER, (
+        ("claims.csv", PLAIN), ("claims.json", PLAIN), ("noise.png", None),
+        ("verdict.md", PLAIN)))], force=args.force)
+    if args.steps < 2:
+        raise RvsmError(f"--steps must be >= 2, got {args.steps}")
+    ks = parse_floats(args.ks)
+    if not ks:
+        raise RvsmError("--ks needs at least one noise intensity")
+    result = ec.run_event_claims(scored_size(args.size), ks, args.steps, seed=args.seed,
+                                 progress=not args.quiet)
+    out = Path(args.output)
+    lines = ec.verdict_lines(result)
+    write_text_atomic(out / "claims.csv", ec.claims_csv(result))
+    write_text_atomic(out / "claims.json", json.dumps(asdict(result), indent=1) + "\n")
+    save_figure(ec.claims_figure(result), out / "noise.png")
+    write_text_atomic(out / "verdict.md", "\n".join(lines) + "\n")
+    for line in lines:
+        print(line)
+    print(f"wrote {out / 'claims.csv'}, claims.json, noise.png, verdict.md "
+          f"({result.seconds:.0f} s)")
     return 0
