@@ -9,7 +9,7 @@ path on fewer steps, ``--numpy-steps``). The fixed twin runs the default design 
 ``rvsm simulate flyball --size 250x400 --model dog4 --noise`` for ``--long-steps`` steps
 (``--frames 401 --steps-per-frame 100`` for 40,000) to an ``.h5`` file, measured as the
 child's ``ru_maxrss``. Every figure is printed with the load average at its start; the
-targets are issue 10's, for a 2-core machine. ``fused/cpu-s`` is the same work per CPU
+targets are issue 10's (the ``dvs`` rows, RVSM-DVS: issue 19's), for a 2-core machine. ``fused/cpu-s`` is the same work per CPU
 second of all threads: the rate a core delivers, less sensitive to other jobs' load (on an
 idle 2-core machine the wall rate approaches twice it).
 """
@@ -44,6 +44,9 @@ CASES = [
     ("float gauss4", "float", "gauss4", True, None),
     ("fixed dog4", "fixed", "dog4", False, 5e8),
     ("fixed dog4", "fixed", "dog4", True, 1.5e8),
+    ("dvs fsm", "dvs", "fsm", False, None),
+    ("dvs dog4", "dvs", "dog4", False, 1e9),
+    ("dvs dog4", "dvs", "dog4", True, 2e8),
 ]
 RSS_TARGET_BYTES = 1.5e9
 
@@ -81,6 +84,13 @@ def best_time(fn, repeat: int) -> tuple[float, float]:
 
 
 def run_case(kind: str, model: str, noise: bool, scene, engine: str):
+    if kind == "dvs":  # RVSM-DVS, the event sensor (issue 19's targets)
+        from rvsm.model.events.config import EventConfig
+        from rvsm.model.events.twin import stream_events
+
+        config = EventConfig(model=model, noise=NoiseParams() if noise else None)
+        return (lambda: stream_events(scene, config, NullSink(), engine=engine),
+                config.spec.num_scales)
     if kind == "float":
         config = SamplerConfig(model=model, noise=NoiseParams() if noise else None)
         return (lambda: stream_float(scene, config, NullSink(), engine=engine),
@@ -123,6 +133,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--long-steps", type=int, default=40000,
                         help="steps of the peak-RSS run (0 to skip)")
+    parser.add_argument("--only", default="", metavar="TEXT",
+                        help="run only the cases whose label contains TEXT (e.g. dvs)")
     args = parser.parse_args()
     m = 10
     scene = builtin_scene("flyball", num_frames=args.steps // m + 1, steps_per_frame=m)
@@ -136,6 +148,8 @@ def main() -> None:
     print(head)
     print("-" * len(head))
     for label, kind, model, noise, target in CASES:
+        if args.only not in label:
+            continue
         ld = load()
         fused, scales = run_case(kind, model, noise, scene, "fused")
         fused()  # compile / warm the caches

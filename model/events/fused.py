@@ -1,11 +1,18 @@
-"""The fused numba engine of the event samplers.
+"""The fused numba engine of the event samplers: the time loop inside, tiles of rows in
+parallel, everything of a tile in cache.
 
-Per block of steps, three compiled passes, each parallel over rows: brightness
-(interpolated between the frames the block touches, plus the dark current) to log
-intensity; the receptive sums of every step (:func:`~rvsm.model.sampling.fused.filter_frames`,
-the orbit order); the event rule. Every float operation is the one :mod:`.numpy_engine`
-does, in the same order, and the log is the shared kernel of :mod:`.log_intensity`, so
-the events are bit-identical to the numpy engine for any block, chunk and thread count.
+:func:`_event_chunk` processes tiles of ``tile_rows`` rows in parallel (``prange``); per
+tile and step it forms the brightness of the tile's rows plus a halo of ``L`` rows
+(interpolated between the chunk's frames, plus the dark current drawn inside the tile from
+the counter-based streams of :mod:`rvsm.model.noise.streams`), the log intensity, the row
+pairs and every scale's receptive sum of each row (the shared kernels of
+:mod:`rvsm.model.sampling.row_sums`, the orbit order), and applies the event rule to the
+tile's accumulators and references.
+
+Every float operation is the one :mod:`.numpy_engine` does, in the same order, the log
+is the formula of :mod:`.log_intensity`, and every pixel's arithmetic depends on nothing
+but its own coordinates, so the events are bit-identical to the numpy engine for any tile
+height, chunk length and thread count.
 """
 
 from __future__ import annotations
@@ -18,77 +25,92 @@ from numba import njit, prange
 from rvsm.model.events.config import EventConfig
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.sensor import NoiseSource
-from rvsm.model.sampling.fused import chunk_frames, filter_frames
+from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, check_coordinates, normal_row
+from rvsm.model.sampling.fused import chunk_frames
+from rvsm.model.sampling.row_sums import row_pairs, scale_sum
 from rvsm.model.scene.scene import Scene
 
-__all__ = ["FusedEventSampler"]
+__all__ = ["DEFAULT_TILE_ROWS", "FusedEventSampler"]
 
-DEFAULT_BLOCK_STEPS = 16
+#: Rows per tile (the log of the ``2L`` halo rows is recomputed per tile).
+DEFAULT_TILE_ROWS = 32
 
 
-@njit(parallel=True, cache=True)
-def _log_steps(frames, fidx, aw, dark, noisy, out):
-    """``out[b]``: ``ln(max(I_b, 0) + 1)`` with ``I_b`` interpolated (plus ``dark[b]``)."""
-    num_steps, height, width = out.shape
-    for i in prange(num_steps * height):
-        b = i // height
-        y = i - b * height
-        f = fidx[b]
-        a = aw[b]
-        oma = 1.0 - a
-        f0 = frames[f, y]
-        dst = out[b, y]
-        if a == 0.0:
-            for x in range(width):
-                dst[x] = f0[x]
-        else:
-            f1 = frames[f + 1, y]
-            for x in range(width):
-                dst[x] = oma * f0[x] + a * f1[x]
-        if noisy:
-            dk = dark[b, y]
-            for x in range(width):
-                dst[x] = dst[x] + dk[x]
+@njit(inline="always", cache=True)
+def _events_row(resp, th, rf, out, width, capture):
+    """The event rule on one row of one scale (``capture``: store the references)."""
+    if capture:
         for x in range(width):
-            v = dst[x]
-            dst[x] = math.log((v if v > 0.0 else 0.0) + 1.0)
+            rf[x] = resp[x]
+            out[x] = 0
+        return
+    for x in range(width):
+        d = resp[x] - rf[x]
+        c = th[x]
+        if d >= c:
+            out[x] = 1
+            rf[x] = rf[x] + c
+        elif d <= -c:
+            out[x] = -1
+            rf[x] = rf[x] - c
+        else:
+            out[x] = 0
 
 
 @njit(parallel=True, cache=True)
-def _events(responses, thr, ref, first, out):
-    """The event rule over ``responses (B, S, H, W)``; ``first``: step 0 captures."""
-    num_steps, num_scales, height, width = responses.shape
-    for i in prange(num_scales * height):
-        s = i // height
-        y = i - s * height
-        th, rf = thr[s, y], ref[s, y]
+def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean, sd,
+                 zx, zr, weights, halves, lmax, tile_rows, out):
+    num_scales, height, width = thr.shape
+    num_steps = fidx.shape[0]
+    num_tiles = (height + tile_rows - 1) // tile_rows
+    for ti in prange(num_tiles):
+        y0 = ti * tile_rows
+        rows = min(height, y0 + tile_rows) - y0
+        prow = rows + 2 * lmax
+        pad = np.zeros((prow, width + 2 * lmax))
+        pairs = np.empty((lmax + 1, prow, width))
+        dark = np.empty(width)
+        resp = np.empty(width)
         for b in range(num_steps):
-            r = responses[b, s, y]
-            o = out[b, s, y]
-            if first and b == 0:
-                for x in range(width):
-                    rf[x] = r[x]
-                    o[x] = 0
-                continue
-            for x in range(width):
-                d = r[x] - rf[x]
-                c = th[x]
-                if d >= c:
-                    o[x] = 1
-                    rf[x] = rf[x] + c
-                elif d <= -c:
-                    o[x] = -1
-                    rf[x] = rf[x] - c
+            f = fidx[b]
+            a = aw[b]
+            oma = 1.0 - a
+            for r in range(prow):
+                y = y0 - lmax + r
+                if y < 0 or y >= height:
+                    continue  # zero padding: L = 0
+                dst = pad[r, lmax:lmax + width]
+                f0 = frames[f, y]
+                if a == 0.0:
+                    for x in range(width):
+                        dst[x] = f0[x]
                 else:
-                    o[x] = 0
+                    f1 = frames[f + 1, y]
+                    for x in range(width):
+                        dst[x] = oma * f0[x] + a * f1[x]
+                if noisy:
+                    normal_row(key, t0 + b, y, width, mean, sd, zx, zr, dark, 0)
+                    for x in range(width):
+                        dst[x] = dst[x] + dark[x]
+                for x in range(width):
+                    v = dst[x]
+                    dst[x] = math.log((v if v > 0.0 else 0.0) + 1.0)
+            row_pairs(pad, prow, lmax, width, pairs)
+            capture = capture_first and b == 0
+            for r in range(rows):
+                y = y0 + r
+                for s in range(num_scales):
+                    scale_sum(pairs, lmax + r, weights[s], halves[s], width, resp)
+                    _events_row(resp, thr[s, y], ref[s, y], out[b, s, y], width, capture)
 
 
 class FusedEventSampler:
     """The fused event sampler's state for one scene and configuration; :meth:`run`
-    covers steps ``t0 .. t1 - 1`` (consecutive calls, consecutive ranges)."""
+    covers steps ``t0 .. t1 - 1`` (consecutive calls, consecutive ranges) and returns
+    ``(t1 - t0, S, H, W) int8`` events."""
 
     def __init__(self, scene: Scene, config: EventConfig, thresholds: np.ndarray,
-                 block_steps: int = DEFAULT_BLOCK_STEPS):
+                 tile_rows: int = DEFAULT_TILE_ROWS):
         spec = config.spec
         self.scene = scene
         _, self.weights, self.halves, self.lmax = kernel_orbits(spec.kernels())
@@ -96,9 +118,15 @@ class FusedEventSampler:
         self.thr = np.ascontiguousarray(thresholds, dtype=np.float64)
         self.ref = np.zeros_like(self.thr)
         self.captured: np.ndarray | None = None
-        self.noise = (NoiseSource(config.noise, scene.shape, spec.num_scales)
-                      if config.noise is not None else None)
-        self.block_steps = max(1, int(block_steps))
+        self.tile_rows = max(1, int(tile_rows))
+        if config.noise is not None:
+            check_coordinates(scene.num_steps, scene.shape)
+            src = NoiseSource(config.noise, scene.shape, spec.num_scales)
+            self.key = src.dark_key
+            self.mean, self.sd = src.dark_mean_sd
+            self.noisy = True
+        else:
+            self.key, self.mean, self.sd, self.noisy = np.uint64(0), 0.0, 0.0, False
         self.next_step = 0
 
     @property
@@ -113,22 +141,20 @@ class FusedEventSampler:
         s, h, w = self.thr.shape
         if out is None:
             out = np.empty((t1 - t0, s, h, w), dtype=np.int8)
-        empty = np.empty((1, 1, 1))
-        for b0 in range(t0, t1, self.block_steps):
-            b1 = min(t1, b0 + self.block_steps)
-            frames, fidx, aw = chunk_frames(self.scene, b0, b1)
-            frames = np.ascontiguousarray(frames, dtype=np.float64)
-            dark = (self.noise.dark_current_at(b0, b1 - b0) if self.noise is not None
-                    else empty)
-            logs = np.empty((b1 - b0, h, w))
-            _log_steps(frames, fidx, aw, dark, self.noise is not None, logs)
-            if self.lmax == 0:  # the plain DVS: 0 + 1.0 * L is L
-                responses = logs[:, None]
-            else:
-                responses = filter_frames(logs, self.weights, self.halves, self.lmax)
-            _events(responses, self.thr, self.ref, b0 == 0,
-                    out[b0 - t0:b1 - t0])
-            if b0 == 0:
-                self.captured = np.array(responses[0], dtype=np.float64)
+        if t0 == 0 and t1 > 0:  # step 0 alone: it captures the references
+            self._chunk(0, 1, out[:1])
+            self.captured = self.ref.copy()
+            self._chunk(1, t1, out[1:])
+        else:
+            self._chunk(t0, t1, out)
         self.next_step = t1
         return out
+
+    def _chunk(self, t0: int, t1: int, out: np.ndarray) -> None:
+        if t1 <= t0:
+            return
+        frames, fidx, aw = chunk_frames(self.scene, t0, t1)
+        _event_chunk(np.ascontiguousarray(frames, dtype=np.float64), fidx, aw, self.thr,
+                     self.ref, t0 == 0, self.noisy, self.key, int(t0), self.mean, self.sd,
+                     ZIG_X, ZIG_RATIO, self.weights, self.halves, self.lmax, self.tile_rows,
+                     out)
