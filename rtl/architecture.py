@@ -21,7 +21,7 @@ from amaranth.lib import wiring
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.infra.errors import RvsmError
 
-__all__ = ["Architecture", "Option"]
+__all__ = ["Architecture", "Option", "require_spike_sensor"]
 
 
 @dataclass(frozen=True)
@@ -98,3 +98,12 @@ class Architecture:
         got = self.simulate(contract, codes, thresholds, clear_before=clear_before,
                             **options)
         return self.compare(contract, expected, got, **options)
+
+
+def require_spike_sensor(contract: ArrayContract, what: str) -> None:
+    """Refuse (:class:`RvsmError`) a contract of the event sensor for ``what`` (e.g. "the
+    formal properties"), which is written for the spike camera's accumulators only."""
+    if getattr(contract, "sensor", "spike") != "spike":
+        raise RvsmError(f"{what} of the event sensor (sensor = {contract.sensor!r}) are not "
+                        "written yet: they state the spike camera's accumulator rules; the "
+                        "event sensor's RTL is checked by co-simulation (docs/events.md)")

@@ -64,7 +64,7 @@ def is_event_list(path: str | os.PathLike) -> bool:
     try:
         with _h5py().File(p, "r") as f:
             fmt = f.attrs.get("format", b"")
-    except (OSError, ValueError, RuntimeError):
+    except Exception:  # noqa: BLE001 - a damaged file is not an event list; its reader says why
         return False
     return (fmt.decode() if isinstance(fmt, bytes | np.bytes_) else str(fmt)) == \
         EVENT_LIST_FORMAT
@@ -204,7 +204,7 @@ def open_event_list(path: str | os.PathLike) -> SpikeSource:
     except RvsmError:
         handle.close()
         raise
-    except (KeyError, ValueError, TypeError, OSError, json.JSONDecodeError) as exc:
+    except (KeyError, ValueError, TypeError, OSError, RuntimeError, json.JSONDecodeError) as exc:
         handle.close()
         raise RvsmError(f"{p} is a damaged event list ({exc})") from None
     def read(t0: int, t1: int) -> np.ndarray:

@@ -9,7 +9,9 @@ DVS), the image ``exp(L_hat) - 1``, then the brightness matching and metrics of 
 section 4. An event list (:mod:`.event_list`) carries the references; the project's own
 event files (the spike-file formats) do not, so they are regenerated from the scene and
 the file's metadata (the same float model, dark current of step 0 included),
-:func:`capture_references`. Files are read chunk by chunk (memory: one chunk
+:func:`capture_references`; for the fixed-point twin's events (their meta holds the
+design point) the integer references and the quantised contrasts, in log units
+(:mod:`rvsm.model.fixed.event_references`). Files are read chunk by chunk (memory: one chunk
 plus the running counts and the scored steps' responses).
 """
 
@@ -108,9 +110,23 @@ def evaluate_events(source: SpikeSource, scene: Scene, match: str = "gain") -> d
                         f"and model {spec.name} (expected {want})")
     steps = scored_event_steps(scene)
     refs = getattr(source, "references", None)  # reported in an event list
+    contrasts = getattr(source, "contrasts", None)
+    if source.meta.get("design_point") is not None:  # the fixed-point twin's events
+        from rvsm.model.fixed.design_point import DesignPoint
+        from rvsm.model.fixed.event_references import fixed_event_references
+
+        try:
+            point = DesignPoint(**source.meta["design_point"]).with_size(*scene.shape)
+        except (TypeError, RvsmError) as exc:
+            raise RvsmError(f"the event file's design point is not valid ({exc})") from None
+        fixed_refs, fixed_contrasts = fixed_event_references(scene, point)
+        refs = fixed_refs if refs is None else refs
+        contrasts = fixed_contrasts if contrasts is None else contrasts
     if refs is None:
         refs = capture_references(scene, config)
-    responses = event_responses(source, refs, config.contrasts, steps)
+    if contrasts is None:
+        contrasts = config.contrasts
+    responses = event_responses(source, refs, contrasts, steps)
     images = event_images(responses, config)
     truth = np.stack([scene.brightness(int(t), int(t) + 1)[0] for t in steps])
     recon = np.clip(match_brightness(images, truth, match), 0.0, DATA_RANGE)

@@ -10,6 +10,11 @@ brightness (8-bit units, dark current already added) and ``q`` the declared roun
 Clipping: ``"saturate"`` (default) pins out-of-range inputs to code 0 / ``2**N - 1``;
 ``"error"`` refuses any input outside ``[0, full_scale]`` instead.
 
+The event sensor (SPEC section 7) has a log ADC instead (:func:`log_adc_codes`):
+``code = clip(q(ln(max(I, 0) + 1) * 2**f), 0, 2**N - 1)`` with the declared fraction bits
+``f``, the same rounding ``q`` and clipping (``"error"`` refuses an input whose log code
+exceeds ``2**N - 1``); the log is the float model's (:mod:`rvsm.model.events.log_intensity`).
+
 The input is analogue, so this stage alone works on float64; everything after it is
 exact integer arithmetic.
 """
@@ -18,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rvsm.model.events.log_intensity import log_intensity
 from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
 
@@ -69,5 +75,30 @@ def adc_codes(
     elif clip != "saturate":
         raise RvsmError(f"adc.clip must be one of {ADC_CLIPS}, got {clip!r}")
     codes = quantise(b * adc_gain(bits, full_scale), rounding)
+    np.clip(codes, 0, top, out=codes)
+    return codes
+
+
+def log_adc_codes(
+    brightness: np.ndarray,
+    bits: int,
+    frac_bits: int,
+    rounding: str = "round-half-up",
+    clip: str = "saturate",
+) -> np.ndarray:
+    """Log ADC codes ``(B, H, W) int64`` in ``0 .. 2**bits - 1`` of analogue
+    ``brightness (B, H, W)`` (8-bit units): the module docstring's event-sensor rule."""
+    x = log_intensity(brightness) * float(2 ** int(frac_bits))
+    top = unsigned_max(bits)
+    if clip == "error":
+        hi = float(x.max(initial=0.0))
+        if hi > top:
+            raise RvsmError(
+                f"adc.clip = 'error': ln(I + 1) * 2**{frac_bits} reaches {hi:g}, beyond the "
+                f"{bits}-bit code {top}; raise adc.bits, lower adc.log_frac_bits or use "
+                "adc.clip = 'saturate'")
+    elif clip != "saturate":
+        raise RvsmError(f"adc.clip must be one of {ADC_CLIPS}, got {clip!r}")
+    codes = quantise(x, rounding)
     np.clip(codes, 0, top, out=codes)
     return codes

@@ -14,6 +14,12 @@ way, so the fixed twin (:mod:`rvsm.model.fixed.twin`) and the RTL tests share on
    ``acc -= thr`` after +1 and ``acc += thr`` after -1.
 
 All arithmetic is ``int64``; widths are checked so nothing can overflow it.
+
+The event sensor (``sensor = "dvs"``, SPEC section 7) keeps steps 1-2 (its codes come
+from a log ADC) and replaces 3-5 by a W-bit signed saturating reference per accumulator
+(:class:`FixedEventIntegrator`): captured as ``clamp(shifted)`` at the first step after
+a clear (no event); afterwards ``d = shifted - ref`` (exact), ``d >= thr`` is ON (+1,
+``ref = clamp(ref + thr)``), else ``d <= -thr`` is OFF (-1, ``ref = clamp(ref - thr)``).
 """
 
 from __future__ import annotations
@@ -27,6 +33,10 @@ from rvsm.model.fixed.widths import signed_range, unsigned_max
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.geometry import is_symmetric, symmetric_orbits
 from rvsm.model.sampling.config import RESET_MODES
+
+#: What an array senses: the spike camera's integrate-and-fire, or the event camera's
+#: log-intensity changes (SPEC section 7).
+SENSORS = ("spike", "dvs")
 
 
 def integer_receptive_sums(codes: np.ndarray, weights: Sequence[np.ndarray]) -> np.ndarray:
@@ -171,6 +181,10 @@ class FixedIntegrator:
         self.acc_max = np.full(num_scales, np.iinfo(np.int64).min, dtype=np.int64)
         self.acc_hist = np.zeros((num_scales, 64), dtype=np.int64) if histogram else None
 
+    def clear(self) -> None:
+        """Every accumulator back to 0 (the RTL's ``clear``; thresholds kept)."""
+        self.acc[...] = 0
+
     def step(self, sums: np.ndarray) -> np.ndarray:
         """Add ``sums (S, H, W) int64``, saturate, compare, reset; return spikes int8."""
         acc = self.acc
@@ -195,6 +209,72 @@ class FixedIntegrator:
         return spikes
 
 
+class FixedEventIntegrator:
+    """W-bit signed saturating references with integer contrast thresholds: the event
+    sensor's state (module docstring), ``(S, H, W)`` of them.
+
+    The interface of :class:`FixedIntegrator`: ``step(sums)`` takes one step's shifted
+    sums and returns events ``(S, H, W) int8``; ``saturated`` counts, per scale, the
+    reference updates (captures included) that left the W-bit range; with ``track``,
+    ``acc_min``/``acc_max`` are the references' pre-saturation extremes and, with
+    ``histogram``, ``acc_hist`` their bit lengths. :meth:`clear` makes the next step
+    capture again.
+    """
+
+    def __init__(self, thresholds: np.ndarray, accumulator_bits: int, track: bool = False,
+                 histogram: bool = False):
+        self._events = FixedIntegrator(thresholds, accumulator_bits, True, "subtract",
+                                       track, histogram)  # validation and counters
+        self.lo, self.hi, self.thr = self._events.lo, self._events.hi, self._events.thr
+        self.ref = np.zeros_like(self.thr)
+        self.captured = False
+        self.track = self._events.track
+
+    def __getattr__(self, name: str):  # saturated, acc_min, acc_max, acc_hist
+        return getattr(self._events, name)
+
+    def clear(self) -> None:
+        """The next step captures the references again (thresholds kept)."""
+        self.captured = False
+
+    def _update(self, new: np.ndarray) -> None:
+        ev = self._events
+        if self.track:
+            np.minimum(ev.acc_min, new.min(axis=(1, 2)), out=ev.acc_min)
+            np.maximum(ev.acc_max, new.max(axis=(1, 2)), out=ev.acc_max)
+            if ev.acc_hist is not None:
+                ev.acc_hist += bit_length_histogram(new)
+        ev.saturated += ((new > self.hi) | (new < self.lo)).sum(axis=(1, 2))
+        np.clip(new, self.lo, self.hi, out=self.ref)
+
+    def step(self, sums: np.ndarray) -> np.ndarray:
+        """One step's shifted sums ``(S, H, W) int64``; events ``(S, H, W) int8``."""
+        sums = np.asarray(sums, dtype=np.int64)
+        if not self.captured:
+            self._update(sums.copy())
+            self.captured = True
+            return np.zeros(self.thr.shape, dtype=np.int8)
+        d = sums - self.ref
+        pos = d >= self.thr
+        neg = (d <= -self.thr) & ~pos
+        events = pos.astype(np.int8) - neg.astype(np.int8)
+        self._update(self.ref + self.thr * events)
+        return events
+
+
+def make_integrator(sensor: str, thresholds: np.ndarray, accumulator_bits: int,
+                    signed: bool, reset: str = "zero", track: bool = False,
+                    histogram: bool = False) -> FixedIntegrator | FixedEventIntegrator:
+    """The state of ``sensor``'s accumulators: :class:`FixedIntegrator` for the spike
+    camera, :class:`FixedEventIntegrator` for the event sensor (``signed``, ``reset``
+    unused there)."""
+    if sensor == "dvs":
+        return FixedEventIntegrator(thresholds, accumulator_bits, track, histogram)
+    if sensor != "spike":
+        raise RvsmError(f"sensor must be one of {SENSORS}, got {sensor!r}")
+    return FixedIntegrator(thresholds, accumulator_bits, signed, reset, track, histogram)
+
+
 class ContractStream:
     """The integer contract run chunk by chunk: state carried from one call to the next.
 
@@ -208,15 +288,16 @@ class ContractStream:
 
     def __init__(self, weights: Sequence[np.ndarray], shift: int, thresholds: np.ndarray,
                  accumulator_bits: int, signed: bool, reset: str = "zero",
-                 block_steps: int = 32):
+                 block_steps: int = 32, sensor: str = "spike"):
         self.weights = list(weights)
         self.shift = int(shift)
         self.block_steps = max(1, int(block_steps))
-        self.integrator = FixedIntegrator(thresholds, accumulator_bits, signed, reset)
+        self.integrator = make_integrator(sensor, thresholds, accumulator_bits, signed, reset)
 
     def clear(self) -> None:
-        """Every accumulator back to 0 (thresholds kept)."""
-        self.integrator.acc[...] = 0
+        """Every accumulator back to 0 (an event sensor: capture again); thresholds
+        kept."""
+        self.integrator.clear()
 
     def run(self, codes: np.ndarray) -> np.ndarray:
         """Spikes ``(B, S, H, W) int8`` of the next ``B`` steps, codes ``(B, H, W)``."""
@@ -243,13 +324,15 @@ def run_integer_array(
     signed: bool,
     reset: str = "zero",
     block_steps: int = 32,
+    sensor: str = "spike",
 ) -> np.ndarray:
-    """Spikes ``(T, S, H, W) int8`` of the whole contract on ``codes (T, H, W)``.
+    """Spikes (or events) ``(T, S, H, W) int8`` of the whole contract on ``codes (T, H,
+    W)``.
 
     This is the bit-accurate model the RTL is checked against.
     """
     return ContractStream(weights, shift, thresholds, accumulator_bits, signed, reset,
-                          block_steps).run(codes)
+                          block_steps, sensor).run(codes)
 
 
 @dataclass(frozen=True)
@@ -259,7 +342,9 @@ class ArrayContract:
     ``weights`` holds, per scale, the integer kernel as a tuple of row tuples (hashable, so
     a contract can key a cache of generated RTL). Thresholds are *not* part of it: they are
     loaded at run time through the configuration interface (fixed-pattern noise lives
-    there), each in ``1 .. 2**(accumulator_bits-1) - 1``.
+    there), each in ``1 .. 2**(accumulator_bits-1) - 1``. ``sensor`` is ``"spike"`` (the
+    spike camera) or ``"dvs"`` (the event sensor: log ADC codes, references instead of
+    accumulators; module docstring).
     """
 
     height: int
@@ -270,6 +355,7 @@ class ArrayContract:
     accumulator_bits: int
     signed: bool
     reset: str = "zero"
+    sensor: str = "spike"
 
     @property
     def num_scales(self) -> int:
@@ -307,7 +393,7 @@ class ArrayContract:
         parts = [
             run_integer_array(
                 codes[a:b], self.weight_arrays, self.shift, thresholds,
-                self.accumulator_bits, self.signed, self.reset,
+                self.accumulator_bits, self.signed, self.reset, sensor=self.sensor,
             )
             for a, b in zip(bounds[:-1], bounds[1:], strict=True)
         ]
@@ -316,4 +402,5 @@ class ArrayContract:
     def stream(self, thresholds: np.ndarray) -> ContractStream:
         """This contract run chunk by chunk from a cleared array (:class:`ContractStream`)."""
         return ContractStream(self.weight_arrays, self.shift, thresholds,
-                              self.accumulator_bits, self.signed, self.reset)
+                              self.accumulator_bits, self.signed, self.reset,
+                              sensor=self.sensor)

@@ -20,6 +20,7 @@ import numpy as np
 
 from rvsm.model.fixed.core import (
     ArrayContract,
+    FixedEventIntegrator,
     FixedIntegrator,
     arithmetic_shift,
     integer_receptive_sums,
@@ -129,11 +130,14 @@ def coverage(stim: Stimulus) -> list[dict[str, int | None]]:
     sums = _shifted(c, codes)
     lo, hi = signed_range(c.accumulator_bits)
     full = unsigned_max(c.adc_bits)
-    integ = FixedIntegrator(stim.thresholds, c.accumulator_bits, c.signed, c.reset)
-    thr = integ.thr
     clears = {t for t in stim.clear_before if 0 < t < stim.num_steps}
     counts = np.zeros((c.num_scales, len(BINS)), dtype=np.int64)
     idx = {b: i for i, b in enumerate(BINS)}
+    if c.sensor == "dvs":
+        _event_coverage(stim, sums, clears, counts, idx)
+        return _reachable(c, counts)
+    integ = FixedIntegrator(stim.thresholds, c.accumulator_bits, c.signed, c.reset)
+    thr = integ.thr
     axes = (1, 2)
     for t in range(stim.num_steps):
         if t in clears:
@@ -150,11 +154,51 @@ def coverage(stim: Stimulus) -> list[dict[str, int | None]]:
         spikes = integ.step(sums[t])
         counts[:, idx["spike_pos"]] += (spikes == 1).sum(axis=axes)
         counts[:, idx["spike_neg"]] += (spikes == -1).sum(axis=axes)
+    return _reachable(c, counts)
+
+
+def _event_coverage(stim: Stimulus, sums: np.ndarray, clears: set[int], counts: np.ndarray,
+                    idx: dict[str, int]) -> None:
+    """The bins for the event sensor, by its rules (:class:`FixedEventIntegrator`): exact
+    hits are ``d = sum - ref == +-thr``, the rails the references' (a capture or an
+    update leaving the W-bit range), spikes the ON/OFF events, and a mid-stream clear
+    counts the captured non-zero references it drops."""
+    c = stim.contract
+    codes = np.asarray(stim.codes, dtype=np.int64)
+    full = unsigned_max(c.adc_bits)
+    integ = FixedEventIntegrator(stim.thresholds, c.accumulator_bits)
+    lo, hi, thr = integ.lo, integ.hi, integ.thr
+    axes = (1, 2)
+    for t in range(stim.num_steps):
+        if t in clears:
+            if integ.captured:
+                counts[:, idx["clear_mid_stream"]] += (integ.ref != 0).sum(axis=axes)
+            integ.clear()
+        counts[:, idx["code_zero"]] += int((codes[t] == 0).sum())
+        counts[:, idx["code_full"]] += int((codes[t] == full).sum())
+        if integ.captured:
+            d = sums[t] - integ.ref
+            counts[:, idx["exact_threshold_pos"]] += (d == thr).sum(axis=axes)
+            counts[:, idx["exact_threshold_neg"]] += (d == -thr).sum(axis=axes)
+            new = integ.ref + thr * ((d >= thr).astype(np.int64) - ((d <= -thr) & (d < thr)))
+        else:
+            new = sums[t]
+        counts[:, idx["rail_high"]] += (new > hi).sum(axis=axes)
+        counts[:, idx["rail_low"]] += (new < lo).sum(axis=axes)
+        events = integ.step(sums[t])
+        counts[:, idx["spike_pos"]] += (events == 1).sum(axis=axes)
+        counts[:, idx["spike_neg"]] += (events == -1).sum(axis=axes)
+
+
+def _reachable(c: ArrayContract, counts: np.ndarray) -> list[dict[str, int | None]]:
+    """Per scale the bin counts, ``None`` for the bins the contract cannot reach."""
     out: list[dict[str, int | None]] = []
     for scale in range(c.num_scales):
         s_lo, s_hi = c.sum_range(scale)
         reachable = {"rail_low": s_lo < 0, "exact_threshold_neg": c.signed and s_lo < 0,
                      "spike_neg": c.signed and s_lo < 0}
+        if c.sensor == "dvs":  # OFF events whenever the response falls; a reference
+            reachable = {"rail_low": s_lo < 0}  # goes below 0 only with negative sums
         out.append({b: (int(counts[scale, i]) if reachable.get(b, True) else None)
                     for i, b in enumerate(BINS)})
     return out

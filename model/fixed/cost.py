@@ -3,6 +3,10 @@
 Both run on the same scene with the same seed and noise (the float sampler with
 ``point.sampler_config()``); both are scored with
 :func:`~rvsm.model.decode.evaluation.evaluate_spikes` using the nominal float thresholds.
+For the event sensor (``array.sensor = "dvs"``) the float model is
+:func:`~rvsm.model.events.twin.sample_events` with ``point.event_config()`` and both are
+scored by :func:`~rvsm.model.events.reconstruction.evaluate_events` (the twin's events
+decoded with its own integer references and contrasts).
 
 Spike agreement (:func:`spike_agreement`): over every (step, scale, pixel) where either
 model fired, the fraction where both fired the same spike (+1 or -1), i.e.
@@ -64,16 +68,29 @@ def quantisation_cost(
     from rvsm.model.decode.evaluation import evaluate_spikes
 
     point = fit_point(scene, point)
-    config = point.sampler_config()
-    flt = sample(scene, config, progress=progress)
     fix = simulate_fixed(scene, point, progress=progress, ranges=False)
-    agree = spike_agreement(fix.spikes, flt.spikes)
-    phis = point.phis
-    ev_float = evaluate_spikes(flt.spikes, scene, point.model, phis, method=method, match=match)
-    ev_fixed = evaluate_spikes(fix.spikes, scene, point.model, phis, method=method, match=match)
+    if point.sensor == "dvs":  # events of the float event sensor against the twin's
+        from rvsm.model.events.reconstruction import evaluate_events
+        from rvsm.model.events.twin import sample_events
+        from rvsm.model.spikes.source import array_source
+
+        flt_events = sample_events(scene, point.event_config())
+        agree = spike_agreement(fix.spikes, flt_events.events)
+        ev_float = evaluate_events(array_source(flt_events.events, flt_events.meta), scene,
+                                   match=match)
+        ev_fixed = evaluate_events(array_source(fix.spikes, fix.meta), scene, match=match)
+    else:
+        flt = sample(scene, point.sampler_config(), progress=progress)
+        agree = spike_agreement(fix.spikes, flt.spikes)
+        phis = point.phis
+        ev_float = evaluate_spikes(flt.spikes, scene, point.model, phis, method=method,
+                                   match=match)
+        ev_fixed = evaluate_spikes(fix.spikes, scene, point.model, phis, method=method,
+                                   match=match)
     return {
         "scene": scene.name,
         "model": point.model,
+        "sensor": point.sensor,
         "height": point.height,
         "width": point.width,
         "steps": scene.num_steps,
@@ -100,7 +117,8 @@ def format_cost(result: dict) -> str:
     """Human-readable summary of :func:`quantisation_cost`."""
     per = ", ".join(f"{100 * a:.2f}%" for a in result["agreement_per_scale"])
     return "\n".join([
-        f"quantisation cost: {result['model']} on {result['scene']} "
+        f"quantisation cost: {result['model']}"
+        f"{' (event sensor)' if result.get('sensor') == 'dvs' else ''} on {result['scene']} "
         f"({result['height']}x{result['width']}, {result['steps']} steps, "
         f"{result['method']} reconstruction)",
         f"spike agreement  {100 * result['agreement']:.2f}% of spikes (per scale: {per}); "

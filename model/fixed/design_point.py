@@ -24,8 +24,9 @@ from typing import Any
 
 import numpy as np
 
+from rvsm.model.events.config import DEFAULT_CONTRAST, EventConfig
 from rvsm.model.fixed.adc import ADC_CLIPS, ROUNDINGS, adc_gain
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.core import SENSORS, ArrayContract
 from rvsm.model.fixed.fields import (
     Choice,
     Field,
@@ -58,6 +59,7 @@ MAX_FRAC_BITS = 40
 MAX_SHIFT = 48
 MAX_ACC_BITS = 62
 MAX_SIDE = 1 << 16
+MAX_LOG_FRAC_BITS = 16
 
 
 @dataclass(frozen=True)
@@ -74,6 +76,8 @@ class DesignPoint:
                          sweep=False)
     model: str = declare("array", "model", Choice(MODEL_NAMES, normalise=True, noun="model"),
                          "dog4", "sampling model")
+    sensor: str = declare("array", "sensor", Choice(SENSORS), "spike",
+                          "spike camera, or dvs: the event sensor of SPEC section 7")
     adc_bits: int = declare("adc", "bits", Integer(1, MAX_ADC_BITS), 7,
                             "ADC resolution N; codes 0..2**N - 1")
     adc_full_scale: float = declare("adc", "full_scale", Number(), 255.0,
@@ -82,6 +86,9 @@ class DesignPoint:
                                 "brightness -> code rounding")
     adc_clip: str = declare("adc", "clip", Choice(ADC_CLIPS), "saturate",
                             "inputs outside 0..full_scale: pin to the rails, or refuse")
+    adc_log_frac_bits: int = declare(
+        "adc", "log_frac_bits", Integer(0, MAX_LOG_FRAC_BITS), 5,
+        "sensor dvs: the log ADC's fraction bits f, code = q(ln(I + 1) * 2**f)")
     weight_bits: int = declare("weights", "bits", Integer(2, MAX_WEIGHT_BITS), 11,
                                "total bits of a signed weight", auto=True)
     weight_frac_bits: int = declare("weights", "frac_bits", Integer(0, MAX_FRAC_BITS), 9,
@@ -98,6 +105,11 @@ class DesignPoint:
     scale_phi: tuple[float, ...] | None = declare(
         "threshold", "scale_phi", PositiveNumbers(), None,
         "per-scale thresholds overriding phi, one per scale")
+    contrast: float = declare("threshold", "contrast", Number(), DEFAULT_CONTRAST,
+                              "sensor dvs: contrast threshold C, log-intensity units")
+    scale_contrast: tuple[float, ...] | None = declare(
+        "threshold", "scale_contrast", PositiveNumbers(), None,
+        "sensor dvs: per-scale contrast thresholds overriding contrast")
     threshold_rounding: str = declare("threshold", "rounding", Choice(THRESHOLD_ROUNDINGS),
                                       "ceil", "threshold -> LSB rounding")
     reset: str = declare("threshold", "reset", Choice(RESET_MODES), "zero",
@@ -127,6 +139,15 @@ class DesignPoint:
                 f"{self.model} has {self.spec.num_scales} scale(s); give one per scale "
                 "or remove it to use threshold.phi for every scale"
             )
+        if self.scale_contrast is not None and \
+                len(self.scale_contrast) != self.spec.num_scales:
+            raise RvsmError(
+                f"{FIELD_PATH['scale_contrast']} has {len(self.scale_contrast)} value(s) but "
+                f"model {self.model} has {self.spec.num_scales} scale(s); give one per scale "
+                "or remove it to use threshold.contrast for every scale")
+        if self.sensor == "dvs" and self.threshold_rule == "response":
+            raise RvsmError(f"{FIELD_PATH['threshold_rule']} = \"response\" is a spike-camera "
+                            "rule; an event sensor's thresholds are threshold.contrast")
         if self.threshold_rule == "response" and self.scale_phi is not None:
             raise RvsmError(
                 f"{FIELD_PATH['threshold_rule']} = \"response\" computes the per-scale "
@@ -163,8 +184,13 @@ class DesignPoint:
 
     def _check_thresholds(self) -> None:
         lo, hi = signed_range(self.accumulator_bits)
-        field = "threshold.scale_phi" if self.scale_phi is not None else "threshold.phi"
-        for s, (v, t) in enumerate(zip(self.phis, self.nominal_thresholds(), strict=True)):
+        if self.sensor == "dvs":
+            field = ("threshold.scale_contrast" if self.scale_contrast is not None
+                     else "threshold.contrast")
+        else:
+            field = "threshold.scale_phi" if self.scale_phi is not None else "threshold.phi"
+        for s, (v, t) in enumerate(zip(self.nominal_values, self.nominal_thresholds(),
+                                       strict=True)):
             if t > hi:
                 raise RvsmError(
                     f"{field} = {v:g} (scale {s}) maps to {t} accumulator LSBs, which a "
@@ -192,8 +218,9 @@ class DesignPoint:
 
     @property
     def signed(self) -> bool:
-        """True for RVSM models (fire -1 too), False for FSM."""
-        return self.spec.signed
+        """True for RVSM models (fire -1 too), False for FSM; an event sensor is always
+        signed (ON and OFF events)."""
+        return self.spec.signed or self.sensor == "dvs"
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -220,13 +247,30 @@ class DesignPoint:
         return np.full(self.num_scales, float(self.phi))
 
     @property
+    def contrasts(self) -> np.ndarray:
+        """Nominal contrast threshold per scale, ``(S,) float64`` (log-intensity units):
+        ``scale_contrast``, else ``contrast`` (the event sensor's thresholds)."""
+        if self.scale_contrast is not None:
+            return np.array(self.scale_contrast, dtype=np.float64)
+        return np.full(self.num_scales, float(self.contrast))
+
+    @property
+    def nominal_values(self) -> np.ndarray:
+        """The nominal float thresholds of this sensor: :attr:`contrasts` (dvs) or
+        :attr:`phis` (spike)."""
+        return self.contrasts if self.sensor == "dvs" else self.phis
+
+    @property
     def adc_gain(self) -> float:
         """ADC codes per brightness unit, ``(2**adc_bits - 1) / adc_full_scale``."""
         return adc_gain(self.adc_bits, self.adc_full_scale)
 
     @property
     def threshold_scale(self) -> float:
-        """Accumulator LSBs per brightness unit: ``adc_gain * 2**frac / 2**shift``."""
+        """Accumulator LSBs per threshold unit: per brightness unit ``adc_gain * 2**frac /
+        2**shift`` (spike), per log-intensity unit ``2**f * 2**frac / 2**shift`` (dvs)."""
+        if self.sensor == "dvs":
+            return 2.0 ** (self.adc_log_frac_bits + self.weight_frac_bits - self.shift)
         return self.adc_gain * 2.0 ** (self.weight_frac_bits - self.shift)
 
     def with_size(self, height: int, width: int) -> DesignPoint:
@@ -250,6 +294,7 @@ class DesignPoint:
             accumulator_bits=self.accumulator_bits,
             signed=self.signed,
             reset=self.reset,
+            sensor=self.sensor,
         )
 
     def to_threshold_lsbs(self, values: np.ndarray) -> np.ndarray:
@@ -264,7 +309,7 @@ class DesignPoint:
 
     def nominal_thresholds(self) -> np.ndarray:
         """Integer threshold per scale without fixed-pattern noise, ``(S,) int64``."""
-        return self.to_threshold_lsbs(self.phis)
+        return self.to_threshold_lsbs(self.nominal_values)
 
     def noise_params(self) -> NoiseParams | None:
         """The float model's noise parameters (SPEC defaults, this point's k and seed; a
@@ -295,9 +340,18 @@ class DesignPoint:
             ).copy()
         src = noise if noise is not None else self.noise_source()
         theta, v_os = src.fixed_pattern()
-        analog = np.maximum(theta * self.phis[:, None, None] + v_os, 0.0)
+        if self.sensor == "dvs":  # the gain only (SPEC section 7)
+            analog = np.maximum(theta * self.contrasts[:, None, None], 0.0)
+        else:
+            analog = np.maximum(theta * self.phis[:, None, None] + v_os, 0.0)
         _, hi = signed_range(self.accumulator_bits)
         return np.clip(self.to_threshold_lsbs(analog), 1, hi)
+
+    def event_config(self) -> EventConfig:
+        """The float event sensor this point approximates (same model, contrasts,
+        noise)."""
+        return EventConfig(model=self.model, contrast=float(self.contrast),
+                           scale_contrast=self.scale_contrast, noise=self.noise_params())
 
     def sampler_config(self) -> SamplerConfig:
         """The float sampler this point approximates (same model, phi, reset, noise)."""
@@ -319,9 +373,16 @@ class DesignPoint:
         """Smallest ``datapath.accumulator_bits`` holding the largest nominal threshold.
 
         Saturation at ``2**(W-1)-1 >= threshold`` still fires, so with ``reset = "zero"``
-        nothing is lost.
+        nothing is lost. An event sensor's references must also hold every shifted sum
+        (a saturated reference misreports the response).
         """
-        return signed_bits(int(self.nominal_thresholds().max()))
+        need = signed_bits(int(self.nominal_thresholds().max()))
+        if self.sensor == "dvs":
+            c = self.contract()
+            for s in range(self.num_scales):
+                lo, hi = c.sum_range(s)
+                need = max(need, signed_bits(hi >> self.shift), signed_bits(lo >> self.shift))
+        return need
 
     @classmethod
     def with_smallest_widths(
@@ -348,6 +409,8 @@ class DesignPoint:
         """Flat plain-JSON form (field name -> value)."""
         d = dataclasses.asdict(self)
         d["scale_phi"] = list(self.scale_phi) if self.scale_phi is not None else None
+        d["scale_contrast"] = (list(self.scale_contrast) if self.scale_contrast is not None
+                               else None)
         return d
 
 

@@ -4,20 +4,21 @@ Steps run in blocks: the analogue brightness ``I_t`` of a block (+ dark current 
 point's :class:`~rvsm.model.noise.sensor.NoiseSource`, the same streams as the float
 twin's), its ADC codes (:mod:`.adc`) and exact integer receptive sums for the whole block
 at once (:mod:`.core`), then the per-step arithmetic shift, saturation, compare, fire and
-reset over whole ``(S, H, W)`` arrays (:class:`~.core.FixedIntegrator`). The spikes are
-exactly ``point.contract().run(codes, thresholds)``.
+reset over whole ``(S, H, W)`` arrays (:class:`~.core.FixedIntegrator`; for the event
+sensor the log ADC and :class:`~.core.FixedEventIntegrator`). The spikes are exactly
+``point.contract().run(codes, thresholds)``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from rvsm.model.fixed.adc import adc_codes
+from rvsm.model.fixed.adc import adc_codes, log_adc_codes
 from rvsm.model.fixed.core import (
-    FixedIntegrator,
     arithmetic_shift,
     bit_length_histogram,
     integer_receptive_sums,
+    make_integrator,
 )
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.noise.sensor import NoiseSource
@@ -33,6 +34,9 @@ def step_codes(scene: Scene, point: DesignPoint, noise: NoiseSource | None, t0: 
     analog = scene.brightness(t0, t1)
     if noise is not None:
         analog += noise.dark_current_at(t0, t1 - t0)
+    if point.sensor == "dvs":
+        return log_adc_codes(analog, point.adc_bits, point.adc_log_frac_bits,
+                             point.adc_rounding, point.adc_clip)
     return adc_codes(analog, point.adc_bits, point.adc_full_scale, point.adc_rounding,
                      point.adc_clip)
 
@@ -56,8 +60,8 @@ class NumpyFixedTwin:
         self.noise = point.noise_source()
         self.weights = point.contract().weight_arrays
         self.block_steps = int(block_steps)
-        self.integrator = FixedIntegrator(
-            thresholds, point.accumulator_bits, point.signed, point.reset,
+        self.integrator = make_integrator(
+            point.sensor, thresholds, point.accumulator_bits, point.signed, point.reset,
             track=True, histogram=histograms,
         )
         s = point.num_scales

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.core import SENSORS, ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
 from rvsm.model.fixed.twin import simulate_fixed
@@ -241,7 +241,7 @@ def _contract(value: np.ndarray, source: str) -> ArrayContract:
         raise RvsmError(f"{source}: 'contract' is not valid JSON ({exc})") from None
     fields = {f.name for f in dataclasses.fields(ArrayContract)}
     if not isinstance(raw, dict) or set(raw) - fields or \
-            fields - {"reset"} - set(raw):
+            fields - {"reset", "sensor"} - set(raw):
         raise RvsmError(f"{source}: 'contract' must be an object with the fields "
                         f"{', '.join(sorted(fields))}")
     for name, (lo, hi) in _CONTRACT_LIMITS.items():
@@ -252,6 +252,9 @@ def _contract(value: np.ndarray, source: str) -> ArrayContract:
     if not isinstance(raw["signed"], bool) or raw.get("reset", "zero") not in _RESETS:
         raise RvsmError(f"{source}: contract signed must be true/false and reset one of "
                         f"{_RESETS}")
+    if raw.get("sensor", "spike") not in SENSORS:
+        raise RvsmError(f"{source}: contract sensor must be one of {SENSORS}, got "
+                        f"{raw.get('sensor')!r}")
     raw["weights"] = _kernels(raw["weights"], source)
     return ArrayContract(**raw)
 

@@ -112,8 +112,9 @@ class StimulusChunks:
         cuts = sorted({t for t in self.clear_before if 0 < t < self.num_steps})
         bounds = [0, *cuts, self.num_steps]
         stream = twin = None
-        if self.stimulus is None and self._engine == "numpy":
-            stream = self.contract.stream(self.thresholds)
+        if self.stimulus is None and (self._engine == "numpy"
+                                      or self.contract.sensor != "spike"):
+            stream = self.contract.stream(self.thresholds)  # the event sensor: no fused twin
         elif self.stimulus is None:
             assert self._scene is not None and self._point is not None
             if cuts:

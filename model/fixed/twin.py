@@ -62,7 +62,8 @@ def stream_fixed(
     saturation counts are always kept): about 1.5x faster. ``keep_codes`` keeps every
     step's ADC codes in ``codes`` (for stimulus files) and ``histograms`` fills the
     profiling histograms; both run the numpy engine (dark current in blocks of
-    ``block_steps``).
+    ``block_steps``). The event sensor's twin (``array.sensor = "dvs"``) runs the numpy
+    engine whichever ``engine`` is named: it has no fused kernel yet.
     """
     check_engine(engine)
     check_chunking(chunk_steps, tile_rows)
@@ -70,7 +71,7 @@ def stream_fixed(
     thresholds = point.integer_thresholds(point.noise_source())
     s_count, (h, w), t_total = point.num_scales, point.shape, scene.num_steps
     shape = (t_total, s_count, h, w)
-    if engine == "fused" and not keep_codes and not histograms:
+    if engine == "fused" and not keep_codes and not histograms and point.sensor == "spike":
         twin = FusedFixedTwin(scene, point, thresholds, tile_rows, ranges)
     else:
         twin = NumpyFixedTwin(scene, point, thresholds, block_steps, keep_codes, histograms)

@@ -20,7 +20,7 @@ MAX_SIDE = 64
 
 
 def check_size(contract: ArrayContract) -> None:
-    """The size rule: at most :data:`MAX_SIDE` pixels on each side."""
+    """The size rule: at most :data:`MAX_SIDE` pixels on each side (either sensor)."""
     if max(contract.height, contract.width) > MAX_SIDE:
         raise RvsmError(
             f"the fully parallel RTL array is limited to {MAX_SIDE}x{MAX_SIDE} pixels "

@@ -49,6 +49,7 @@ from amaranth.hdl import (
 
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.widths import signed_range
+from rvsm.rtl.architecture import require_spike_sensor
 from rvsm.rtl.formal import ElaborateAfter, FormalHarness
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.array import RvsmArray, accumulator_index
@@ -264,4 +265,5 @@ class ParallelProperties(FormalHarness):
 def parallel_properties(contract: ArrayContract, mutation: str | None = None,
                         **options: int) -> ParallelProperties:
     """The ``"properties"`` harness factory of :data:`~rvsm.rtl.parallel.PARALLEL`."""
+    require_spike_sensor(contract, "the formal properties")
     return ParallelProperties(contract, mutation=mutation)

@@ -20,7 +20,7 @@ reset returns the threshold to its ``init`` value ``2**(W-1) - 1``.
 
 from __future__ import annotations
 
-from amaranth.hdl import Module, Mux, Signal, signed, unsigned
+from amaranth.hdl import Module, Mux, Signal, Value, signed, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -34,7 +34,11 @@ class PixelCell(wiring.Component):
     """The accumulator of one (scale, pixel).
 
     Parameters: ``sum_bits`` (signed width of ``sum_in``), ``shift``, ``accumulator_bits``
-    (W), ``signed_model`` (fire -1 spikes), ``reset`` (``"zero"`` or ``"subtract"``).
+    (W), ``signed_model`` (fire -1 spikes), ``reset`` (``"zero"`` or ``"subtract"``),
+    ``sensor``: ``"spike"``, or ``"dvs"`` for the event sensor's cell (``acc`` is then the
+    reference, captured as ``clamp(shifted)`` at the first strobe after a clear or reset
+    with no event; afterwards ``d = shifted - ref``, ``d >= thr`` ON and ``ref =
+    clamp(ref + thr)``, else ``d <= -thr`` OFF and ``ref = clamp(ref - thr)``).
 
     Ports: ``sum_in`` In(signed(sum_bits)); ``strobe``, ``clear`` In(1); ``thr``
     In(ThresholdWriteSignature(W-1)): ``thr.we``, ``thr.data``; ``spike_pos``,
@@ -55,7 +59,11 @@ class PixelCell(wiring.Component):
         signed_model: bool,
         reset: str = "zero",
         mutation: str | None = None,
+        sensor: str = "spike",
     ):
+        if sensor not in ("spike", "dvs"):
+            raise ValueError(f"sensor must be 'spike' or 'dvs', got {sensor!r}")
+        self.sensor = sensor
         if reset not in ("zero", "subtract"):
             raise ValueError(f"reset must be 'zero' or 'subtract', got {reset!r}")
         self.sum_bits = sum_bits
@@ -113,6 +121,8 @@ class PixelCell(wiring.Component):
         else:
             after = Mux(pos, sat - thr, Mux(neg, sat + thr, sat))
 
+        if self.sensor == "dvs":
+            return self._event_cell(m, thr, acc, shifted)
         with m.If(self.thr.we):
             m.d.sync += thr.eq(self.thr.data)
         clear = self.clear if self.mutation != "parallel.clear_ignored" else 0
@@ -120,4 +130,24 @@ class PixelCell(wiring.Component):
             m.d.sync += [acc.eq(0), self.spike_pos.eq(0), self.spike_neg.eq(0)]
         with m.Elif(self.strobe):
             m.d.sync += [acc.eq(after), self.spike_pos.eq(pos), self.spike_neg.eq(neg)]
+        return m
+
+    def _event_cell(self, m: Module, thr: Signal, ref: Signal, shifted: Value) -> Module:
+        """The event sensor's next-state logic (class docstring): ``ref`` in ``acc``."""
+        lo, hi = self.acc_range
+        captured = Signal()
+        d = Signal(signed(max(self.accumulator_bits, len(shifted)) + 1))
+        m.d.comb += d.eq(shifted - ref)
+        up, down = d >= thr, d <= -thr
+        moved = Mux(up, ref + thr, Mux(down, ref - thr, ref))
+        new = Mux(captured, moved, shifted)
+        with m.If(self.thr.we):
+            m.d.sync += thr.eq(self.thr.data)
+        with m.If(self.clear):
+            m.d.sync += [ref.eq(0), captured.eq(0), self.spike_pos.eq(0),
+                         self.spike_neg.eq(0)]
+        with m.Elif(self.strobe):
+            m.d.sync += [ref.eq(Mux(new > hi, hi, Mux(new < lo, lo, new))),
+                         captured.eq(1), self.spike_pos.eq(captured & up),
+                         self.spike_neg.eq(captured & ~up & down)]
         return m

@@ -69,7 +69,7 @@ def _notes(dut: RvsmStreamArray) -> list[str]:
 
 
 def _check(contract: ArrayContract, lanes: int) -> None:
-    StreamGeometry(contract, lanes)
+    StreamGeometry(contract, lanes)  # both sensors: the spike camera and the event sensor
 
 
 def _compare(contract: ArrayContract, expected: np.ndarray, got: OutputBeats,

@@ -496,15 +496,24 @@ class RvsmStreamArray(wiring.Component):
                 fire_neg = (~fire_pos & (total <= -thr1)) if c.signed else Const(0)
                 if self.mutation == "stream.no_negative_spikes":
                     fire_neg = Const(0)
-                tail_stmts += [
-                    total.eq(acc + shifted),
-                    thr1.eq(thr_q[i * tw:(i + 1) * tw]),
-                    sat.eq(total[:wa].as_signed()
-                           if self.mutation == "stream.no_saturation"  # wraps around
-                           else Mux(total > hi, hi, Mux(total < lo, lo, total))),
-                    pos.eq(fire_pos), neg.eq(fire_neg), thr2.eq(thr1),
-                ]
-                if self.mutation == "stream.no_reset_on_spike":
+                if c.sensor == "dvs":
+                    tail_stmts += self._event_tail(m, s, i, acc_q[i * wa:(i + 1) * wa]
+                                                   .as_signed(), fresh, shifted,
+                                                   thr_q[i * tw:(i + 1) * tw], total, thr1,
+                                                   sat, thr2, pos, neg)
+                    after = sat
+                else:
+                    tail_stmts += [
+                        total.eq(acc + shifted),
+                        thr1.eq(thr_q[i * tw:(i + 1) * tw]),
+                        sat.eq(total[:wa].as_signed()
+                               if self.mutation == "stream.no_saturation"  # wraps around
+                               else Mux(total > hi, hi, Mux(total < lo, lo, total))),
+                        pos.eq(fire_pos), neg.eq(fire_neg), thr2.eq(thr1),
+                    ]
+                if c.sensor == "dvs":
+                    pass
+                elif self.mutation == "stream.no_reset_on_spike":
                     after = sat
                 elif c.reset == "zero" or self.mutation == "stream.zero_instead_of_subtract":
                     after = Mux(pos | neg, 0, sat)
@@ -527,3 +536,32 @@ class RvsmStreamArray(wiring.Component):
             m.d.sync += tail_stmts
         m.d.sync += self.spikes.valid.eq(wr_en)
         return probes, thr_memories
+
+    def _event_tail(self, m: Module, s: int, i: int, ref: Value, fresh: Value,
+                    shifted: Value, thr: Value, total: Signal, thr1: Signal, sat: Signal,
+                    thr2: Signal, pos: Signal, neg: Signal) -> list:
+        """The event sensor's tail for lane ``i`` of scale ``s`` (``contract.sensor ==
+        "dvs"``): the statements of its two registered stages, the same registers as the
+        spike camera's (``total`` holds ``d = shifted - ref``, ``sat`` the new
+        reference, written back).
+
+        Stage 1: ``d = shifted - ref`` (exact), the threshold, the capture flag (a fresh
+        frame: the first after a clear), the sum and the reference. Stage 2: ``pos = ~cap
+        & d >= thr``, ``neg = ~cap & ~pos & d <= -thr`` and the new reference
+        ``clamp(cap ? shifted : ref + thr*pos - thr*neg)``.
+        """
+        wa = self.contract.accumulator_bits
+        lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
+        data = {"reset_less": True}
+        cap1 = Signal(name=f"cap1_s{s}_l{i}", **data)
+        sum1 = Signal(signed(len(shifted)), name=f"sum1_s{s}_l{i}", **data)
+        ref1 = Signal(signed(wa), name=f"ref1_s{s}_l{i}", **data)
+        up, down = total >= thr1, total <= -thr1
+        moved = Mux(up, ref1 + thr1, Mux(down, ref1 - thr1, ref1))
+        new = Mux(cap1, sum1, moved)
+        return [
+            total.eq(shifted - ref), thr1.eq(thr), cap1.eq(fresh), sum1.eq(shifted),
+            ref1.eq(ref),
+            pos.eq(~cap1 & up), neg.eq(~cap1 & ~up & down), thr2.eq(thr1),
+            sat.eq(Mux(new > hi, hi, Mux(new < lo, lo, new))),
+        ]

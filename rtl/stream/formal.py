@@ -67,6 +67,7 @@ from amaranth.hdl import Array, Cat, Module, Mux, ResetSignal, Signal, Value, si
 
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.widths import signed_range
+from rvsm.rtl.architecture import require_spike_sensor
 from rvsm.rtl.formal import ElaborateAfter, FormalHarness
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.array import RvsmArray
@@ -563,6 +564,7 @@ def stream_check(group: str):
 
     def factory(contract: ArrayContract, mutation: str | None = None, lanes: int = 1,
                 **options: int) -> StreamProperties:
+        require_spike_sensor(contract, "the formal properties")
         return StreamProperties(contract, lanes, mutation, groups=(group,))
 
     factory.__name__ = f"stream_{group}"
@@ -573,4 +575,5 @@ def stream_check(group: str):
 def stream_equivalence(contract: ArrayContract, mutation: str | None = None,
                        lanes: int = 1, **options: int) -> StreamEquivalence:
     """The ``"equivalence"`` harness factory of :data:`~rvsm.rtl.stream.STREAM`."""
+    require_spike_sensor(contract, "the formal properties")
     return StreamEquivalence(contract, lanes, mutation)

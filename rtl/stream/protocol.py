@@ -22,8 +22,8 @@ applied in numpy:
 * position ``p`` reads its threshold word at the edge after the one accepting beat
   ``p + threshold_lag``: a write at an earlier edge is seen, one at that edge is not;
 * released positions of a frame cut by a clear are those whose window had arrived, so
-  :class:`~rvsm.model.fixed.core.FixedIntegrator` over the segment's frames (with the
-  thresholds each position read) gives every spike.
+  the contract's integrator over the segment's frames (with the thresholds each position
+  read; :func:`~rvsm.model.fixed.core.make_integrator`, either sensor) gives every spike.
 """
 
 from __future__ import annotations
@@ -36,9 +36,9 @@ import numpy as np
 
 from rvsm.model.fixed.core import (
     ArrayContract,
-    FixedIntegrator,
     arithmetic_shift,
     integer_receptive_sums,
+    make_integrator,
 )
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.stream.geometry import StreamGeometry
@@ -271,7 +271,8 @@ def _expected(c: ArrayContract, geo: StreamGeometry, seg_info: list, we: np.ndar
             .transpose(0, 3, 1, 2, 4).reshape(n_frames, c.num_scales, c.height, c.width)
         sums = arithmetic_shift(integer_receptive_sums(frames[:n_frames], c.weight_arrays),
                                 c.shift)
-        integ = FixedIntegrator(thr_frames[0], c.accumulator_bits, c.signed, c.reset)
+        integ = make_integrator(c.sensor, thr_frames[0], c.accumulator_bits, c.signed,
+                                c.reset)
         spikes = []
         for t in range(n_frames):
             integ.thr = thr_frames[t]

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from rvsm.model.decode.reconstruction import MATCH_MODES, METHODS
+from rvsm.model.fixed.core import SENSORS
 from rvsm.model.sampling.thresholds import THRESHOLD_RULES
 from rvsm.sim.cli.args import (
     SceneRequest,
@@ -17,6 +18,9 @@ from rvsm.sim.cli.args import (
 )
 from rvsm.sim.cli.outputs import PLAIN, Output, check_outputs
 
+#: ``rvsm config new --sensor dvs``: log ADC bits (ln(I + 1) of 8-bit brightness needs
+#: 5.55 * 2**5 = 178 codes).
+DVS_ADC_BITS = 8
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``config``, ``stimulus``, ``profile`` and ``cost``."""
@@ -26,6 +30,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     q = cfg.add_parser("new", help="print the documented default design point as TOML")
     q.add_argument("-o", "--output", help="write to this file instead of stdout")
     q.add_argument("--size", metavar="HxW", help="array size (default 250x400)")
+    q.add_argument("--sensor", choices=SENSORS, default="spike",
+                   help="spike (default) or dvs: the event sensor of SPEC section 7, with "
+                   "an 8-bit log ADC of 5 fraction bits (ln(I + 1) up to 7.97)")
     add_force_argument(q)
     q.set_defaults(func=run_config_new)
     q = cfg.add_parser("check", help="validate a design point and print its integers")
@@ -86,6 +93,10 @@ def run_config_new(args: argparse.Namespace) -> int:
 
     check_outputs([args.output and Output(args.output, "-o", PLAIN)], force=args.force)
     point = default_design_point()
+    if args.sensor == "dvs":
+        import dataclasses
+
+        point = dataclasses.replace(point, sensor="dvs", adc_bits=DVS_ADC_BITS)
     size = parse_size_arg(args.size)
     if size is not None:
         point = point.with_size(*size)
@@ -103,14 +114,21 @@ def run_config_check(args: argparse.Namespace) -> int:
 
     p = load_design_point(args.point)
     c = p.contract()
-    print(f"{args.point}: valid design point, {p.model} on {p.height}x{p.width}")
-    print(f"  ADC {p.adc_bits} bits, {p.adc_gain:.6g} codes per brightness unit "
-          f"({p.adc_rounding}, {p.adc_clip})")
+    sensor = " (event sensor)" if p.sensor == "dvs" else ""
+    print(f"{args.point}: valid design point, {p.model}{sensor} on {p.height}x{p.width}")
+    if p.sensor == "dvs":
+        print(f"  log ADC {p.adc_bits} bits, code = ln(I + 1) * 2**{p.adc_log_frac_bits} "
+              f"({p.adc_rounding}, {p.adc_clip}; ln(I + 1) up to "
+              f"{((1 << p.adc_bits) - 1) / 2 ** p.adc_log_frac_bits:.3g})")
+    else:
+        print(f"  ADC {p.adc_bits} bits, {p.adc_gain:.6g} codes per brightness unit "
+              f"({p.adc_rounding}, {p.adc_clip})")
     print(f"  weights {p.weight_bits} bits / {p.weight_frac_bits} fraction "
           f"({p.weight_rounding}); shift {p.shift}; accumulator {p.accumulator_bits} bits")
     for s, t in enumerate(p.nominal_thresholds()):
         lo, hi = c.sum_range(s)
-        print(f"  scale {s}: threshold {int(t)} LSBs (phi {p.phis[s]:g}), "
+        what = "contrast" if p.sensor == "dvs" else "phi"
+        print(f"  scale {s}: threshold {int(t)} LSBs ({what} {p.nominal_values[s]:g}), "
               f"per-step sum {lo}..{hi}, kernel {len(c.weights[s])}x{len(c.weights[s])}")
     return 0
 

@@ -210,7 +210,8 @@ def run_simulate(args: argparse.Namespace) -> int:
     t = counts.steps
     s = len(counts.per_scale)
     h, w = scene.shape
-    what = ("events", "OFF") if args.sensor == "dvs" else ("spikes", "negative")
+    events = args.sensor == "dvs" or (args.fixed and point.sensor == "dvs")
+    what = ("events", "OFF") if events else ("spikes", "negative")
     print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}, "
           f"{counts.spikes} {what[0]} ({counts.negative} {what[1]})")
     return 0

@@ -19,6 +19,7 @@ from pathlib import Path
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.architecture import require_spike_sensor
 from rvsm.rtl.mutations import Mutation, mutations_for
 from rvsm.sim.mutate.checks import COSIM_CHECKS
 
@@ -75,6 +76,7 @@ def tiny_formal_point(point: DesignPoint, arch: str) -> DesignPoint:
 
 def _contracts(point: DesignPoint) -> dict[str, ArrayContract]:
     base = point.contract()
+    require_spike_sensor(base, "the mutations")
     return {reset: dataclasses.replace(base, reset=reset) for reset in RESETS}
 
 
