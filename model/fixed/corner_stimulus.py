@@ -40,6 +40,8 @@ BINS: tuple[str, ...] = ("code_zero", "code_full", "exact_threshold_pos",
                          "spike_neg", "clear_mid_stream")
 
 MIN_STEPS = 12
+#: Missing bins a summary line names before it counts the rest.
+MAX_LISTED = 10
 
 
 def _shifted(contract: ArrayContract, codes: np.ndarray) -> np.ndarray:
@@ -211,6 +213,8 @@ def coverage_summary(cov: list[dict[str, int | None]]) -> list[str]:
         live = {b: n for b, n in bins.items() if n is not None}
         hit = [b for b, n in live.items() if n > 0]
         missing = [b for b in live if b not in hit]
-        tail = f" (missing: {', '.join(missing)})" if missing else ""
+        shown = ", ".join(missing[:MAX_LISTED])
+        more = f", and {len(missing) - MAX_LISTED} more" if len(missing) > MAX_LISTED else ""
+        tail = f" (missing: {shown}{more})" if missing else ""
         lines.append(f"scale {scale}: {len(hit)}/{len(live)} bins hit{tail}")
     return lines

@@ -545,23 +545,30 @@ class RvsmStreamArray(wiring.Component):
         spike camera's (``total`` holds ``d = shifted - ref``, ``sat`` the new
         reference, written back).
 
-        Stage 1: ``d = shifted - ref`` (exact), the threshold, the capture flag (a fresh
-        frame: the first after a clear), the sum and the reference. Stage 2: ``pos = ~cap
-        & d >= thr``, ``neg = ~cap & ~pos & d <= -thr`` and the new reference
-        ``clamp(cap ? shifted : ref + thr*pos - thr*neg)``.
+        Stage 1, in parallel: ``d = shifted - ref`` (exact), the threshold, the capture
+        flag (a fresh frame: the first after a clear), ``clamp(shifted)``, ``ref + thr``
+        and ``ref - thr`` with their overflow bits (``ref`` and ``thr`` fit W bits, so a
+        W+1-bit sum leaves the range exactly when its top two bits differ). Stage 2: ``up
+        = d >= thr``, ``down = d <= -thr``, ``pos = ~cap & up``, ``neg = ~cap & ~up &
+        down`` and the new reference, a 4-way choice of stage-1 values: one compare and
+        a multiplexer, the short path ``rvsm fpga`` measured (``docs/events.md``).
         """
         wa = self.contract.accumulator_bits
         lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
         data = {"reset_less": True}
         cap1 = Signal(name=f"cap1_s{s}_l{i}", **data)
-        sum1 = Signal(signed(len(shifted)), name=f"sum1_s{s}_l{i}", **data)
+        sum1 = Signal(signed(wa), name=f"sum1_s{s}_l{i}", **data)
         ref1 = Signal(signed(wa), name=f"ref1_s{s}_l{i}", **data)
+        up1 = Signal(signed(wa + 1), name=f"up1_s{s}_l{i}", **data)
+        down1 = Signal(signed(wa + 1), name=f"down1_s{s}_l{i}", **data)
+        up_over = up1[wa] ^ up1[wa - 1]
+        down_over = down1[wa] ^ down1[wa - 1]
         up, down = total >= thr1, total <= -thr1
-        moved = Mux(up, ref1 + thr1, Mux(down, ref1 - thr1, ref1))
-        new = Mux(cap1, sum1, moved)
+        moved = Mux(up, Mux(up_over, hi, up1), Mux(down, Mux(down_over, lo, down1), ref1))
         return [
-            total.eq(shifted - ref), thr1.eq(thr), cap1.eq(fresh), sum1.eq(shifted),
-            ref1.eq(ref),
+            total.eq(shifted - ref), thr1.eq(thr), cap1.eq(fresh),
+            sum1.eq(Mux(shifted > hi, hi, Mux(shifted < lo, lo, shifted))),
+            ref1.eq(ref), up1.eq(ref + thr), down1.eq(ref - thr),
             pos.eq(~cap1 & up), neg.eq(~cap1 & ~up & down), thr2.eq(thr1),
-            sat.eq(Mux(new > hi, hi, Mux(new < lo, lo, new))),
+            sat.eq(Mux(cap1, sum1, moved)),
         ]
