@@ -41,6 +41,10 @@ BINS: tuple[str, ...] = ("code_zero", "code_full", "exact_threshold_pos",
 MIN_STEPS = 12
 
 
+#: Steps whose sums :func:`coverage` holds at once.
+COVERAGE_CHUNK_STEPS = 32
+
+
 def _shifted(contract: ArrayContract, codes: np.ndarray) -> np.ndarray:
     """Shifted weighted sums ``(T, S, H, W) int64`` of ``codes (T, H, W)``."""
     return arithmetic_shift(integer_receptive_sums(codes, contract.weight_arrays),
@@ -119,33 +123,34 @@ def _segment_images(c: ArrayContract, level: int) -> list[np.ndarray]:
 
 def coverage(stim: Stimulus) -> list[dict[str, int | None]]:
     """Per scale, accumulator-steps of ``stim`` in each of :data:`BINS` (None: the
-    contract cannot reach that bin)."""
+    contract cannot reach that bin). Runs chunk by chunk: a lazy stimulus
+    (:func:`~.stimulus.open_stimulus`) is read a range of steps at a time."""
     c = stim.contract
-    codes = np.asarray(stim.codes, dtype=np.int64)
-    sums = _shifted(c, codes)
     lo, hi = signed_range(c.accumulator_bits)
     full = unsigned_max(c.adc_bits)
     integ = FixedIntegrator(stim.thresholds, c.accumulator_bits, c.signed, c.reset)
     thr = integ.thr
-    clears = {t for t in stim.clear_before if 0 < t < stim.num_steps}
     counts = np.zeros((c.num_scales, len(BINS)), dtype=np.int64)
     idx = {b: i for i, b in enumerate(BINS)}
     axes = (1, 2)
-    for t in range(stim.num_steps):
-        if t in clears:
+    for t0, t1, clear in stim.step_ranges(COVERAGE_CHUNK_STEPS):
+        codes = np.asarray(stim.codes[t0:t1], dtype=np.int64)
+        sums = _shifted(c, codes)
+        if clear:
             counts[:, idx["clear_mid_stream"]] += (integ.acc != 0).sum(axis=axes)
             integ.acc[...] = 0
-        counts[:, idx["code_zero"]] += int((codes[t] == 0).sum())
-        counts[:, idx["code_full"]] += int((codes[t] == full).sum())
-        pre = integ.acc + sums[t]
-        counts[:, idx["rail_high"]] += (pre > hi).sum(axis=axes)
-        counts[:, idx["rail_low"]] += (pre < lo).sum(axis=axes)
-        clipped = np.clip(pre, lo, hi)
-        counts[:, idx["exact_threshold_pos"]] += (clipped == thr).sum(axis=axes)
-        counts[:, idx["exact_threshold_neg"]] += (clipped == -thr).sum(axis=axes)
-        spikes = integ.step(sums[t])
-        counts[:, idx["spike_pos"]] += (spikes == 1).sum(axis=axes)
-        counts[:, idx["spike_neg"]] += (spikes == -1).sum(axis=axes)
+        for b in range(t1 - t0):
+            counts[:, idx["code_zero"]] += int((codes[b] == 0).sum())
+            counts[:, idx["code_full"]] += int((codes[b] == full).sum())
+            pre = integ.acc + sums[b]
+            counts[:, idx["rail_high"]] += (pre > hi).sum(axis=axes)
+            counts[:, idx["rail_low"]] += (pre < lo).sum(axis=axes)
+            clipped = np.clip(pre, lo, hi)
+            counts[:, idx["exact_threshold_pos"]] += (clipped == thr).sum(axis=axes)
+            counts[:, idx["exact_threshold_neg"]] += (clipped == -thr).sum(axis=axes)
+            spikes = integ.step(sums[b])
+            counts[:, idx["spike_pos"]] += (spikes == 1).sum(axis=axes)
+            counts[:, idx["spike_neg"]] += (spikes == -1).sum(axis=axes)
     out: list[dict[str, int | None]] = []
     for scale in range(c.num_scales):
         s_lo, s_hi = c.sum_range(scale)
