@@ -109,10 +109,14 @@ class Stimulus:
         return isinstance(self.codes, MemberArray) or isinstance(self.spikes, MemberArray)
 
     def loaded(self) -> Stimulus:
-        """This stimulus with ``codes`` and ``spikes`` in memory (a lazy one's read whole,
-        refused when they would not fit)."""
+        """This stimulus with ``codes`` and ``spikes`` in memory (a lazy one's read whole;
+        :class:`RvsmError` naming ``--harness chunk`` when they would not fit)."""
         if not self.lazy:
             return self
+        require_memory(self.codes.nbytes + self.spikes.nbytes,
+                       f"a stimulus of {self.num_steps} steps read whole",
+                       "replay it in the long-run harness (--harness chunk), which reads "
+                       "it a chunk of steps at a time")
         return dataclasses.replace(self, codes=_whole(self.codes, np.uint16),
                                    spikes=_whole(self.spikes, np.int8))
 
@@ -560,12 +564,7 @@ def load_stimulus(path: str | os.PathLike) -> Stimulus:
     """Read a stimulus file written by :func:`save_stimulus` or :func:`write_stimulus`,
     whole (refused when it would not fit in memory; :func:`open_stimulus` reads it a
     chunk of steps at a time)."""
-    stim = open_stimulus(path)
-    need = stim.codes.nbytes + stim.spikes.nbytes
-    require_memory(need, f"stimulus file {path} ({stim.num_steps} steps)",
-                   "replay it in the long-run harness (--harness chunk), which reads it a "
-                   "chunk of steps at a time")
-    return stim.loaded()
+    return open_stimulus(path).loaded()
 
 
 _MEMBER_DIMS = {"codes": 3, "thresholds": 3, "spikes": 4, "weights": None,

@@ -208,3 +208,19 @@ def test_the_cli_streams(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     assert main([*args, "--steps", "100000"]) == 2
     assert not out.exists()
     assert_no_partial_files(tmp_path)
+
+
+def test_a_file_too_large_to_read_whole_opens_lazily(tmp_path: Path, monkeypatch) -> None:
+    """On a machine too small for the whole file: it still opens and is checked chunk by
+    chunk; reading it whole is refused in one line naming the long-run harness."""
+    import rvsm.model.infra.memory as memory
+
+    stim = _random(300, h=8, w=8)  # codes and spikes: 77 kB
+    save_stimulus(tmp_path / "s.npz", stim)
+    monkeypatch.setattr(memory, "available_bytes", lambda: 40_000)
+    lazy = open_stimulus(tmp_path / "s.npz")
+    assert lazy.first_inconsistency() is None
+    with pytest.raises(RvsmError, match="--harness chunk"):
+        lazy.loaded()
+    with pytest.raises(RvsmError, match="--harness chunk"):
+        load_stimulus(tmp_path / "s.npz")
