@@ -53,10 +53,14 @@ def run_child(args: list[str]) -> tuple[float, float]:
     """``(peak RSS bytes, wall seconds)`` of one ``rvsm ARGS`` child."""
     cmd = [sys.executable, "-m", "rvsm.sim.cli.main", *args]
     start = time.perf_counter()
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - start
-    err = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
+    # stderr (progress bars) to a file: a pipe read only after wait4 fills up and blocks
+    # the child on a long run
+    with tempfile.TemporaryFile() as log:
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=log)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - start
+        log.seek(0)
+        err = log.read().decode(errors="replace")
     proc.returncode = os.waitstatus_to_exitcode(status)
     if proc.returncode != 0:
         raise SystemExit(f"run failed ({proc.returncode}): {err.strip()[-500:]}")
