@@ -26,7 +26,7 @@ from rvsm.model.fixed.core import (
     integer_receptive_sums,
 )
 from rvsm.model.fixed.stimulus import Stimulus
-from rvsm.model.fixed.widths import signed_range, unsigned_max
+from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
 
 __all__ = ["BINS", "corner_stimulus", "coverage", "coverage_summary", "min_steps"]
@@ -42,6 +42,10 @@ BINS: tuple[str, ...] = ("code_zero", "code_full", "exact_threshold_pos",
 MIN_STEPS = 12
 #: Missing bins a summary line names before it counts the rest.
 MAX_LISTED = 10
+
+
+#: Steps whose sums :func:`coverage` holds at once.
+COVERAGE_CHUNK_STEPS = 32
 
 
 def _shifted(contract: ArrayContract, codes: np.ndarray) -> np.ndarray:
@@ -126,70 +130,70 @@ def _segment_images(c: ArrayContract, level: int) -> list[np.ndarray]:
 
 def coverage(stim: Stimulus) -> list[dict[str, int | None]]:
     """Per scale, accumulator-steps of ``stim`` in each of :data:`BINS` (None: the
-    contract cannot reach that bin)."""
+    contract cannot reach that bin). Runs chunk by chunk: a lazy stimulus
+    (:func:`~.stimulus.open_stimulus`) is read a range of steps at a time. The event
+    sensor's bins follow its rules (:func:`_event_bins`)."""
     c = stim.contract
-    codes = np.asarray(stim.codes, dtype=np.int64)
-    sums = _shifted(c, codes)
-    lo, hi = signed_range(c.accumulator_bits)
     full = unsigned_max(c.adc_bits)
-    clears = {t for t in stim.clear_before if 0 < t < stim.num_steps}
     counts = np.zeros((c.num_scales, len(BINS)), dtype=np.int64)
     idx = {b: i for i, b in enumerate(BINS)}
-    if c.sensor == "dvs":
-        _event_coverage(stim, sums, clears, counts, idx)
-        return _reachable(c, counts)
-    integ = FixedIntegrator(stim.thresholds, c.accumulator_bits, c.signed, c.reset)
-    thr = integ.thr
+    event = c.sensor == "dvs"
+    integ = (FixedEventIntegrator(stim.thresholds, c.accumulator_bits) if event else
+             FixedIntegrator(stim.thresholds, c.accumulator_bits, c.signed, c.reset))
     axes = (1, 2)
-    for t in range(stim.num_steps):
-        if t in clears:
-            counts[:, idx["clear_mid_stream"]] += (integ.acc != 0).sum(axis=axes)
-            integ.acc[...] = 0
-        counts[:, idx["code_zero"]] += int((codes[t] == 0).sum())
-        counts[:, idx["code_full"]] += int((codes[t] == full).sum())
-        pre = integ.acc + sums[t]
-        counts[:, idx["rail_high"]] += (pre > hi).sum(axis=axes)
-        counts[:, idx["rail_low"]] += (pre < lo).sum(axis=axes)
-        clipped = np.clip(pre, lo, hi)
-        counts[:, idx["exact_threshold_pos"]] += (clipped == thr).sum(axis=axes)
-        counts[:, idx["exact_threshold_neg"]] += (clipped == -thr).sum(axis=axes)
-        spikes = integ.step(sums[t])
-        counts[:, idx["spike_pos"]] += (spikes == 1).sum(axis=axes)
-        counts[:, idx["spike_neg"]] += (spikes == -1).sum(axis=axes)
+    for t0, t1, clear in stim.step_ranges(COVERAGE_CHUNK_STEPS):
+        codes = np.asarray(stim.codes[t0:t1], dtype=np.int64)
+        sums = _shifted(c, codes)
+        if clear:
+            if event:
+                if integ.captured:
+                    counts[:, idx["clear_mid_stream"]] += (integ.ref != 0).sum(axis=axes)
+            else:
+                counts[:, idx["clear_mid_stream"]] += (integ.acc != 0).sum(axis=axes)
+            integ.clear()
+        for b in range(t1 - t0):
+            counts[:, idx["code_zero"]] += int((codes[b] == 0).sum())
+            counts[:, idx["code_full"]] += int((codes[b] == full).sum())
+            (_event_bins if event else _spike_bins)(integ, sums[b], counts, idx)
     return _reachable(c, counts)
 
 
-def _event_coverage(stim: Stimulus, sums: np.ndarray, clears: set[int], counts: np.ndarray,
-                    idx: dict[str, int]) -> None:
-    """The bins for the event sensor, by its rules (:class:`FixedEventIntegrator`): exact
-    hits are ``d = sum - ref == +-thr``, the rails the references' (a capture or an
-    update leaving the W-bit range), spikes the ON/OFF events, and a mid-stream clear
-    counts the captured non-zero references it drops."""
-    c = stim.contract
-    codes = np.asarray(stim.codes, dtype=np.int64)
-    full = unsigned_max(c.adc_bits)
-    integ = FixedEventIntegrator(stim.thresholds, c.accumulator_bits)
-    lo, hi, thr = integ.lo, integ.hi, integ.thr
+def _spike_bins(integ: FixedIntegrator, sums: np.ndarray, counts: np.ndarray,
+                idx: dict[str, int]) -> None:
+    """One step of the spike camera's bins: rails and exact hits before the compare."""
     axes = (1, 2)
-    for t in range(stim.num_steps):
-        if t in clears:
-            if integ.captured:
-                counts[:, idx["clear_mid_stream"]] += (integ.ref != 0).sum(axis=axes)
-            integ.clear()
-        counts[:, idx["code_zero"]] += int((codes[t] == 0).sum())
-        counts[:, idx["code_full"]] += int((codes[t] == full).sum())
-        if integ.captured:
-            d = sums[t] - integ.ref
-            counts[:, idx["exact_threshold_pos"]] += (d == thr).sum(axis=axes)
-            counts[:, idx["exact_threshold_neg"]] += (d == -thr).sum(axis=axes)
-            new = integ.ref + thr * ((d >= thr).astype(np.int64) - ((d <= -thr) & (d < thr)))
-        else:
-            new = sums[t]
-        counts[:, idx["rail_high"]] += (new > hi).sum(axis=axes)
-        counts[:, idx["rail_low"]] += (new < lo).sum(axis=axes)
-        events = integ.step(sums[t])
-        counts[:, idx["spike_pos"]] += (events == 1).sum(axis=axes)
-        counts[:, idx["spike_neg"]] += (events == -1).sum(axis=axes)
+    pre = integ.acc + sums
+    counts[:, idx["rail_high"]] += (pre > integ.hi).sum(axis=axes)
+    counts[:, idx["rail_low"]] += (pre < integ.lo).sum(axis=axes)
+    clipped = np.clip(pre, integ.lo, integ.hi)
+    counts[:, idx["exact_threshold_pos"]] += (clipped == integ.thr).sum(axis=axes)
+    counts[:, idx["exact_threshold_neg"]] += (clipped == -integ.thr).sum(axis=axes)
+    spikes = integ.step(sums)
+    counts[:, idx["spike_pos"]] += (spikes == 1).sum(axis=axes)
+    counts[:, idx["spike_neg"]] += (spikes == -1).sum(axis=axes)
+
+
+def _event_bins(integ: FixedEventIntegrator, sums: np.ndarray, counts: np.ndarray,
+                idx: dict[str, int]) -> None:
+    """One step of the event sensor's bins, by its rules (:class:`FixedEventIntegrator`):
+    exact hits are ``d = sum - ref == +-thr``, the rails the references' (a capture or
+    an update leaving the W-bit range), spikes the ON/OFF events (a mid-stream clear
+    counts the captured non-zero references it drops, in :func:`coverage`)."""
+    axes = (1, 2)
+    thr = integ.thr
+    if integ.captured:
+        d = sums - integ.ref
+        counts[:, idx["exact_threshold_pos"]] += (d == thr).sum(axis=axes)
+        counts[:, idx["exact_threshold_neg"]] += (d == -thr).sum(axis=axes)
+        up = (d >= thr).astype(np.int64)
+        new = integ.ref + thr * (up - ((d <= -thr) & (up == 0)))
+    else:
+        new = sums
+    counts[:, idx["rail_high"]] += (new > integ.hi).sum(axis=axes)
+    counts[:, idx["rail_low"]] += (new < integ.lo).sum(axis=axes)
+    events = integ.step(sums)
+    counts[:, idx["spike_pos"]] += (events == 1).sum(axis=axes)
+    counts[:, idx["spike_neg"]] += (events == -1).sum(axis=axes)
 
 
 def _reachable(c: ArrayContract, counts: np.ndarray) -> list[dict[str, int | None]]:

@@ -5,7 +5,10 @@ A :class:`StimulusChunks` gives the ADC codes ``(B, H, W) uint16`` and the expec
 ``(B, S, H, W) int8`` of consecutive step ranges, plus the thresholds and clears: the
 content of a :class:`~.stimulus.Stimulus` without ever holding all of it. Two sources:
 
-* :meth:`StimulusChunks.from_stimulus`: slices of a stimulus in memory (a file);
+* :meth:`StimulusChunks.from_stimulus`: slices of a stimulus, in memory or a file read
+  a range of steps at a time (:func:`~.stimulus.open_stimulus`: bounded memory however
+  long the file), optionally with the expectation recomputed from its codes chunk by
+  chunk (:class:`~.core.ContractStream`);
 * :meth:`StimulusChunks.from_scene`: a scene through a design point, produced on demand:
   brightness of the chunk's steps (+ the point's dark current, same streams as the
   twins), its ADC codes (:func:`~.numpy_engine.step_codes`), and the expectation from
@@ -33,7 +36,7 @@ from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.fused import FusedFixedTwin
 from rvsm.model.fixed.numpy_engine import step_codes
 from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
-from rvsm.model.fixed.stimulus import Stimulus, load_stimulus
+from rvsm.model.fixed.stimulus import Stimulus, open_stimulus, step_ranges
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.scene import Scene
 
@@ -61,8 +64,9 @@ class StimulusChunks:
     """A run's ``contract``, ``thresholds (S, H, W) int64``, ``num_steps``, the steps
     ``clear_before`` which the array restarts from zero, and its chunks (:meth:`chunks`).
     ``spec`` describes how to open it again (:func:`open_stimulus_chunks`; empty when
-    it cannot be: a scene made in code); ``stimulus`` is the whole stimulus when it is
-    held in memory (:meth:`from_stimulus`), else None."""
+    it cannot be: a scene made in code); ``stimulus`` is the stimulus the chunks are cut
+    from (:meth:`from_stimulus`; in memory, or lazy: read from its file a chunk at a
+    time), else None."""
 
     contract: ArrayContract
     thresholds: np.ndarray
@@ -73,13 +77,21 @@ class StimulusChunks:
     _scene: Scene | None = field(default=None, repr=False)
     _point: DesignPoint | None = field(default=None, repr=False)
     _engine: str = field(default="fused", repr=False)
+    _recompute: bool = field(default=False, repr=False)
 
     @classmethod
-    def from_stimulus(cls, stim: Stimulus, path: str | None = None) -> StimulusChunks:
-        """Chunks of ``stim`` (``path``: the file it was read from, for :attr:`spec`)."""
-        spec = {"kind": "stimulus", "path": path} if path else {}
+    def from_stimulus(cls, stim: Stimulus, path: str | None = None,
+                      recompute: bool = False) -> StimulusChunks:
+        """Chunks of ``stim`` (``path``: the file it was read from, for :attr:`spec`; ``stim``
+        may be its first steps). ``recompute`` takes the expected spikes from its codes
+        (the integer contract run chunk by chunk) instead of its ``spikes``."""
+        spec = {}
+        if path:
+            spec = {"kind": "stimulus", "path": path, "steps": stim.num_steps,
+                    "recompute": bool(recompute)}
         return cls(stim.contract, np.asarray(stim.thresholds, dtype=np.int64),
-                   stim.num_steps, tuple(stim.clear_before), spec, stimulus=stim)
+                   stim.num_steps, tuple(stim.clear_before), spec, stimulus=stim,
+                   _recompute=bool(recompute))
 
     @classmethod
     def from_scene(cls, scene: Scene, point: DesignPoint, num_steps: int | None = None,
@@ -107,36 +119,32 @@ class StimulusChunks:
 
     def chunks(self, chunk_steps: int) -> Iterator[StimulusChunk]:
         """Consecutive chunks of at most ``chunk_steps`` steps, never across a clear."""
-        if chunk_steps < 1:
-            raise RvsmError(f"chunk steps must be >= 1, got {chunk_steps}")
-        cuts = sorted({t for t in self.clear_before if 0 < t < self.num_steps})
-        bounds = [0, *cuts, self.num_steps]
+        ranges = step_ranges(self.num_steps, self.clear_before, chunk_steps)
         stream = twin = None
-        if self.stimulus is None and (self._engine == "numpy"
-                                      or self.contract.sensor != "spike"):
-            stream = self.contract.stream(self.thresholds)  # the event sensor: no fused twin
+        spike = self.contract.sensor == "spike"  # the event sensor has no fused twin
+        if (self._engine == "numpy" or not spike) and self.stimulus is None \
+                or self._recompute:
+            stream = self.contract.stream(self.thresholds)
         elif self.stimulus is None:
             assert self._scene is not None and self._point is not None
-            if cuts:
+            if any(0 < t < self.num_steps for t in self.clear_before):
                 raise RvsmError("the fused engine runs scenes without clears")
             twin = FusedFixedTwin(self._scene, self._point, self.thresholds, ranges=False)
         noise = self._point.noise_source() if self._point is not None else None
-        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
-            if stream is not None and a:
+        for t0, t1, clear in ranges:
+            if stream is not None and clear:
                 stream.clear()
-            for t0 in range(a, b, chunk_steps):
-                t1 = min(t0 + chunk_steps, b)
-                if self.stimulus is not None:
-                    codes = self.stimulus.codes[t0:t1]
-                    spikes = self.stimulus.spikes[t0:t1]
-                else:
-                    assert self._scene is not None and self._point is not None
-                    codes = step_codes(self._scene, self._point, noise, t0, t1)
-                    spikes = (twin.run(t0, t1) if twin is not None
-                              else stream.run(codes))  # type: ignore[union-attr]
-                yield StimulusChunk(t0, np.asarray(codes, dtype=np.uint16),
-                                    np.asarray(spikes, dtype=np.int8),
-                                    clear=bool(t0 == a and a > 0))
+            if self.stimulus is not None:
+                codes = np.asarray(self.stimulus.codes[t0:t1])
+                spikes = (stream.run(codes) if stream is not None
+                          else self.stimulus.spikes[t0:t1])
+            else:
+                assert self._scene is not None and self._point is not None
+                codes = step_codes(self._scene, self._point, noise, t0, t1)
+                spikes = (twin.run(t0, t1) if twin is not None
+                          else stream.run(codes))  # type: ignore[union-attr]
+            yield StimulusChunk(t0, np.asarray(codes, dtype=np.uint16),
+                                np.asarray(spikes, dtype=np.int8), clear=clear)
 
 
 def open_stimulus_chunks(spec: dict | str) -> StimulusChunks:
@@ -146,7 +154,14 @@ def open_stimulus_chunks(spec: dict | str) -> StimulusChunks:
     d = json.loads(spec) if isinstance(spec, str) else dict(spec)
     kind = d.get("kind")
     if kind == "stimulus":
-        return StimulusChunks.from_stimulus(load_stimulus(d["path"]), d["path"])
+        stim = open_stimulus(d["path"])
+        steps = d.get("steps")
+        if steps is not None and not 1 <= int(steps) <= stim.num_steps:
+            raise RvsmError(f"{d['path']}: {steps} steps asked, the file holds "
+                            f"{stim.num_steps}")
+        if steps is not None and int(steps) < stim.num_steps:
+            stim = stim.first_steps(int(steps))
+        return StimulusChunks.from_stimulus(stim, d["path"], bool(d.get("recompute")))
     if kind == "scene":
         h, w = d["size"]
         scene = load_scene(d["scene"], size=(int(h), int(w)), num_frames=d["num_frames"],

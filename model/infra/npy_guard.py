@@ -108,10 +108,13 @@ def npy_layout(path: str | os.PathLike) -> NpyLayout:
     return NpyLayout(shape, dtype, offset, fortran)
 
 
-def check_npz_members(path: str | os.PathLike, ndims: dict[str, int | None]) -> None:
+def check_npz_members(path: str | os.PathLike, ndims: dict[str, int | None],
+                      lazy: tuple[str, ...] = ()) -> None:
     """Check the headers of the members ``ndims`` names (``name -> ndim``, None = any) of
     an ``.npz`` file before :func:`numpy.load` allocates them; missing members and
-    unreadable archives are left to the loader's own messages."""
+    unreadable archives are left to the loader's own messages. Members named in
+    ``lazy`` are read a range at a time, never whole: checked against the bytes they
+    hold, not against the memory."""
     p = Path(path)
     try:
         zf = zipfile.ZipFile(p)
@@ -139,4 +142,23 @@ def check_npz_members(path: str | os.PathLike, ndims: dict[str, int | None]) -> 
                                 f"({exc})") from None
             if ndim is not None and len(shape) != ndim:
                 raise RvsmError(f"{source} must have {ndim} dimensions, got shape {shape}")
-            _check(shape, dtype, info.file_size - offset, source)
+            if name in lazy:
+                _check_size(shape, dtype, info.file_size - offset, source)
+            else:
+                _check(shape, dtype, info.file_size - offset, source)
+
+
+def npz_member_layout(archive: zipfile.ZipFile, info: zipfile.ZipInfo, source: str
+                      ) -> NpyLayout:
+    """The :class:`NpyLayout` of the ``.npy`` member ``info`` of an open archive
+    (``offset``: the data's offset inside the member's uncompressed bytes), its header
+    checked against the member's size (not against the memory)."""
+    try:
+        with archive.open(info) as handle:
+            shape, dtype, offset, fortran = _header(handle, source, info.file_size)
+    except (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError,
+            NotImplementedError, RuntimeError) as exc:
+        raise RvsmError(f"{source}: unreadable member, the archive is damaged "
+                        f"({exc})") from None
+    _check_size(shape, dtype, info.file_size - offset, source)
+    return NpyLayout(shape, dtype, offset, fortran)

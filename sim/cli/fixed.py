@@ -134,17 +134,16 @@ def run_config_check(args: argparse.Namespace) -> int:
 
 
 def cmd_stimulus(args: argparse.Namespace) -> int:
-    """``rvsm stimulus``."""
-    from rvsm.model.fixed.stimulus import make_stimulus, save_stimulus
+    """``rvsm stimulus``: made and written a chunk of steps at a time (bounded memory)."""
+    from rvsm.model.fixed.stimulus import write_stimulus
 
     check_outputs([Output(args.output, "-o", "stimulus file")], [args.scene, args.fixed],
                   args.force)
     point, scene = _point_and_scene(args)
-    stim = make_stimulus(scene, point, progress=True, num_steps=args.steps)
-    save_stimulus(args.output, stim)
-    t, s, h, w = stim.spikes.shape
+    done = write_stimulus(args.output, scene, point, progress=True, num_steps=args.steps)
+    t, s, h, w = done.shape
     print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}, "
-          f"{int((stim.spikes != 0).sum())} expected spikes")
+          f"{done.spikes} expected spikes")
     return 0
 
 

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.fixed.stimulus import Stimulus, load_stimulus, save_stimulus
+from rvsm.model.fixed.stimulus import Stimulus, open_stimulus, save_stimulus
 from rvsm.model.fixed.stimulus_chunks import StimulusChunks
 from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
@@ -190,30 +190,32 @@ def replay(
     """
     check_simulator(sim)
     check_harness(harness, arch)
-    stim = load_stimulus(stimulus)
+    stim = open_stimulus(stimulus)  # codes and spikes read a range of steps at a time
     c = stim.contract
     _resolve(arch, options, c)
     if steps is not None and steps > stim.num_steps:
         raise RvsmError(f"--steps {steps}: {stimulus} holds {stim.num_steps} steps; ask for "
                         f"at most {stim.num_steps}")
-    whole_file = steps is None or steps == stim.num_steps
     if steps is not None and steps < stim.num_steps:
         stim = stim.first_steps(steps)
+    harness = choose_harness(harness, arch, c.height * c.width, stim.num_steps, options)
+    check_code_coverage(code_coverage, harness, sim)
+    if harness != "chunk":  # the per-cycle testbench takes the stimulus whole
+        stim = stim.loaded()
     if recompute_expected:
-        stim = stim.with_recomputed_expectation()
+        if harness != "chunk":
+            stim = stim.with_recomputed_expectation()
     else:
-        problem = stim.first_inconsistency()
+        problem = stim.first_inconsistency()  # chunk by chunk
         if problem:
             raise RvsmError(f"{stimulus} is a bad stimulus, not an RTL failure: {problem}; "
                             f"fix the file, or replay it with --recompute-expected to take "
                             f"the expectation from its codes")
     name = Path(stimulus).stem or "stimulus"
-    harness = choose_harness(harness, arch, c.height * c.width, stim.num_steps, options)
-    check_code_coverage(code_coverage, harness, sim)
     if harness == "chunk":
-        source = StimulusChunks.from_stimulus(
-            stim, str(Path(stimulus).resolve())
-            if whole_file and not recompute_expected else None)
+        # the testbench opens the file again and reads it a chunk at a time
+        source = StimulusChunks.from_stimulus(stim, str(Path(stimulus).resolve()),
+                                              recompute=recompute_expected)
         result = check_chunks(source, sim, work_dir=work_dir, name=name, arch=arch,
                               waves=waves, progress=progress, chunk_steps=chunk_steps,
                               code_coverage=code_coverage,

@@ -145,6 +145,41 @@ def test_cli_verify_with_the_long_run_harness(tmp_path: Path,
     assert "--chunk-steps must be >= 1" in capsys.readouterr().err
 
 
+def test_replay_of_a_stimulus_file_in_the_long_run_harness(
+        tmp_path: Path, capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``rvsm verify --stimulus F --harness chunk`` reads the file a chunk of steps at a
+    time (never whole: ``MemberArray.__array__`` is refused), with ``--steps`` and
+    ``--recompute-expected`` passed to the testbench in its spec; a wrong spike is a bad
+    stimulus (2) found chunk by chunk before any simulator runs."""
+    from rvsm.model.fixed.stimulus import MemberArray, save_stimulus
+
+    c = default_design_point().with_size(6, 8).contract()
+    stim = _random_stimulus(dataclasses.replace(c, weights=c.weights[:2]), 20, 4,
+                            clears=(7,))
+    path = tmp_path / "s.npz"
+    save_stimulus(path, stim)
+    wrong = stim.spikes.copy()
+    wrong[15, 1, 2, 5] = 0 if wrong[15, 1, 2, 5] else 1
+    save_stimulus(tmp_path / "bad.npz", dataclasses.replace(stim, spikes=wrong))
+
+    def whole(self, dtype=None, copy=None):
+        raise AssertionError("a stimulus file read whole")
+
+    monkeypatch.setattr(MemberArray, "__array__", whole)
+    work = str(tmp_path / "w")
+    base = ["verify", "--harness", "chunk", "--lanes", "2", "--chunk-steps", "3", "--json",
+            "--work", work, "--stimulus"]
+    assert main([*base, str(path), "--steps", "13"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mismatches"] == 0 and out["steps"] == 13 and out["harness"] == "chunk"
+    assert out["compared"] == 13 * 2 * 6 * 8
+    assert main([*base, str(tmp_path / "bad.npz")]) == 2
+    assert "step 15, scale 1, row 2, column 5" in capsys.readouterr().err
+    assert main([*base, str(tmp_path / "bad.npz"), "--recompute-expected"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mismatches"] == 0 and out["expectation"] == "recomputed"
+
+
 def test_auto_harness_takes_the_long_run_one_for_long_streams() -> None:
     """``--harness auto``: the long-run harness beyond AUTO_CHUNK_BEATS input beats of the
     streaming array (and a reloadable stimulus), the per-cycle testbench otherwise."""
