@@ -247,6 +247,9 @@ class FusedFixedTwin:
 
     def __init__(self, scene: Scene, point: DesignPoint, thresholds: np.ndarray,
                  tile_rows: int = DEFAULT_TILE_ROWS, ranges: bool = True):
+        if point.sensor != "spike":
+            raise RvsmError("the fused fixed twin runs the spike camera; the event sensor "
+                            "runs the numpy engine (rvsm.model.fixed.twin.make_twin)")
         self.scene = scene
         self.ranges = bool(ranges)
         self.point = point

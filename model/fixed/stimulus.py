@@ -513,11 +513,10 @@ def write_stimulus(
     bounded memory (``rvsm stimulus``): the same arrays and ``meta``, made and written
     ``chunk_steps`` steps at a time, the codes first (scene brightness, dark current,
     ADC), then the expected spikes (the fused fixed twin, whose spikes and saturation
-    counts are the numpy engine's)."""
-    from rvsm.model.fixed.fused import FusedFixedTwin
+    counts are the numpy engine's; the event sensor's numpy twin)."""
     from rvsm.model.fixed.numpy_engine import step_codes
     from rvsm.model.fixed.results import FixedStats, fixed_meta
-    from rvsm.model.fixed.twin import fit_point
+    from rvsm.model.fixed.twin import fit_point, make_twin
 
     if isinstance(chunk_steps, bool) or int(chunk_steps) < 1:
         raise RvsmError(f"chunk steps must be >= 1, got {chunk_steps!r}")
@@ -540,7 +539,7 @@ def write_stimulus(
             bar.close()
 
     def spikes() -> Iterator[np.ndarray]:
-        twin = state["twin"] = FusedFixedTwin(scene, point, thresholds, ranges=False)
+        twin = state["twin"] = make_twin(scene, point, thresholds, "fused", ranges=False)
         buf = np.empty((min(int(chunk_steps), max(total, 1)), s_count, h, w), np.int8)
         bar = progress_bar(total, f"fixed {point.model} {scene.name}", progress)
         try:

@@ -40,6 +40,19 @@ def fit_point(scene: Scene, point: DesignPoint) -> DesignPoint:
     return point if scene.shape == point.shape else point.with_size(*scene.shape)
 
 
+def make_twin(scene: Scene, point: DesignPoint, thresholds: np.ndarray, engine: str = "fused",
+              tile_rows: int = DEFAULT_TILE_ROWS, ranges: bool = True,
+              block_steps: int = DEFAULT_BLOCK_STEPS, keep_codes: bool = False,
+              histograms: bool = False) -> FusedFixedTwin | NumpyFixedTwin:
+    """The engine that runs ``point`` on ``scene`` (arguments as :func:`stream_fixed`):
+    the fused twin when ``engine == "fused"`` and neither codes nor histograms are kept,
+    for the spike camera; otherwise the numpy engine (the event sensor has no fused
+    kernel)."""
+    if engine == "fused" and not keep_codes and not histograms and point.sensor == "spike":
+        return FusedFixedTwin(scene, point, thresholds, tile_rows, ranges)
+    return NumpyFixedTwin(scene, point, thresholds, block_steps, keep_codes, histograms)
+
+
 def stream_fixed(
     scene: Scene,
     point: DesignPoint,
@@ -71,10 +84,8 @@ def stream_fixed(
     thresholds = point.integer_thresholds(point.noise_source())
     s_count, (h, w), t_total = point.num_scales, point.shape, scene.num_steps
     shape = (t_total, s_count, h, w)
-    if engine == "fused" and not keep_codes and not histograms and point.sensor == "spike":
-        twin = FusedFixedTwin(scene, point, thresholds, tile_rows, ranges)
-    else:
-        twin = NumpyFixedTwin(scene, point, thresholds, block_steps, keep_codes, histograms)
+    twin = make_twin(scene, point, thresholds, engine, tile_rows, ranges, block_steps,
+                     keep_codes, histograms)
     buf = np.empty((min(chunk_steps, max(t_total, 1)),) + shape[1:], dtype=np.int8)
 
     def produce(t0: int, t1: int) -> np.ndarray:

@@ -15,7 +15,12 @@ from rvsm.model.fixed.adc import log_adc_codes
 from rvsm.model.fixed.core import ArrayContract, FixedEventIntegrator
 from rvsm.model.fixed.cost import quantisation_cost, spike_agreement
 from rvsm.model.fixed.design_point import DesignPoint
-from rvsm.model.fixed.stimulus import load_stimulus, make_stimulus, save_stimulus
+from rvsm.model.fixed.stimulus import (
+    load_stimulus,
+    make_stimulus,
+    save_stimulus,
+    write_stimulus,
+)
 from rvsm.model.fixed.twin import simulate_fixed
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.loaders import load_scene
@@ -101,6 +106,11 @@ def test_stimulus_files_keep_the_sensor(tmp_path) -> None:
     path = tmp_path / "s.npz"
     save_stimulus(path, make_stimulus(scene, p))
     assert load_stimulus(path).contract.sensor == "dvs"
+    streamed = tmp_path / "w.npz"  # rvsm stimulus's chunked writer: the event twin too
+    write_stimulus(streamed, scene, p, chunk_steps=7)
+    back = load_stimulus(streamed)
+    assert back.first_inconsistency() is None
+    assert np.array_equal(back.spikes, load_stimulus(path).spikes)
 
 
 def test_converges_to_the_float_model() -> None:
