@@ -9,9 +9,10 @@ path on fewer steps, ``--numpy-steps``). The fixed twin runs the default design 
 ``rvsm simulate flyball --size 250x400 --model dog4 --noise`` for ``--long-steps`` steps
 (``--frames 401 --steps-per-frame 100`` for 40,000) to an ``.h5`` file, measured as the
 child's ``ru_maxrss``. Every figure is printed with the load average at its start; the
-targets are issue 10's (the ``dvs`` rows, RVSM-DVS: issue 19's), for a 2-core machine. ``fused/cpu-s`` is the same work per CPU
-second of all threads: the rate a core delivers, less sensitive to other jobs' load (on an
-idle 2-core machine the wall rate approaches twice it).
+targets are issue 10's (the ``dvs`` rows, RVSM-DVS: issue 19's), for a 2-core machine.
+``fused/cpu-s`` is the same work per CPU second of all threads: the rate a core delivers,
+less sensitive to other jobs' load (on an idle 2-core machine the wall rate approaches
+twice it).
 """
 
 from __future__ import annotations
