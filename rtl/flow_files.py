@@ -38,9 +38,9 @@ LINT_WAIVER_RULES: dict[str, str] = {
                    "operand to the expression's width, zero or sign as its type says; "
                    "Amaranth emits operands at their own widths and relies on exactly "
                    "that (the co-simulation checks every spike on Icarus and Verilator)",
-    "WIDTHTRUNC": "the truncations are intended: `! x[7:6]` (logical not of a two-bit "
-                  "field, true when it is zero) and assignments of the low bits of a "
-                  "wider intermediate",
+    "WIDTHTRUNC": "every one is the logical not of a multi-bit value (`! read_bank`, "
+                  "`! thr_addr_r[7:6]`: true when the value is zero, IEEE 1364-2005 "
+                  "5.1.9), which Verilator counts as a truncation to one bit",
     "UNUSEDSIGNAL": "the converter keeps intermediate wires whose upper bits are unused "
                     "(modular adder slices) and a memory cell's `rst` input that its "
                     "read port does not use",
