@@ -8,10 +8,15 @@ registered architecture (:mod:`rvsm.rtl.architectures`).
   first frame after reset or ``clear``, line-buffer rows outside the frame are masked
   and thresholds must be loaded; at sensor size those ``initial`` blocks were most of
   the file).
-* :func:`write_outputs` writes ``<top>.v``, ``<top>.ports.json`` (architecture, top,
-  latency, the architecture's timing and memories, ports) and ``<top>.ports.md`` (the
-  port map, with flat-vector bit ordering and payload fields).
-* :func:`verilator_lint` runs ``verilator --lint-only`` with :data:`LINT_WAIVERS`.
+* :func:`write_outputs` writes ``<top>.v`` (a provenance header and ``timescale`` first),
+  ``<top>.ports.json`` (architecture, top, latency, the architecture's timing and
+  memories, ports, ``provenance``), ``<top>.ports.md`` (the port map, with flat-vector
+  bit ordering and payload fields), and for a vanilla flow ``<top>.vlt`` (Verilator
+  waivers), ``<top>.core`` (FuseSoC) and ``<top>.sdc`` (:mod:`rvsm.rtl.flow_files`).
+  Nothing time-dependent is written: the same inputs give byte-identical files.
+* :func:`verilator_lint` runs ``verilator --lint-only -Wall <top>.vlt <top>.v`` as a user
+  would (no ``-Wno-*`` flags); :func:`icarus_lint` runs ``iverilog -g2005`` and
+  ``-g2012`` (``-Wall``); both refuse any warning.
 * :func:`yosys_stats` reads the Verilog into the system ``yosys`` (Debian's 0.23),
   runs ``synth -flatten`` and ``stat -json``; returns cells and flip-flops.
 """
@@ -36,13 +41,24 @@ from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.model.infra.tools import ToolFailure, run_tool
 from rvsm.rtl.architecture import Architecture
 from rvsm.rtl.architectures import get_architecture
+from rvsm.rtl.flow_files import (
+    DEFAULT_CLOCK_MHZ,
+    TIMESCALE,
+    fusesoc_core,
+    header,
+    provenance,
+    sdc_constraints,
+    verilator_waivers,
+)
 from rvsm.rtl.ports import verilog_ports
 
 __all__ = [
-    "LINT_WAIVERS",
+    "OUTPUT_SUFFIXES",
     "GeneratedVerilog",
+    "ICARUS_GENERATIONS",
     "check_top",
     "generate_verilog",
+    "icarus_lint",
     "port_map_markdown",
     "ports_meta",
     "strip_zero_memory_init",
@@ -62,22 +78,6 @@ def check_top(top: str) -> str:
         raise RvsmError(f"top module name must be a Verilog identifier (a letter or _, "
                         f"then letters, digits or _; at most 128), got {top!r}")
     return top
-
-#: Verilator warnings waived for Amaranth's generated netlist, and why:
-#: UNUSEDSIGNAL -- the converter keeps intermediate wires whose upper bits are unused
-#: (modular adder slices); DECLFILENAME -- one file holds the top and every cell
-#: module; WIDTHEXPAND/WIDTHTRUNC -- Amaranth zero/sign-extends and truncates
-#: explicitly by construction, in assignments Verilator flags though they are intended.
-#: PROCASSINIT -- registers carry their reset value as a declaration initialiser too
-#: (Amaranth's ``init``), which is intended and matches the synchronous reset.
-LINT_WAIVERS: tuple[str, ...] = (
-    "-Wno-PROCASSINIT",
-    "-Wno-UNUSEDSIGNAL",
-    "-Wno-DECLFILENAME",
-    "-Wno-WIDTHEXPAND",
-    "-Wno-WIDTHTRUNC",
-)
-
 
 @dataclass(frozen=True)
 class GeneratedVerilog:
@@ -153,30 +153,45 @@ def port_map_markdown(arch: str | Architecture, component: wiring.Component,
     return "\n".join(lines) + "\n"
 
 
+#: The files :func:`write_outputs` writes, by key: ``<top><suffix>``.
+OUTPUT_SUFFIXES: dict[str, str] = {
+    "verilog": ".v", "ports_json": ".ports.json", "ports_md": ".ports.md",
+    "waivers": ".vlt", "core": ".core", "sdc": ".sdc",
+}
+
+
 def write_outputs(
     contract: ArrayContract,
     out_dir: str | os.PathLike,
     arch: str | Architecture,
     top: str | None = None,
+    command: str | None = None,
+    clock_mhz: float = DEFAULT_CLOCK_MHZ,
     **options: int,
 ) -> tuple[dict[str, Path], GeneratedVerilog]:
-    """Write ``<top>.v``, ``<top>.ports.json`` and ``<top>.ports.md`` of architecture
-    ``arch`` (``options`` as :meth:`Architecture.resolve`) into ``out_dir``."""
+    """Write the files of :data:`OUTPUT_SUFFIXES` for architecture ``arch`` (``options``
+    as :meth:`Architecture.resolve`) into ``out_dir``: the Verilog with a provenance
+    header (``command``: the command line that made it, ``None`` for a library call) and
+    a ``timescale``, the port map (JSON with a ``provenance`` field, Markdown), the
+    Verilator waivers, a FuseSoC core and an SDC template clocked at ``clock_mhz``.
+    Deterministic: nothing time-dependent is written."""
     a = get_architecture(arch)
     top = check_top(top or a.default_top)
     out = Path(out_dir)
-    dut = a.component(contract, **a.resolve(options))
+    resolved = a.resolve(options)
+    dut = a.component(contract, **resolved)
     gen = generate_verilog(contract, a, top, component=dut)
-    paths = {
-        "verilog": out / f"{top}.v",
-        "ports_json": out / f"{top}.ports.json",
-        "ports_md": out / f"{top}.ports.md",
-    }
+    paths = {key: out / f"{top}{suffix}" for key, suffix in OUTPUT_SUFFIXES.items()}
+    prov = provenance(contract, a.name, resolved, top, command)
     meta = ports_meta(a, dut, top)
-    meta["generation_seconds"] = round(gen.seconds, 3)
-    write_text_atomic(paths["verilog"], gen.text)
+    meta["provenance"] = prov
+    write_text_atomic(paths["verilog"], f"{header(prov)}{TIMESCALE}\n{gen.text}")
     write_text_atomic(paths["ports_json"], json.dumps(meta, indent=2) + "\n")
-    write_text_atomic(paths["ports_md"], port_map_markdown(a, dut, top))
+    write_text_atomic(paths["ports_md"], header(prov, "<!--")
+                      + port_map_markdown(a, dut, top))
+    write_text_atomic(paths["waivers"], verilator_waivers(top, prov))
+    write_text_atomic(paths["core"], fusesoc_core(top, prov, prov["rvsm_version"]))
+    write_text_atomic(paths["sdc"], sdc_constraints(top, prov, meta["ports"], clock_mhz))
     return paths, gen
 
 
@@ -200,7 +215,9 @@ def verilator_env() -> dict[str, str]:
 
 
 def verilator_lint(verilog_path: str | os.PathLike, top: str | None = None) -> str:
-    """``verilator --lint-only -Wall`` with :data:`LINT_WAIVERS`; returns its output.
+    """``verilator --lint-only -Wall <top>.vlt <top>.v``, as a user runs it in the output
+    folder: no ``-Wno-*`` flag, only the waiver file written beside the Verilog (used
+    when present). Returns Verilator's output.
 
     ``top`` defaults to the file's name without ``.v`` (as :func:`write_outputs` names it).
 
@@ -208,9 +225,12 @@ def verilator_lint(verilog_path: str | os.PathLike, top: str | None = None) -> s
     :class:`~rvsm.model.infra.tools.ToolFailure` if it crashes or is killed.
     """
     env = verilator_env()
-    cmd = ["verilator", "--lint-only", "-Wall", *LINT_WAIVERS, "--top-module",
-           check_top(top or Path(verilog_path).stem), str(verilog_path)]
-    proc = run_tool(cmd, tool="verilator --lint-only", env=env, capture=True, check=False)
+    path = Path(verilog_path).resolve()
+    waivers = path.with_name(f"{check_top(top or path.stem)}.vlt")
+    cmd = ["verilator", "--lint-only", "-Wall",
+           *([waivers.name] if waivers.is_file() else []), path.name]
+    proc = run_tool(cmd, tool="verilator --lint-only", env=env, capture=True, check=False,
+                    cwd=path.parent)
     out = (proc.stdout + proc.stderr).strip()
     if proc.returncode < 0 or proc.returncode > 1:  # crashed or killed, not a finding
         last = out.splitlines()[-1][-300:] if out else ""
@@ -218,6 +238,34 @@ def verilator_lint(verilog_path: str | os.PathLike, top: str | None = None) -> s
     if proc.returncode != 0 or "%Warning" in out or "%Error" in out:
         raise RvsmError(f"verilator lint failed for {verilog_path}:\n{out}")
     return out
+
+
+#: The Verilog generations :func:`icarus_lint` checks.
+ICARUS_GENERATIONS = ("-g2005", "-g2012")
+
+
+def icarus_lint(verilog_path: str | os.PathLike) -> str:
+    """``iverilog -gGEN -Wall -o /dev/null <top>.v`` for each of
+    :data:`ICARUS_GENERATIONS`; returns their output (empty when clean).
+
+    Raises :class:`ToolError` when ``iverilog`` is missing, :class:`RvsmError` (with the
+    output) if it prints anything or fails.
+    """
+    exe = shutil.which("iverilog")
+    if exe is None:
+        raise ToolError("Icarus Verilog not found; install it with `apt-get install "
+                        "iverilog`")
+    outs = []
+    for gen in ICARUS_GENERATIONS:
+        proc = run_tool([exe, gen, "-Wall", "-o", os.devnull, str(verilog_path)],
+                        tool=f"iverilog {gen}", capture=True, check=False)
+        out = (proc.stdout + proc.stderr).strip()
+        if proc.returncode < 0:
+            raise ToolFailure(f"iverilog {gen}", proc.returncode, None, out[-300:])
+        if proc.returncode != 0 or out:
+            raise RvsmError(f"iverilog {gen} is not clean for {verilog_path}:\n{out}")
+        outs.append(out)
+    return "\n".join(o for o in outs if o)
 
 
 _FF_RE = re.compile(r"^\$_(S?DFF|DFFE|SDFFE|SDFFCE|DFFSR|DFFSRE|ALDFF|ALDFFE|DLATCH)")

@@ -9,6 +9,7 @@ command is registered. Errors a user can fix are raised as
 from __future__ import annotations
 
 import argparse
+import shlex
 import signal
 import sys
 from types import ModuleType
@@ -81,6 +82,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             parser = build_parser()
             args = parser.parse_args(argv)
+            args.command_line = "rvsm " + shlex.join(sys.argv[1:] if argv is None else argv)
         except KeyboardInterrupt as exc:
             return _interrupted(exc)
         if not getattr(args, "func", None):

@@ -8,6 +8,7 @@ import shlex
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures import ARCHITECTURES, DEFAULT_ARCHITECTURE
+from rvsm.rtl.flow_files import DEFAULT_CLOCK_MHZ
 from rvsm.sim.cli.args import (
     SceneRequest,
     add_force_argument,
@@ -33,7 +34,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                        f"{a.default_top} for {a.name}" for a in ARCHITECTURES.values())
                    + ")")
     add_arch_arguments(p)
-    p.add_argument("--lint", action="store_true", help="run verilator --lint-only")
+    p.add_argument("--lint", action="store_true",
+                   help="lint the written files as a user would: verilator --lint-only "
+                   "-Wall with the shipped <top>.vlt only, and iverilog -g2005 and -g2012 "
+                   "(-Wall); any warning fails")
+    p.add_argument("--clock-mhz", type=float, default=DEFAULT_CLOCK_MHZ, metavar="MHZ",
+                   help="clock of the constraints template <top>.sdc (default "
+                   f"{DEFAULT_CLOCK_MHZ:g} MHz)")
     p.add_argument("--stats", action="store_true",
                    help="synthesise with yosys (synth; stat) and print cells/flip-flops")
     add_force_argument(p)
@@ -121,21 +128,33 @@ def arch_options(args: argparse.Namespace) -> dict[str, int]:
 
 
 def _verilog(args: argparse.Namespace) -> int:
-    from rvsm.rtl.verilog import verilator_lint, write_outputs, yosys_stats
+    from rvsm.rtl.verilog import (
+        OUTPUT_SUFFIXES,
+        icarus_lint,
+        verilator_lint,
+        write_outputs,
+        yosys_stats,
+    )
 
     arch = ARCHITECTURES[args.arch]
     options = arch_options(args)
+    if not args.clock_mhz > 0:
+        raise RvsmError(f"--clock-mhz must be > 0, got {args.clock_mhz:g}")
     _, contract = sized_contract(args.point, args.size, arch, options)
     args.top = args.top or arch.default_top
-    files = tuple((f"{args.top}{ext}", PLAIN) for ext in (".v", ".ports.json", ".ports.md"))
+    files = tuple((f"{args.top}{ext}", PLAIN) for ext in OUTPUT_SUFFIXES.values())
     check_outputs([Output(args.out, "-o", FOLDER, files)], [args.point], args.force)
-    paths, gen = write_outputs(contract, args.out, arch, args.top, **options)
-    print(f"wrote {paths['verilog']} ({gen.seconds:.1f} s), {paths['ports_json']}, "
-          f"{paths['ports_md']}; {_arch_text(args.arch, options)}, latency {gen.latency} "
-          "cycle(s)")
+    paths, gen = write_outputs(contract, args.out, arch, args.top,
+                               command=getattr(args, "command_line", None),
+                               clock_mhz=args.clock_mhz, **options)
+    print(f"wrote {paths['verilog']} ({gen.seconds:.1f} s), "
+          + ", ".join(str(p) for k, p in paths.items() if k != "verilog")
+          + f"; {_arch_text(args.arch, options)}, latency {gen.latency} cycle(s)")
     if args.lint:
         verilator_lint(paths["verilog"], args.top)
-        print("verilator --lint-only: clean (documented waivers only)")
+        print(f"verilator --lint-only -Wall {args.top}.vlt {args.top}.v: clean")
+        icarus_lint(paths["verilog"])
+        print(f"iverilog -g2005 / -g2012 -Wall {args.top}.v: clean")
     if args.stats:
         st = yosys_stats(paths["verilog"], args.top)
         pixels = contract.height * contract.width

@@ -343,6 +343,8 @@ def _reuse_verilog(
                           ("ports_md", f"{top}.ports.md")):
             paths[key] = root / name
             shutil.copyfile(other / name, paths[key])
+        # port maps no longer record a generation time (their files are deterministic):
+        # a copied Verilog took none; older port maps still give theirs
         seconds = meta.get("generation_seconds", 0.0)
         return paths, GeneratedVerilog("", top, meta["latency"],
                                        float(seconds) if isinstance(seconds, int | float)

@@ -21,7 +21,8 @@ def test_cli_verilog_writes_verilog_and_port_map(tmp_path: Path,
     assert main(["verilog", str(tmp_path / "p.toml"), "-o", str(tmp_path / "out"),
                  "--arch", "parallel"]) == 0
     names = {p.name for p in (tmp_path / "out").iterdir()}
-    assert names == {"rvsm_array.v", "rvsm_array.ports.json", "rvsm_array.ports.md"}
+    assert names == {f"rvsm_array{ext}" for ext in (".v", ".ports.json", ".ports.md", ".vlt",
+                                                     ".core", ".sdc")}
     assert "latency 1 cycle(s)" in capsys.readouterr().out
 
 
