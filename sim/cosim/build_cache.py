@@ -47,6 +47,7 @@ from rvsm.sim.cosim.chunk_harness import (
     HARNESS_VERSION,
     LONG_RUN_TESTBENCHES,
     HarnessLayout,
+    clock_inside,
     harness_verilog,
 )
 from rvsm.sim.cosim.cocotb_adapter import build_args, check_simulator, cocotb_build, cxx_opt
@@ -177,7 +178,8 @@ def build_key(contract: ArrayContract, sim: str, top: str, traced: bool,
     }
     if harness and sim == "icarus":  # the simulation-only netlist (:mod:`.icarus_netlist`)
         fields["icarus_netlist"] = {"version": ICARUS_NETLIST_VERSION, "script": YOSYS_SCRIPT,
-                                    "yosys": _yosys_version()}
+                                    "yosys": _yosys_version(),
+                                    "clock_inside": clock_inside(sim)}
     text = json.dumps(fields, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16], fields
 
@@ -252,7 +254,7 @@ def build(
         if harness:
             layout = HarnessLayout.from_ports(port_map)
             sources.append(stage / f"{HARNESS_TOP}.v")
-            sources[-1].write_text(harness_verilog(layout))
+            sources[-1].write_text(harness_verilog(layout, clock_inside(sim)))
             hdl_top, ports = HARNESS_TOP, layout.ports
             if sim == "icarus":  # simulation-only, about 2x faster (:mod:`.icarus_netlist`)
                 sources[0] = stage / icarus_netlist_name(top)

@@ -8,9 +8,10 @@ stimulus file, or a scene through a design point); ``RVSM_PORTS`` -- the array's
 ``<top>.ports.json``; ``RVSM_RESULT`` -- where the JSON result goes; optional
 ``RVSM_CHUNK_STEPS`` (steps produced at a time, default 8), ``RVSM_DEPTH`` (the
 harness's beats per chunk, default :data:`~.chunk_harness.DEFAULT_DEPTH`),
-``RVSM_PROGRESS`` (a file rewritten with ``steps done/total`` after each chunk) and
+``RVSM_PROGRESS`` (a file rewritten with ``steps done/total`` after each chunk),
 ``RVSM_STOP_AFTER_CYCLE`` (stop once the simulation passes that cycle: a waveform
-window's re-run).
+window's re-run) and ``RVSM_HARNESS_CLOCK`` (``inside``: the harness makes ``clk``
+itself, :func:`~.chunk_harness.clock_inside`; default ``outside``, a cocotb ``Clock``).
 
 Per chunk of steps the testbench gets codes and expected spikes (the twin, produced
 there and then), writes the input beats as a ``$readmemh`` file, pulses ``start`` and
@@ -42,6 +43,9 @@ from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.stream.coverage import BorderCoverage
 from rvsm.rtl.stream.drive import threshold_writes
 from rvsm.rtl.stream.schedule import OutputBeats, StreamChecker
+from rvsm.sim.cosim.chunk_harness import (
+    CLOCK_NS as HARNESS_CLOCK_NS,
+)
 from rvsm.sim.cosim.chunk_harness import (
     DEFAULT_DEPTH,
     STAMP_BITS,
@@ -77,6 +81,10 @@ async def stream_long_run(dut: object) -> None:
     depth = int(_optional("depth", str(DEFAULT_DEPTH)))
     progress = _optional("progress", None)
     stop_after = _optional("stop_after_cycle", None)
+    clock = _optional("harness_clock", "outside")
+    if clock not in ("inside", "outside") or HARNESS_CLOCK_NS != CLOCK_NS:
+        raise RuntimeError(f"RVSM_HARNESS_CLOCK must be inside or outside, got {clock!r} "
+                           f"(harness period {HARNESS_CLOCK_NS} ns, testbench {CLOCK_NS})")
     c = source.contract
     geo = stream_geometry(c, ports)
     lanes = geo.lanes
@@ -90,7 +98,7 @@ async def stream_long_run(dut: object) -> None:
     clk = dut.clk  # type: ignore[attr-defined]
     h = {name: getattr(dut, name) for name in layout.ports}
     await clock_and_reset(dut, ("clear", "thr_we", "thr_addr", "thr_data", "start",
-                                "count"))
+                                "count"), clock=clock == "outside")
     t0 = time.perf_counter()
     h["thr_we"].value = 1
     for addr, word in threshold_writes(geo, source.thresholds):
