@@ -51,8 +51,9 @@ from rvsm.model.infra.tools import find_tool, run_tool
 __all__ = ["ICARUS_NETLIST_VERSION", "YOSYS_SCRIPT", "group_enables", "merge_clocked",
            "write_icarus_netlist", "yosys_version"]
 
-#: Bump when the rewrite changes (part of an Icarus harness build's cache key).
-ICARUS_NETLIST_VERSION = "1"
+#: Bump when the rewrite, or the Icarus harness's own clock
+#: (:func:`~.chunk_harness.clock_inside`), changes: part of an Icarus harness build's key.
+ICARUS_NETLIST_VERSION = "2"
 #: yosys passes between ``read_verilog``/``hierarchy -top`` and ``write_verilog -noattr``.
 YOSYS_SCRIPT = "proc; flatten; opt; opt_clean -purge; splitnets -driver; opt_clean -purge"
 

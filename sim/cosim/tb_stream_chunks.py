@@ -95,6 +95,17 @@ async def stream_long_run(dut: object) -> None:
     cwd = Path.cwd()
     in_file, out_file = cwd / "chunk_in.hex", cwd / "chunk_out.hex"
 
+    def encode(beats: np.ndarray) -> list[tuple[int, bytes]]:
+        """``beats (K, P)`` as ``$readmemh`` texts of at most ``depth`` beats each."""
+        return [(min(depth, beats.shape[0] - k0),
+                 encode_input_beats(beats[k0:k0 + depth], c.adc_bits, layout.in_bits))
+                for k0 in range(0, beats.shape[0], depth)]
+
+    # The twin starts at once: its first chunk (imports, the JIT cache, the scene's first
+    # frames) is made while the simulator resets and takes the thresholds.
+    flush = encode(np.zeros((sched.lag, lanes), dtype=np.uint16))
+    producer = ChunkProducer(source.chunks(chunk_steps),
+                             lambda chunk: encode(sched.frame_beats(chunk.codes)))
     clk = dut.clk  # type: ignore[attr-defined]
     h = {name: getattr(dut, name) for name in layout.ports}
     await clock_and_reset(dut, ("clear", "thr_we", "thr_addr", "thr_data", "start",
@@ -113,12 +124,6 @@ async def stream_long_run(dut: object) -> None:
     beats_sent = chunks = 0
     steps_done = expected_spikes = 0
     stopped_early = False
-
-    def encode(beats: np.ndarray) -> list[tuple[int, bytes]]:
-        """``beats (K, P)`` as ``$readmemh`` texts of at most ``depth`` beats each."""
-        return [(min(depth, beats.shape[0] - k0),
-                 encode_input_beats(beats[k0:k0 + depth], c.adc_bits, layout.in_bits))
-                for k0 in range(0, beats.shape[0], depth)]
 
     async def send(parts: list[tuple[int, bytes]]) -> None:
         """Stream encoded beats through the harness, one part at a time; check outputs."""
@@ -170,9 +175,6 @@ async def stream_long_run(dut: object) -> None:
             beats_sent += count
             chunks += 1
 
-    flush = encode(np.zeros((sched.lag, lanes), dtype=np.uint16))
-    producer = ChunkProducer(source.chunks(chunk_steps),
-                             lambda chunk: encode(sched.frame_beats(chunk.codes)))
     while True:
         ta = time.perf_counter()
         item = producer.next()
