@@ -23,7 +23,7 @@ TOML text and a number of steps.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -105,13 +105,8 @@ class StimulusChunks:
         return cls(point.contract(), thresholds, steps, (), spec, _scene=scene,
                    _point=point, _engine=engine)
 
-    def chunks(self, chunk_steps: int,
-               codes_ready: Callable[[int, np.ndarray, bool], None] | None = None
-               ) -> Iterator[StimulusChunk]:
-        """Consecutive chunks of at most ``chunk_steps`` steps, never across a clear.
-        ``codes_ready(t0, codes, clear)``, when given, is called with each chunk's codes
-        before its expected spikes are made (a simulator can start on them while the
-        twin runs)."""
+    def chunks(self, chunk_steps: int) -> Iterator[StimulusChunk]:
+        """Consecutive chunks of at most ``chunk_steps`` steps, never across a clear."""
         if chunk_steps < 1:
             raise RvsmError(f"chunk steps must be >= 1, got {chunk_steps}")
         cuts = sorted({t for t in self.clear_before if 0 < t < self.num_steps})
@@ -131,19 +126,16 @@ class StimulusChunks:
             for t0 in range(a, b, chunk_steps):
                 t1 = min(t0 + chunk_steps, b)
                 if self.stimulus is not None:
-                    raw = self.stimulus.codes[t0:t1]
+                    codes = self.stimulus.codes[t0:t1]
                     spikes = self.stimulus.spikes[t0:t1]
                 else:
                     assert self._scene is not None and self._point is not None
-                    raw = step_codes(self._scene, self._point, noise, t0, t1)
-                codes = np.asarray(raw, dtype=np.uint16)
-                clear = bool(t0 == a and a > 0)
-                if codes_ready is not None:
-                    codes_ready(t0, codes, clear)
-                if self.stimulus is None:
+                    codes = step_codes(self._scene, self._point, noise, t0, t1)
                     spikes = (twin.run(t0, t1) if twin is not None
-                              else stream.run(raw))  # type: ignore[union-attr]
-                yield StimulusChunk(t0, codes, np.asarray(spikes, dtype=np.int8), clear=clear)
+                              else stream.run(codes))  # type: ignore[union-attr]
+                yield StimulusChunk(t0, np.asarray(codes, dtype=np.uint16),
+                                    np.asarray(spikes, dtype=np.int8),
+                                    clear=bool(t0 == a and a > 0))
 
 
 def open_stimulus_chunks(spec: dict | str) -> StimulusChunks:

@@ -104,8 +104,8 @@ async def stream_long_run(dut: object) -> None:
     # The twin starts at once: its first chunk (imports, the JIT cache, the scene's first
     # frames) is made while the simulator resets and takes the thresholds.
     flush = encode(np.zeros((sched.lag, lanes), dtype=np.uint16))
-    producer = ChunkProducer(source, chunk_steps,
-                             lambda codes: encode(sched.frame_beats(codes)))
+    producer = ChunkProducer(source.chunks(chunk_steps),
+                             lambda chunk: encode(sched.frame_beats(chunk.codes)))
     clk = dut.clk  # type: ignore[attr-defined]
     h = {name: getattr(dut, name) for name in layout.ports}
     await clock_and_reset(dut, ("clear", "thr_we", "thr_addr", "thr_data", "start",
@@ -126,11 +126,9 @@ async def stream_long_run(dut: object) -> None:
     steps_done = expected_spikes = 0
     stopped_early = False
 
-    async def run_parts(parts: list[tuple[int, bytes]]) -> list[tuple]:
-        """Stream encoded beats through the harness, one part at a time; their outputs,
-        decoded (checked by :func:`check_parts`)."""
+    async def send(parts: list[tuple[int, bytes]]) -> None:
+        """Stream encoded beats through the harness, one part at a time; check outputs."""
         nonlocal beats_sent, chunks
-        outputs = []
         for count, text in parts:
             ta = time.perf_counter()
             in_file.write_bytes(text)
@@ -155,18 +153,6 @@ async def stream_long_run(dut: object) -> None:
                 raise RuntimeError(f"harness wrote {bits.shape[0]} output beats, counted "
                                    f"{n_out}")
             td = time.perf_counter()
-            timings["encode"] += tb - ta
-            timings["simulate"] += tc - tb
-            timings["decode"] += td - tc
-            beats_sent += count
-            chunks += 1
-            outputs.append((bits, unknown))
-        return outputs
-
-    def check_parts(outputs: list[tuple]) -> None:
-        """Check the decoded outputs of :func:`run_parts` against the expectation."""
-        for bits, unknown in outputs:
-            td = time.perf_counter()
             cycles = _bits_value(bits, layout.out_bits, STAMP_BITS)
             npos = scales * lanes
             po, _ = fields["pos"]
@@ -184,37 +170,32 @@ async def stream_long_run(dut: object) -> None:
                 checker.listed.append({"beat": first + k, "cycle": int(cycles[k]),
                                        "error": f"X/Z in {int(unknown.sum())} output "
                                        "beat(s)"})
-            timings["check"] += time.perf_counter() - td
-
-    async def send(parts: list[tuple[int, bytes]]) -> None:
-        """Stream encoded beats through the harness and check their outputs."""
-        check_parts(await run_parts(parts))
+            te = time.perf_counter()
+            timings["encode"] += tb - ta
+            timings["simulate"] += tc - tb
+            timings["decode"] += td - tc
+            timings["check"] += te - td
+            beats_sent += count
+            chunks += 1
 
     while True:
         ta = time.perf_counter()
-        item = producer.next()  # a chunk's codes: simulated while the twin runs it
+        item = producer.next()
         timings["wait_for_twin"] += time.perf_counter() - ta
         if item is None:
             await send(flush)  # the last lag positions
             break
-        t_first, clear, parts = item
-        if clear:
+        chunk, parts = item
+        if chunk.clear:
             await send(flush)
             h["clear"].value = 1
             await FallingEdge(clk)
             h["clear"].value = 0
-            checker.restart(t_first)
-        outputs = await run_parts(parts)
-        ta = time.perf_counter()
-        chunk = producer.next()  # the same chunk with its expected spikes
-        timings["wait_for_twin"] += time.perf_counter() - ta
-        if chunk is None or chunk.t0 != t_first:
-            raise RuntimeError(f"the twin's chunk {chunk and chunk.t0} is not the one "
-                               f"simulated ({t_first})")
+            checker.restart(chunk.t0)
         checker.expect(chunk.spikes)
         border.update(chunk.spikes)
         expected_spikes += int(np.count_nonzero(chunk.spikes))
-        check_parts(outputs)
+        await send(parts)
         steps_done = chunk.t0 + chunk.num_steps
         if progress:
             write_text_atomic(progress, f"{steps_done}/{source.num_steps}\n")
@@ -265,33 +246,23 @@ async def stream_long_run(dut: object) -> None:
 
 
 class ChunkProducer:
-    """The next chunks of ``source`` made by a thread while the simulator runs (numpy
-    releases the interpreter lock, and so does cocotb while the simulator runs): for each
-    chunk, first ``(t0, clear, parts)``, its codes encoded by ``encode(codes)`` (the
-    simulator can start), then the :class:`StimulusChunk` with its expected spikes (the
-    twin's, made meanwhile: the first chunk's JIT loading and scene rendering no longer
-    hold the simulator up). At most ``ahead`` items wait, so memory stays bounded.
+    """The next chunks and their encoded input beats, made by a thread; at most
+    ``ahead`` chunks wait, so memory stays bounded. The thread works while the testbench
+    waits for it or runs Python, not while the simulator runs: cocotb 2.1 keeps the
+    interpreter lock then (its ``simulator`` module calls ``PyGILState_Ensure/Release``
+    around each callback, never ``PyEval_SaveThread``), so with a harness that clocks
+    itself the twin's time adds to the simulator's (docs/long-runs.md).
 
-    :meth:`next` gives the next item, or None at the end (re-raising the thread's
+    :meth:`next` gives ``(chunk, parts)`` or None at the end (re-raising the thread's
     error); ``seconds`` is the thread's working time."""
 
-    def __init__(self, source: object, chunk_steps: int, encode: Callable,
-                 ahead: int = 4):
+    def __init__(self, chunks: Iterator, encode: Callable, ahead: int = 2):
         self.queue: queue.Queue = queue.Queue(maxsize=ahead)
         self.stop = threading.Event()
         self.seconds = 0.0
-        self.encode = encode
-        chunks = source.chunks(chunk_steps, codes_ready=self._codes)  # type: ignore[attr-defined]
-        self.thread = threading.Thread(target=self._run, args=(chunks,), daemon=True)
+        self.thread = threading.Thread(target=self._run, args=(chunks, encode),
+                                       daemon=True)
         self.thread.start()
-
-    def _codes(self, t0: int, codes: np.ndarray, clear: bool) -> None:
-        item = (t0, clear, self.encode(codes))
-        t = time.perf_counter()
-        handed = self._put(item)
-        self.seconds -= time.perf_counter() - t  # waiting, not working
-        if not handed:
-            raise _Stopped
 
     def _put(self, item: object) -> bool:
         while not self.stop.is_set():
@@ -302,21 +273,20 @@ class ChunkProducer:
                 continue
         return False
 
-    def _run(self, chunks: Iterator) -> None:
+    def _run(self, chunks: Iterator, encode: Callable) -> None:
         try:
             while True:
                 t = time.perf_counter()
                 chunk = next(chunks, None)
+                item = None if chunk is None else (chunk, encode(chunk))
                 self.seconds += time.perf_counter() - t
-                if not self._put(chunk) or chunk is None:
+                if not self._put(item) or item is None:
                     return
-        except _Stopped:
-            return
         except BaseException as exc:  # handed to the testbench, raised there
             self._put(exc)
 
-    def next(self) -> object:
-        """The next item, or None after the last."""
+    def next(self) -> tuple | None:
+        """The next ``(chunk, parts)``, or None after the last."""
         item = self.queue.get()
         if isinstance(item, BaseException):
             raise item
@@ -326,10 +296,6 @@ class ChunkProducer:
         """Stop the thread (it may be waiting to hand over a chunk)."""
         self.stop.set()
         self.thread.join(timeout=10)
-
-
-class _Stopped(Exception):
-    """The testbench closed the producer while it handed over codes."""
 
 
 def _cycle_time_ns(cycle: int) -> int:

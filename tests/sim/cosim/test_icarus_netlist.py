@@ -191,18 +191,3 @@ def test_icarus_stamps_the_cycles_verilator_does(small_contract, cosim_work: Pat
             == found["verilator"]["first_mismatch"]["cycle"])
     assert found["icarus"]["cycles"] == found["verilator"]["cycles"]
 
-
-def test_codes_come_before_their_spikes(small_contract) -> None:
-    """``chunks(codes_ready=...)`` hands each chunk's codes (and its clear) over before
-    the chunk with its expected spikes is yielded: what lets the long-run testbench
-    simulate a chunk while the twin makes its expectation."""
-    c = small_contract("dog2", 4, 5)
-    stim = _stimulus(c, 14, 3)
-    seen: list[tuple[int, np.ndarray, bool]] = []
-    for chunk in StimulusChunks.from_stimulus(stim).chunks(
-            4, codes_ready=lambda t0, codes, clear: seen.append((t0, codes, clear))):
-        t0, codes, clear = seen[-1]
-        assert (t0, clear) == (chunk.t0, chunk.clear)
-        assert np.array_equal(codes, chunk.codes)
-    assert [(t0, clear) for t0, _, clear in seen] == [(0, False), (4, False), (6, True),
-                                                      (10, False)]
