@@ -21,9 +21,10 @@ the array's port map (``<top>.ports.json``): it instantiates the array and adds
   itself (an output: ``initial`` ... ``forever #5 clk = ~clk``, rising edges at 0, 10,
   20 ns ... as cocotb's ``Clock`` drives them) and the testbench starts no clock: on
   Icarus cocotb 2.1's ``Clock`` is a Python coroutine woken twice per cycle (its C++
-  ``gpi`` clock only with ``COCOTB_TRUST_INERTIAL_WRITES``), 7-10% of a long run's
-  simulation time (docs/long-runs.md); Verilator builds keep the input (a delay needs
-  ``--timing``);
+  ``gpi`` clock only with ``COCOTB_TRUST_INERTIAL_WRITES``): with the Icarus netlist,
+  4,648 -> 5,584 cycles per CPU second of the simulator's thread, 12.0 -> 6.8 s of
+  simulation on a quieter machine (docs/long-runs.md); Verilator builds keep the input
+  (a delay needs ``--timing``);
 * ``+rvsm_dump_file=F +rvsm_dump_from=C0 +rvsm_dump_to=C1``: a waveform (VCD) of the
   array's ports and internals for clock cycles ``C0 .. C1`` only (``$dumpvars`` at
   ``C0``, ``$dumpoff`` after ``C1``), the window around a mismatch of a long run.
