@@ -11,7 +11,10 @@ which runs cocotb and the twin). Cases:
   harness: wall time including generation and build (target <= 5 min), sustained
   cycles/s of the run (target >= 40,000);
 * ``medium``: 64x96 dog4, P=8, Verilator, 2,000 steps (target >= 150,000 cycles/s);
-* ``icarus``: 64x64 dog4, P=4, Icarus, 40 steps (target >= 5,000 cycles/s);
+* ``icarus``: 64x64 dog4, P=4, Icarus, 40 steps (target >= 5,000 cycles/s), also the
+  simulator's own rate (cycles over the seconds the testbench waited for it): the
+  harness's Icarus build simulates a yosys-rewritten netlist and makes its own clock
+  (``sim/cosim/icarus_netlist.py``, ``chunk_harness.py``; docs/long-runs.md);
 * ``one-second`` (unless ``--quick``): 250x400, P=40, Verilator, 40,000 steps of a
   4,001-frame scene: wall time including build (target <= 60 min), peak RSS (<= 4 GB);
 * ``simulate`` (unless ``--quick``): ``rvsm simulate`` of that scene to ``.h5``: peak
@@ -79,7 +82,7 @@ def verify_case(tmp: Path, name: str, size: str, lanes: int, sim: str, steps: in
             "rss_mb": rss / 1024, "cycles_per_second": r["cycles_per_second"],
             "build": r["build_seconds"], "generate": r["generate_seconds"],
             "stream": r["stream_seconds"], "seconds": r["seconds"], "steps": r["steps"],
-            "compared": r["compared"]}
+            "compared": r["compared"], "cycles": r["cycles"]}
 
 
 REGRESS_PLAN = """
@@ -184,8 +187,17 @@ def main() -> int:
                 rows.append(("64x96 P=8 Verilator", f"{cps:,.0f} cycles/s", ">= 150,000",
                              "met" if cps >= 150000 else "MISSED"))
             elif name == "icarus":
-                rows.append(("64x64 P=4 Icarus", f"{cps:,.0f} cycles/s", ">= 5,000",
-                             "met" if cps >= 5000 else "MISSED"))
+                sec = r["seconds"]
+                alone = r["cycles"] / sec["simulate"]
+                cpu = r["cycles"] / sec["simulate_cpu"]
+                print(f"  the simulator alone: {alone:,.0f} cycles/s ({r['cycles']:,} cycles "
+                      f"in {sec['simulate']:.1f} s), {cpu:,.0f} per second of its thread's "
+                      f"CPU time (other jobs barely change it); waiting for the twin "
+                      f"{sec['wait_for_twin']:.1f} s", flush=True)
+                rows += [("64x64 P=4 Icarus", f"{cps:,.0f} cycles/s", ">= 5,000",
+                          "met" if cps >= 5000 else "MISSED"),
+                         ("  its simulator alone", f"{alone:,.0f} cycles/s", "", ""),
+                         ("  per CPU second", f"{cpu:,.0f} cycles/s", "", "")]
             else:
                 rows += [("250x400, 40,000 steps incl. build", f"{r['wall'] / 60:.1f} min",
                           "<= 60 min", "met" if r["wall"] <= 3600 else "MISSED"),

@@ -17,6 +17,14 @@ the array's port map (``<top>.ports.json``): it instantiates the array and adds
   ``start``); ``overflow`` is set if a chunk presented more beats than the memory holds;
 * Verilator code coverage leaves the harness out (``verilator coverage_off``): the
   figures are the array's.
+* with ``clock_inside`` (Icarus builds, :func:`clock_inside`), the harness makes ``clk``
+  itself (an output: ``initial`` ... ``forever #5 clk = ~clk``, rising edges at 0, 10,
+  20 ns ... as cocotb's ``Clock`` drives them) and the testbench starts no clock: on
+  Icarus cocotb 2.1's ``Clock`` is a Python coroutine woken twice per cycle (its C++
+  ``gpi`` clock only with ``COCOTB_TRUST_INERTIAL_WRITES``): with the Icarus netlist,
+  4,648 -> 5,584 cycles per CPU second of the simulator's thread, 12.0 -> 6.8 s of
+  simulation on a quieter machine (docs/long-runs.md); Verilator builds keep the input
+  (a delay needs ``--timing``);
 * ``+rvsm_dump_file=F +rvsm_dump_from=C0 +rvsm_dump_to=C1``: a waveform (VCD) of the
   array's ports and internals for clock cycles ``C0 .. C1`` only (``$dumpvars`` at
   ``C0``, ``$dumpoff`` after ``C1``), the window around a mismatch of a long run.
@@ -36,9 +44,9 @@ import numpy as np
 
 from rvsm.model.infra.errors import ToolError
 
-__all__ = ["DEFAULT_DEPTH", "HARNESS_TOP", "HARNESS_VERSION", "LONG_RUN_TESTBENCHES",
-           "STAMP_BITS", "TAIL", "HarnessLayout", "decode_output_beats",
-           "encode_input_beats", "harness_verilog"]
+__all__ = ["CLOCK_NS", "DEFAULT_DEPTH", "HARNESS_TOP", "HARNESS_VERSION",
+           "LONG_RUN_TESTBENCHES", "STAMP_BITS", "TAIL", "HarnessLayout", "clock_inside",
+           "decode_output_beats", "encode_input_beats", "harness_verilog"]
 
 #: The long-run testbench of each architecture the harness drives.
 LONG_RUN_TESTBENCHES = {"stream": "rvsm.sim.cosim.tb_stream_chunks"}
@@ -51,6 +59,8 @@ DEFAULT_DEPTH = 8192
 #: Idle cycles after a chunk's last beat before its outputs are written: the last
 #: output beat is presented in the second cycle after its input beat is taken.
 TAIL = 4
+#: Clock period (ns) of a harness that makes its own clock (the testbenches' ``CLOCK_NS``).
+CLOCK_NS = 10
 #: Bits of the cycle stamp stored with each output beat.
 STAMP_BITS = 32
 _HEX = np.frombuffer(b"0123456789abcdef", dtype=np.uint8)
@@ -104,8 +114,14 @@ class HarnessLayout:
                 "done", "out_count", "stray", "overflow"]
 
 
-def harness_verilog(layout: HarnessLayout) -> str:
-    """The Verilog text of :data:`HARNESS_TOP` around ``layout.top``."""
+def clock_inside(sim: str) -> bool:
+    """Whether the harness of a ``sim`` build makes its own clock: Icarus only."""
+    return sim == "icarus"
+
+
+def harness_verilog(layout: HarnessLayout, clock_inside: bool = False) -> str:
+    """The Verilog text of :data:`HARNESS_TOP` around ``layout.top``; ``clock_inside``:
+    ``clk`` is made by the harness (module docstring), not driven from outside."""
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", layout.top):
         raise ToolError(f"not a Verilog identifier: {layout.top!r}")
     w = layout.widths
@@ -117,7 +133,7 @@ def harness_verilog(layout: HarnessLayout) -> str:
 `timescale 1ns/1ps
 // verilator coverage_off
 module {HARNESS_TOP} (
-  input  wire clk,
+  {"output reg  clk," if clock_inside else "input  wire clk,"}
   input  wire rst,
   input  wire clear,
   input  wire thr_we,
@@ -152,7 +168,7 @@ module {HARNESS_TOP} (
     .thr_we(thr_we), .thr_addr(thr_addr), .thr_data(thr_data)
   );
 
-  initial begin
+{_CLOCK.format(half=CLOCK_NS // 2, period=CLOCK_NS) if clock_inside else ""}  initial begin
     if (!$value$plusargs("rvsm_chunk_in=%s", in_file)) in_file = "chunk_in.hex";
     if (!$value$plusargs("rvsm_chunk_out=%s", out_file)) out_file = "chunk_out.hex";
     dumping = 0;
@@ -222,6 +238,18 @@ module {HARNESS_TOP} (
   end
 endmodule
 // verilator coverage_on
+"""
+
+
+_CLOCK = """  // The clock, made here (no call into Python per edge): rising edges every {period} ns
+  // from time 0, as cocotb's Clock drives them.
+  // (From x straight to 1, after the time-0 processes have started: a rising edge at 0
+  // that every clocked block sees, and no falling edge there.)
+  initial begin
+    #0 clk = 1'b1;
+    forever #{half} clk = ~clk;
+  end
+
 """
 
 

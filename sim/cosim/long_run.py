@@ -35,6 +35,7 @@ from rvsm.rtl.architecture import Architecture
 from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.sim.cosim.build_cache import SimBuild, build, new_run_dir
+from rvsm.sim.cosim.chunk_harness import clock_inside
 from rvsm.sim.cosim.code_coverage import read_coverage, summary
 from rvsm.sim.cosim.simulation import run_cocotb
 
@@ -134,7 +135,8 @@ def check_chunks(
     run_dir = new_run_dir(work, f"{name}-{sim}")
     geo = StreamGeometry(source.contract, int(resolved["lanes"]))
     try:
-        inputs = _source_inputs(source, run_dir, chunk_steps)
+        inputs = {**_source_inputs(source, run_dir, chunk_steps),
+                  "RVSM_HARNESS_CLOCK": "inside" if clock_inside(sim) else "outside"}
         plusargs = []
         if waves:
             plusargs = [f"+rvsm_dump_file={run_dir / WHOLE_RUN_WAVES}", "+rvsm_dump_from=0",

@@ -35,11 +35,13 @@ def logic_bits(value: object) -> tuple[int, int]:
     return int(clean, 2), int(xmask, 2)
 
 
-async def clock_and_reset(dut: object, idle: tuple[str, ...]) -> None:
-    """Start ``dut.clk``, hold ``rst`` high with every input in ``idle`` at 0 for two
-    cycles, release ``rst`` on a falling edge."""
+async def clock_and_reset(dut: object, idle: tuple[str, ...], clock: bool = True) -> None:
+    """Start ``dut.clk`` (unless not ``clock``: a design that makes its own), hold ``rst``
+    high with every input in ``idle`` at 0 for two cycles, release ``rst`` on a falling
+    edge."""
     clk = dut.clk  # type: ignore[attr-defined]
-    cocotb.start_soon(Clock(clk, CLOCK_NS, unit="ns").start())
+    if clock:
+        cocotb.start_soon(Clock(clk, CLOCK_NS, unit="ns").start())
     dut.rst.value = 1  # type: ignore[attr-defined]
     for name in idle:
         getattr(dut, name).value = 0

@@ -8,9 +8,10 @@ stimulus file, or a scene through a design point); ``RVSM_PORTS`` -- the array's
 ``<top>.ports.json``; ``RVSM_RESULT`` -- where the JSON result goes; optional
 ``RVSM_CHUNK_STEPS`` (steps produced at a time, default 8), ``RVSM_DEPTH`` (the
 harness's beats per chunk, default :data:`~.chunk_harness.DEFAULT_DEPTH`),
-``RVSM_PROGRESS`` (a file rewritten with ``steps done/total`` after each chunk) and
+``RVSM_PROGRESS`` (a file rewritten with ``steps done/total`` after each chunk),
 ``RVSM_STOP_AFTER_CYCLE`` (stop once the simulation passes that cycle: a waveform
-window's re-run).
+window's re-run) and ``RVSM_HARNESS_CLOCK`` (``inside``: the harness makes ``clk``
+itself, :func:`~.chunk_harness.clock_inside`; default ``outside``, a cocotb ``Clock``).
 
 Per chunk of steps the testbench gets codes and expected spikes (the twin, produced
 there and then), writes the input beats as a ``$readmemh`` file, pulses ``start`` and
@@ -42,6 +43,9 @@ from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.stream.coverage import BorderCoverage
 from rvsm.rtl.stream.drive import threshold_writes
 from rvsm.rtl.stream.schedule import OutputBeats, StreamChecker
+from rvsm.sim.cosim.chunk_harness import (
+    CLOCK_NS as HARNESS_CLOCK_NS,
+)
 from rvsm.sim.cosim.chunk_harness import (
     DEFAULT_DEPTH,
     STAMP_BITS,
@@ -77,6 +81,10 @@ async def stream_long_run(dut: object) -> None:
     depth = int(_optional("depth", str(DEFAULT_DEPTH)))
     progress = _optional("progress", None)
     stop_after = _optional("stop_after_cycle", None)
+    clock = _optional("harness_clock", "outside")
+    if clock not in ("inside", "outside") or HARNESS_CLOCK_NS != CLOCK_NS:
+        raise RuntimeError(f"RVSM_HARNESS_CLOCK must be inside or outside, got {clock!r} "
+                           f"(harness period {HARNESS_CLOCK_NS} ns, testbench {CLOCK_NS})")
     c = source.contract
     geo = stream_geometry(c, ports)
     lanes = geo.lanes
@@ -87,10 +95,21 @@ async def stream_long_run(dut: object) -> None:
     cwd = Path.cwd()
     in_file, out_file = cwd / "chunk_in.hex", cwd / "chunk_out.hex"
 
+    def encode(beats: np.ndarray) -> list[tuple[int, bytes]]:
+        """``beats (K, P)`` as ``$readmemh`` texts of at most ``depth`` beats each."""
+        return [(min(depth, beats.shape[0] - k0),
+                 encode_input_beats(beats[k0:k0 + depth], c.adc_bits, layout.in_bits))
+                for k0 in range(0, beats.shape[0], depth)]
+
+    # The twin starts at once: its first chunk (imports, the JIT cache, the scene's first
+    # frames) is made while the simulator resets and takes the thresholds.
+    flush = encode(np.zeros((sched.lag, lanes), dtype=np.uint16))
+    producer = ChunkProducer(source.chunks(chunk_steps),
+                             lambda chunk: encode(sched.frame_beats(chunk.codes)))
     clk = dut.clk  # type: ignore[attr-defined]
     h = {name: getattr(dut, name) for name in layout.ports}
     await clock_and_reset(dut, ("clear", "thr_we", "thr_addr", "thr_data", "start",
-                                "count"))
+                                "count"), clock=clock == "outside")
     t0 = time.perf_counter()
     h["thr_we"].value = 1
     for addr, word in threshold_writes(geo, source.thresholds):
@@ -101,16 +120,11 @@ async def stream_long_run(dut: object) -> None:
 
     checker = StreamChecker(sched)
     border = BorderCoverage(c, lanes)
-    timings = {"wait_for_twin": 0.0, "encode": 0.0, "simulate": 0.0, "decode": 0.0, "check": 0.0}
+    timings = {"wait_for_twin": 0.0, "encode": 0.0, "simulate": 0.0, "decode": 0.0, "check": 0.0,
+               "simulate_cpu": 0.0}
     beats_sent = chunks = 0
     steps_done = expected_spikes = 0
     stopped_early = False
-
-    def encode(beats: np.ndarray) -> list[tuple[int, bytes]]:
-        """``beats (K, P)`` as ``$readmemh`` texts of at most ``depth`` beats each."""
-        return [(min(depth, beats.shape[0] - k0),
-                 encode_input_beats(beats[k0:k0 + depth], c.adc_bits, layout.in_bits))
-                for k0 in range(0, beats.shape[0], depth)]
 
     async def send(parts: list[tuple[int, bytes]]) -> None:
         """Stream encoded beats through the harness, one part at a time; check outputs."""
@@ -119,6 +133,7 @@ async def stream_long_run(dut: object) -> None:
             ta = time.perf_counter()
             in_file.write_bytes(text)
             tb = time.perf_counter()
+            cpu = time.thread_time()  # the simulator runs in this thread: its CPU time
             h["count"].value = count
             h["start"].value = 1
             await FallingEdge(clk)
@@ -126,6 +141,7 @@ async def stream_long_run(dut: object) -> None:
             await RisingEdge(h["done"])
             await FallingEdge(clk)
             tc = time.perf_counter()
+            timings["simulate_cpu"] += time.thread_time() - cpu
             n_out = int(h["out_count"].value)
             if n_out:
                 bits, unknown = decode_output_beats(out_file.read_bytes(),
@@ -162,9 +178,6 @@ async def stream_long_run(dut: object) -> None:
             beats_sent += count
             chunks += 1
 
-    flush = encode(np.zeros((sched.lag, lanes), dtype=np.uint16))
-    producer = ChunkProducer(source.chunks(chunk_steps),
-                             lambda chunk: encode(sched.frame_beats(chunk.codes)))
     while True:
         ta = time.perf_counter()
         item = producer.next()
@@ -233,9 +246,12 @@ async def stream_long_run(dut: object) -> None:
 
 
 class ChunkProducer:
-    """The next chunks and their encoded input beats, made by a thread while the
-    simulator runs (numpy releases the interpreter lock, and so does cocotb while the
-    simulator runs); at most ``ahead`` chunks wait, so memory stays bounded.
+    """The next chunks and their encoded input beats, made by a thread; at most
+    ``ahead`` chunks wait, so memory stays bounded. The thread works while the testbench
+    waits for it or runs Python, not while the simulator runs: cocotb 2.1 keeps the
+    interpreter lock then (its ``simulator`` module calls ``PyGILState_Ensure/Release``
+    around each callback, never ``PyEval_SaveThread``), so with a harness that clocks
+    itself the twin's time adds to the simulator's (docs/long-runs.md).
 
     :meth:`next` gives ``(chunk, parts)`` or None at the end (re-raising the thread's
     error); ``seconds`` is the thread's working time."""
