@@ -10,8 +10,11 @@ stimulus file, or a scene through a design point); ``RVSM_PORTS`` -- the array's
 harness's beats per chunk, default :data:`~.chunk_harness.DEFAULT_DEPTH`),
 ``RVSM_PROGRESS`` (a file rewritten with ``steps done/total`` after each chunk),
 ``RVSM_STOP_AFTER_CYCLE`` (stop once the simulation passes that cycle: a waveform
-window's re-run) and ``RVSM_HARNESS_CLOCK`` (``inside``: the harness makes ``clk``
-itself, :func:`~.chunk_harness.clock_inside`; default ``outside``, a cocotb ``Clock``).
+window's re-run), ``RVSM_HARNESS_CLOCK`` (``inside``: the harness makes ``clk``
+itself, :func:`~.chunk_harness.clock_inside`; default ``outside``, a cocotb ``Clock``)
+and ``RVSM_PRODUCER`` (``process``, default: the twin runs in a forked process beside
+the simulator, :class:`ProcessChunkProducer`; ``thread``: in a thread of the simulator's
+process, :class:`ChunkProducer`).
 
 Per chunk of steps the testbench gets codes and expected spikes (the twin, produced
 there and then), writes the input beats as a ``$readmemh`` file, pulses ``start`` and
@@ -104,7 +107,8 @@ async def stream_long_run(dut: object) -> None:
     # The twin starts at once: its first chunk (imports, the JIT cache, the scene's first
     # frames) is made while the simulator resets and takes the thresholds.
     flush = encode(np.zeros((sched.lag, lanes), dtype=np.uint16))
-    producer = ChunkProducer(source.chunks(chunk_steps),
+    producer = make_producer(os.environ.get("RVSM_PRODUCER", "process"),
+                             lambda: source.chunks(chunk_steps),
                              lambda chunk: encode(sched.frame_beats(chunk.codes)))
     clk = dut.clk  # type: ignore[attr-defined]
     h = {name: getattr(dut, name) for name in layout.ports}
@@ -296,6 +300,89 @@ class ChunkProducer:
         """Stop the thread (it may be waiting to hand over a chunk)."""
         self.stop.set()
         self.thread.join(timeout=10)
+
+
+def _produce(make_chunks: Callable[[], Iterator], encode: Callable, out: object) -> None:
+    """The twin's process (:class:`ProcessChunkProducer`): every chunk and its encoded
+    beats into ``out``, then ``("end", seconds)``; an error as ``("error", text)``."""
+    import sys
+    import traceback
+
+    # cocotb imports through pytest's assertion-rewriting hook, which rewrites every
+    # module the twin imports on first use (scipy, scikit-image: 3.7 of the first
+    # chunk's 4.6 s at 64x64, measured); the twin asserts nothing for pytest
+    sys.meta_path[:] = [f for f in sys.meta_path
+                        if type(f).__name__ != "AssertionRewritingHook"]
+    seconds = 0.0
+    try:
+        chunks = make_chunks()
+        while True:
+            t = time.perf_counter()
+            chunk = next(chunks, None)
+            if chunk is None:
+                out.put(("end", seconds + time.perf_counter() - t))  # type: ignore[attr-defined]
+                return
+            item = ("chunk", chunk, encode(chunk))
+            seconds += time.perf_counter() - t
+            out.put(item)  # type: ignore[attr-defined]
+    except BaseException:  # handed to the testbench, raised there
+        out.put(("error", traceback.format_exc(limit=8)))  # type: ignore[attr-defined]
+
+
+class ProcessChunkProducer:
+    """:class:`ChunkProducer`'s interface with the twin in a forked child process: the
+    simulator holds the interpreter lock while it runs (cocotb 2.1), so a thread of its
+    process cannot overlap it, a process can (the machine's second core). At most
+    ``ahead`` chunks wait in the queue; the child is killed by :meth:`close` (and with
+    the simulator's process group). ``seconds`` is the child's working time."""
+
+    def __init__(self, make_chunks: Callable[[], Iterator], encode: Callable,
+                 ahead: int = 2):
+        import multiprocessing
+
+        ctx = multiprocessing.get_context("fork")
+        self.queue = ctx.Queue(maxsize=ahead)
+        self.proc = ctx.Process(target=_produce, args=(make_chunks, encode, self.queue),
+                                daemon=True, name="rvsm-twin")
+        self.proc.start()
+        self.seconds = 0.0
+
+    def next(self) -> tuple | None:
+        """The next ``(chunk, parts)``, or None after the last."""
+        while True:
+            try:
+                item = self.queue.get(timeout=1.0)
+                break
+            except queue.Empty:
+                if not self.proc.is_alive():
+                    raise RuntimeError(f"the twin's process ended (exit code "
+                                       f"{self.proc.exitcode}) without its chunks") from None
+        if item[0] == "error":
+            raise RuntimeError(f"the twin's process failed:\n{item[1]}")
+        if item[0] == "end":
+            self.seconds = float(item[1])
+            return None
+        return item[1], item[2]
+
+    def close(self) -> None:
+        """Stop the child (it may be waiting to hand over a chunk)."""
+        if self.proc.is_alive():
+            self.proc.terminate()
+        self.proc.join(timeout=10)
+        self.queue.close()
+
+
+def make_producer(kind: str, make_chunks: Callable[[], Iterator], encode: Callable
+                  ) -> ChunkProducer | ProcessChunkProducer:
+    """``"process"`` (:class:`ProcessChunkProducer`, where ``fork`` exists) or
+    ``"thread"`` (:class:`ChunkProducer`)."""
+    import multiprocessing
+
+    if kind == "process" and "fork" in multiprocessing.get_all_start_methods():
+        return ProcessChunkProducer(make_chunks, encode)
+    if kind not in ("process", "thread"):
+        raise RuntimeError(f"RVSM_PRODUCER must be 'process' or 'thread', got {kind!r}")
+    return ChunkProducer(make_chunks(), encode)
 
 
 def _cycle_time_ns(cycle: int) -> int:
