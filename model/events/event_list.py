@@ -26,7 +26,6 @@ list back as a :class:`~rvsm.model.spikes.source.SpikeSource` of dense events
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 from pathlib import Path
@@ -36,6 +35,7 @@ import numpy as np
 from rvsm.model.infra.atomic import PartialFile
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.versions import with_versions
+from rvsm.model.spikes.h5 import abort_partial
 from rvsm.model.spikes.source import SpikeSource
 
 __all__ = ["EVENT_LIST_FORMAT", "STEP_US", "EventListWriter", "is_event_list",
@@ -154,13 +154,7 @@ class EventListWriter:
         self._partial = None
 
     def abort(self) -> None:
-        if self._file is not None:
-            with contextlib.suppress(Exception):
-                self._file.close()
-            self._file = None
-        if self._partial is not None:
-            self._partial.abort()
-        self._partial = None
+        self._file, self._partial = abort_partial(self._file, self._partial)
 
 
 def open_event_list(path: str | os.PathLike) -> SpikeSource:

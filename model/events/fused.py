@@ -24,9 +24,8 @@ from numba import njit, prange
 
 from rvsm.model.events.config import EventConfig
 from rvsm.model.kernels.orbits import kernel_orbits
-from rvsm.model.noise.sensor import NoiseSource
-from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, check_coordinates, normal_row
-from rvsm.model.sampling.fused import chunk_frames
+from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, normal_row
+from rvsm.model.sampling.fused import chunk_frames, dark_current_stream
 from rvsm.model.sampling.row_sums import row_pairs, scale_sum
 from rvsm.model.scene.scene import Scene
 
@@ -119,14 +118,8 @@ class FusedEventSampler:
         self.ref = np.zeros_like(self.thr)
         self.captured: np.ndarray | None = None
         self.tile_rows = max(1, int(tile_rows))
-        if config.noise is not None:
-            check_coordinates(scene.num_steps, scene.shape)
-            src = NoiseSource(config.noise, scene.shape, spec.num_scales)
-            self.key = src.dark_key
-            self.mean, self.sd = src.dark_mean_sd
-            self.noisy = True
-        else:
-            self.key, self.mean, self.sd, self.noisy = np.uint64(0), 0.0, 0.0, False
+        self.noisy, self.key, self.mean, self.sd = dark_current_stream(
+            config.noise, scene, spec.num_scales)
         self.next_step = 0
 
     @property

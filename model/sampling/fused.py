@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit, prange
 
 from rvsm.model.kernels.orbits import kernel_orbits
-from rvsm.model.noise.sensor import NoiseSource
+from rvsm.model.noise.sensor import NoiseParams, NoiseSource
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, check_coordinates, normal_row
 from rvsm.model.sampling.config import SamplerConfig
 from rvsm.model.sampling.row_sums import row_pairs, scale_sum
@@ -160,6 +160,19 @@ def _float_chunk(kf, fidx, aw, thr, acc, signed, zero_reset, noisy, key, t0, mea
                                    signed, zero_reset)
 
 
+def dark_current_stream(noise: NoiseParams | None, scene: Scene, num_scales: int
+                        ) -> tuple[bool, np.uint64, float, float]:
+    """What a fused kernel needs to draw the dark current itself: ``(noisy, key, mean,
+    sd)`` of ``noise``'s stream (:class:`NoiseSource`; coordinates checked), or
+    ``(False, 0, 0.0, 0.0)`` without noise."""
+    if noise is None:
+        return False, np.uint64(0), 0.0, 0.0
+    check_coordinates(scene.num_steps, scene.shape)
+    src = NoiseSource(noise, scene.shape, num_scales)
+    mean, sd = src.dark_mean_sd
+    return True, src.dark_key, mean, sd
+
+
 class FusedFloatSampler:
     """The float sampler's state and fused chunk kernel for one scene and configuration.
 
@@ -179,14 +192,8 @@ class FusedFloatSampler:
         self.signed = bool(spec.signed)
         self.zero_reset = config.reset == "zero"
         self.tile_rows = max(1, int(tile_rows))
-        if config.noise is not None:
-            check_coordinates(scene.num_steps, scene.shape)
-            src = NoiseSource(config.noise, scene.shape, spec.num_scales)
-            self.key = src.dark_key
-            self.mean, self.sd = src.dark_mean_sd
-            self.noisy = True
-        else:
-            self.key, self.mean, self.sd, self.noisy = np.uint64(0), 0.0, 0.0, False
+        self.noisy, self.key, self.mean, self.sd = dark_current_stream(
+            config.noise, scene, spec.num_scales)
         self.next_step = 0
         self._kf: np.ndarray | None = None
         self._padded: np.ndarray | None = None

@@ -128,13 +128,18 @@ class H5SpikeWriter:
         self._partial = None
 
     def abort(self) -> None:
-        if self._file is not None:
-            with contextlib.suppress(Exception):
-                self._file.close()
-            self._file = None
-        if self._partial is not None:
-            self._partial.abort()
-        self._partial = None
+        self._file, self._partial = abort_partial(self._file, self._partial)
+
+
+def abort_partial(handle, partial: PartialFile | None) -> tuple[None, None]:
+    """Close an open HDF5 ``handle`` (errors ignored: it is being thrown away) and remove
+    its :class:`PartialFile`; returns ``(None, None)`` for the writer's two fields."""
+    if handle is not None:
+        with contextlib.suppress(Exception):
+            handle.close()
+    if partial is not None:
+        partial.abort()
+    return None, None
 
 
 def _fixed(text: str) -> np.bytes_:
