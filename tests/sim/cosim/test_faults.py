@@ -271,7 +271,7 @@ def test_disk_full_is_exit_3(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     def full(*args: object, **kwargs: object) -> None:
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), "stimulus.npz")
 
-    monkeypatch.setattr(stimulus_module.np, "savez_compressed", full)
+    monkeypatch.setattr(stimulus_module, "_write_chunks", full)  # the members' writer
     work = tmp_path / "w"
     assert main(_verify_args(_point(tmp_path / "p.toml"), work)) == 3
     assert "No space left on device" in _one_line(capsys.readouterr().err)
