@@ -166,6 +166,7 @@ def test_icarus_netlist_agrees_with_the_twin(small_contract, cosim_work: Path,
 
 
 
+@pytest.mark.slow  # a Verilator harness build: about 40 s (make regress)
 @pytest.mark.verilator
 @pytest.mark.skipif(shutil.which("iverilog") is None, reason="needs Icarus Verilog")
 def test_icarus_stamps_the_cycles_verilator_does(small_contract, cosim_work: Path,
