@@ -427,7 +427,6 @@ class RvsmStreamArray(wiring.Component):
         p, words, wa = geo.lanes, geo.beats_per_frame, c.accumulator_bits
         rd_addr, bank_q, fresh_q, wr_addr, wr_en = (tail.rd_addr, tail.bank_q, tail.fresh_q,
                                                     tail.wr_addr, tail.wr_en)
-        lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
         tw = c.threshold_bits
         # Threshold writes land one edge after the bus accepts them (a registered bus),
         # so a read at the bus' edge does not see them; a read meeting the registered
@@ -488,37 +487,22 @@ class RvsmStreamArray(wiring.Component):
                 thr2 = Signal(unsigned(tw), name=f"thr2_s{s}_l{i}", **data)
                 pos = Signal(name=f"pos_s{s}_l{i}", **data)
                 neg = Signal(name=f"neg_s{s}_l{i}", **data)
-                fire_pos = total >= thr1
-                if self.mutation == "stream.threshold_off_by_one":
-                    fire_pos = total > thr1
-                elif self.mutation == "stream.stale_threshold":
-                    fire_pos = total >= thr2  # the previous position's threshold
-                fire_neg = (~fire_pos & (total <= -thr1)) if c.signed else Const(0)
-                if self.mutation == "stream.no_negative_spikes":
-                    fire_neg = Const(0)
                 if c.sensor == "dvs":
                     tail_stmts += self._event_tail(m, s, i, acc_q[i * wa:(i + 1) * wa]
                                                    .as_signed(), fresh, shifted,
                                                    thr_q[i * tw:(i + 1) * tw], total, thr1,
                                                    sat, thr2, pos, neg)
-                    after = sat
+                    after = sat  # the moved, saturated reference
                 else:
-                    tail_stmts += [
-                        total.eq(acc + shifted),
-                        thr1.eq(thr_q[i * tw:(i + 1) * tw]),
-                        sat.eq(total[:wa].as_signed()
-                               if self.mutation == "stream.no_saturation"  # wraps around
-                               else Mux(total > hi, hi, Mux(total < lo, lo, total))),
-                        pos.eq(fire_pos), neg.eq(fire_neg), thr2.eq(thr1),
-                    ]
-                if c.sensor == "dvs":
-                    pass
-                elif self.mutation == "stream.no_reset_on_spike":
-                    after = sat
-                elif c.reset == "zero" or self.mutation == "stream.zero_instead_of_subtract":
-                    after = Mux(pos | neg, 0, sat)
-                else:
-                    after = Mux(pos, sat - thr2, Mux(neg, sat + thr2, sat))
+                    tail_stmts += self._spike_tail(acc, shifted, thr_q[i * tw:(i + 1) * tw],
+                                                   total, thr1, sat, thr2, pos, neg)
+                    if self.mutation == "stream.no_reset_on_spike":
+                        after = sat
+                    elif c.reset == "zero" or \
+                            self.mutation == "stream.zero_instead_of_subtract":
+                        after = Mux(pos | neg, 0, sat)
+                    else:
+                        after = Mux(pos, sat - thr2, Mux(neg, sat + thr2, sat))
                 after_lanes.append(after.as_unsigned()[:wa])
                 probes[s].append({"acc": acc, "total": total, "thr1": thr1, "sat": sat,
                                   "thr2": thr2, "pos": pos, "neg": neg, "after": after})
@@ -536,6 +520,32 @@ class RvsmStreamArray(wiring.Component):
             m.d.sync += tail_stmts
         m.d.sync += self.spikes.valid.eq(wr_en)
         return probes, thr_memories
+
+    def _spike_tail(self, acc: Value, shifted: Value, thr: Value, total: Signal,
+                    thr1: Signal, sat: Signal, thr2: Signal, pos: Signal, neg: Signal
+                    ) -> list:
+        """The spike camera's tail for one lane and scale: stage 1 ``total = acc +
+        shifted`` and the threshold; stage 2 saturation, fire and the threshold kept for
+        the reset (the caller's ``after``)."""
+        c = self.contract
+        wa = c.accumulator_bits
+        lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
+        fire_pos = total >= thr1
+        if self.mutation == "stream.threshold_off_by_one":
+            fire_pos = total > thr1
+        elif self.mutation == "stream.stale_threshold":
+            fire_pos = total >= thr2  # the previous position's threshold
+        fire_neg = (~fire_pos & (total <= -thr1)) if c.signed else Const(0)
+        if self.mutation == "stream.no_negative_spikes":
+            fire_neg = Const(0)
+        return [
+            total.eq(acc + shifted),
+            thr1.eq(thr),
+            sat.eq(total[:wa].as_signed()
+                   if self.mutation == "stream.no_saturation"  # wraps around
+                   else Mux(total > hi, hi, Mux(total < lo, lo, total))),
+            pos.eq(fire_pos), neg.eq(fire_neg), thr2.eq(thr1),
+        ]
 
     def _event_tail(self, m: Module, s: int, i: int, ref: Value, fresh: Value,
                     shifted: Value, thr: Value, total: Signal, thr1: Signal, sat: Signal,
