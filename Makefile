@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep lint clean
+.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep lint diagrams clean
 
 setup: $(STAMP)
 
@@ -85,6 +85,10 @@ bench-rtl: setup
 # sweep speed-up 1 -> 2 workers on sweeps/example.toml (about 4 minutes per round)
 bench-sweep: setup
 	$(BIN)/python scripts/bench_sweep.py --rounds $(or $(ROUNDS),1)
+
+# the integration guide's timing diagrams, recorded from amaranth.sim (docs/integration.md)
+diagrams: setup
+	$(BIN)/python scripts/timing_diagrams.py --out docs/diagrams
 
 lint: setup
 	$(BIN)/ruff check .

@@ -65,7 +65,13 @@ def _notes(dut: RvsmStreamArray) -> list[str]:
     s = geo.state_bits
     return [f"State memory: accumulators {s['accumulators']} bits, thresholds "
             f"{s['thresholds']} bits, line buffer {s['line_buffer']} bits; banks of "
-            f"{geo.bank_sizes} words per scale and kind."]
+            f"{geo.bank_sizes} words per scale and kind.",
+            "",
+            f"Pixel to spike: output p is presented in the second cycle after input beat "
+            f"p + {geo.lag} is accepted ({geo.lag + 1} cycles after the edge accepting "
+            f"beat p when beats come back to back). To end a stream send {geo.lag} flush "
+            f"beats (any codes), wait one cycle, then clear. Timing diagrams, formulas, "
+            f"reset and instantiation: docs/integration.md (the rvsm integration guide)."]
 
 
 def _check(contract: ArrayContract, lanes: int) -> None:
