@@ -6,7 +6,8 @@ by cycle and records its ports in a :class:`~rvsm.rtl.wavejson.CycleTable`, so e
 diagram in ``docs/integration.md`` is what the RTL did, not a drawing. Recording also
 checks the documented rules: output position ``p`` is presented in the second period
 after input beat ``p + lag`` is accepted, in raster order, with ``last`` on a frame's
-last position, and nothing of a stream cut by ``clear`` comes out after it.
+last position, and every output released before a ``clear`` comes out (the rest of
+that stream never does).
 
 Labels: ``codes.payload`` shows ``b<k>`` for input beat ``k`` (counted from the last
 clear; ``f`` marks a flush beat, any codes), ``spikes.payload`` ``p<k> (<row>,<group>)``
