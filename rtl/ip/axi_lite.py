@@ -145,25 +145,23 @@ class AxiLiteRegisters(wiring.Component):
         with m.If(go):
             m.d.sync += [aw_have.eq(0), w_have.eq(0), bvalid.eq(1), bresp.eq(RESP_SLVERR),
                          self.wdata.eq(w_data)]
-            with m.Switch(aw_addr[2:]):
-                for r in rm.registers:
-                    if not r.writable:
-                        continue
-                    with m.Case(r.offset >> 2):
-                        bad = (w_strb != 0xF) | self.refuse[r.name]
+            writable = [r for r in rm.registers if r.writable]
+            for n, r in enumerate(writable):  # if/elif, not a case: no incomplete case
+                with (m.If if n == 0 else m.Elif)(aw_addr[2:] == r.offset >> 2):
+                    bad = (w_strb != 0xF) | self.refuse[r.name]
+                    for f in r.fields:
+                        if f.max is not None and f.max < (1 << f.width) - 1:
+                            bad = bad | (w_data[f.lsb:f.lsb + f.width] > f.max)
+                    with m.If(~bad):
+                        m.d.sync += [bresp.eq(RESP_OKAY), self.written[r.name].eq(1)]
                         for f in r.fields:
-                            if f.max is not None and f.max < (1 << f.width) - 1:
-                                bad = bad | (w_data[f.lsb:f.lsb + f.width] > f.max)
-                        with m.If(~bad):
-                            m.d.sync += [bresp.eq(RESP_OKAY), self.written[r.name].eq(1)]
-                            for f in r.fields:
-                                k, bits = _key(r.name, f), w_data[f.lsb:f.lsb + f.width]
-                                if f.access == "RW" and not f.external:
-                                    m.d.sync += self.value[k].eq(bits)
-                                elif f.access == "WO":
-                                    m.d.sync += self.pulse[k].eq(bits)
-                                elif f.access == "W1C":
-                                    m.d.comb += clears[k].eq(bits)
+                            k, bits = _key(r.name, f), w_data[f.lsb:f.lsb + f.width]
+                            if f.access == "RW" and not f.external:
+                                m.d.sync += self.value[k].eq(bits)
+                            elif f.access == "WO":
+                                m.d.sync += self.pulse[k].eq(bits)
+                            elif f.access == "W1C":
+                                m.d.comb += clears[k].eq(bits)
 
     def _read_channel(self, m: Module) -> None:
         bus, rm = self.bus, self.regmap
@@ -176,7 +174,6 @@ class AxiLiteRegisters(wiring.Component):
             m.d.sync += rvalid.eq(0)
         with m.If(bus.arvalid & ~rvalid):
             m.d.sync += [rvalid.eq(1), rdata.eq(0), rresp.eq(RESP_SLVERR)]
-            with m.Switch(bus.araddr[2:]):
-                for r in rm.registers:
-                    with m.Case(r.offset >> 2):
-                        m.d.sync += [rdata.eq(self.read_value(r.name)), rresp.eq(RESP_OKAY)]
+            for n, r in enumerate(rm.registers):
+                with (m.If if n == 0 else m.Elif)(bus.araddr[2:] == r.offset >> 2):
+                    m.d.sync += [rdata.eq(self.read_value(r.name)), rresp.eq(RESP_OKAY)]

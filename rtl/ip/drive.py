@@ -218,20 +218,25 @@ def run_bench(dut: RvsmAxisIp, bench: Callable[[Cycler], Awaitable[None]],
 def simulate_ip(contract: ArrayContract, lanes: int, codes: np.ndarray,
                 thresholds: np.ndarray, fifo_depth: int = RvsmAxisIp.FIFO_DEPTH,
                 drop: bool = False, valid: Sequence[bool] = (), ready: Sequence[bool] = (),
-                flush: str = "source", drain: int = 64, vcd_path: str | None = None
-                ) -> IpRun:
+                flush: str = "source", drain: int = 64, vcd_path: str | None = None,
+                clear_before: Sequence[int] = ()) -> IpRun:
     """Run the IP on frames ``codes (T, H, W)`` with ``thresholds (S, H, W)``.
 
     ``flush``: ``"source"`` sends the ``lag`` flush beats as ordinary input beats (the
     stream the model :func:`run_stream_model` takes), ``"control"`` writes
-    ``CONTROL = flush | clear`` after the frames. The sink follows ``ready`` from the
+    ``CONTROL = flush | clear`` after the frames, and after every segment between
+    ``clear_before`` steps (:meth:`StreamSchedule.segments`; ``"control"`` only: the
+    segments restart at frame 0 as :meth:`ArrayContract.run` does). The sink follows ``ready`` from the
     stream's first cycle; the bench then drains ``drain`` cycles with the sink ready
     and reads every register."""
     dut = RvsmAxisIp(contract, lanes, fifo_depth)
     sched = dut.geometry.schedule
     rm = dut.regmap
-    words, tuser, tlast = input_stream(sched, np.asarray(codes, dtype=np.int64),
-                                       contract.adc_bits, flush == "source")
+    codes = np.asarray(codes, dtype=np.int64)
+    if clear_before and flush != "control":
+        raise ValueError("clear_before needs flush='control'")
+    streams = [input_stream(sched, codes[a:b], contract.adc_bits, flush == "source")
+               for a, b in sched.segments(len(codes), clear_before)]
     result: dict[str, object] = {}
 
     async def bench(cy: Cycler) -> None:
@@ -243,10 +248,11 @@ def simulate_ip(contract: ArrayContract, lanes: int, codes: np.ndarray,
         for _ in range(4):
             await cy.tick()
         cy.mark, cy.ready = cy.cycle, ready
-        await stream_beats(cy, words, tuser, tlast, valid)
-        if flush == "control":
-            bits = rm.field("CONTROL", "flush").mask | rm.field("CONTROL", "clear").mask
-            await axil_write(cy, rm["CONTROL"].offset, bits | policy)
+        for words, tuser, tlast in streams:
+            await stream_beats(cy, words, tuser, tlast, valid)
+            if flush == "control":
+                bits = rm.field("CONTROL", "flush").mask | rm.field("CONTROL", "clear").mask
+                await axil_write(cy, rm["CONTROL"].offset, bits | policy)
         while cy.cycle - cy.mark < len(ready):
             await cy.tick()
         cy.ready = ()

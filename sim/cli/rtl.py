@@ -9,6 +9,7 @@ import shlex
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures import ARCHITECTURES, DEFAULT_ARCHITECTURE
 from rvsm.rtl.flow_files import DEFAULT_CLOCK_MHZ
+from rvsm.rtl.ip.architecture import INTERFACES, STREAM_AXIS, interface_architecture
 from rvsm.sim.cli.args import (
     SceneRequest,
     add_force_argument,
@@ -34,6 +35,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                        f"{a.default_top} for {a.name}" for a in ARCHITECTURES.values())
                    + ")")
     add_arch_arguments(p)
+    p.add_argument("--interface", choices=INTERFACES, default="native",
+                   help="native (default): the bare array's ports; axis: the streaming "
+                   "array as IP, AXI4-Stream video in and spikes out, AXI4-Lite "
+                   "registers, plus <top>.regs.md/.json/.h (docs/ip.md)")
+    p.add_argument("--fifo-depth", type=int, metavar="BEATS",
+                   help="--interface axis: output FIFO depth in beats (default "
+                   f"{STREAM_AXIS.options[-1].default})")
     p.add_argument("--lint", action="store_true",
                    help="lint the written files as a user would: verilator --lint-only "
                    "-Wall with the shipped <top>.vlt only, and iverilog -g2005 and -g2012 "
@@ -136,20 +144,27 @@ def _verilog(args: argparse.Namespace) -> int:
         yosys_stats,
     )
 
-    arch = ARCHITECTURES[args.arch]
+    base = ARCHITECTURES[args.arch]
     options = arch_options(args)
     if not args.clock_mhz > 0:
         raise RvsmError(f"--clock-mhz must be > 0, got {args.clock_mhz:g}")
-    _, contract = sized_contract(args.point, args.size, arch, options)
+    _, contract = sized_contract(args.point, args.size, base, options)
+    arch = interface_architecture(base, args.interface)
+    if args.fifo_depth is not None and args.interface != "axis":
+        raise RvsmError("--fifo-depth applies to --interface axis only")
+    options = arch.resolve({**options, **({"fifo_depth": args.fifo_depth}
+                                          if arch is STREAM_AXIS else {})})
+    arch.check(contract, **options)
     args.top = args.top or arch.default_top
-    files = tuple((f"{args.top}{ext}", PLAIN) for ext in OUTPUT_SUFFIXES.values())
+    suffixes = (*OUTPUT_SUFFIXES.values(), *arch.extra_suffixes)
+    files = tuple((f"{args.top}{ext}", PLAIN) for ext in suffixes)
     check_outputs([Output(args.out, "-o", FOLDER, files)], [args.point], args.force)
     paths, gen = write_outputs(contract, args.out, arch, args.top,
                                command=getattr(args, "command_line", None),
                                clock_mhz=args.clock_mhz, **options)
     print(f"wrote {paths['verilog']} ({gen.seconds:.1f} s), "
           + ", ".join(str(p) for k, p in paths.items() if k != "verilog")
-          + f"; {_arch_text(args.arch, options)}, latency {gen.latency} cycle(s)")
+          + f"; {_arch_text(arch.name, options)}, latency {gen.latency} cycle(s)")
     if args.lint:
         verilator_lint(paths["verilog"], args.top)
         print(f"verilator --lint-only -Wall {args.top}.vlt {args.top}.v: clean")

@@ -208,6 +208,7 @@ def test_slave_errors_sticky_flags_and_framing() -> None:
     assert not seen["status_after"] & overflow and seen["status_after"] & framing
 
 
+@pytest.mark.filterwarnings("ignore::amaranth.hdl._ir.UnusedElaboratable")
 def test_fifo_depth_is_checked() -> None:
     c, _, _ = _run(model="fsm")
     with pytest.raises(RvsmError, match="fifo_depth"):
