@@ -226,9 +226,9 @@ def simulate_ip(contract: ArrayContract, lanes: int, codes: np.ndarray,
     stream the model :func:`run_stream_model` takes), ``"control"`` writes
     ``CONTROL = flush | clear`` after the frames, and after every segment between
     ``clear_before`` steps (:meth:`StreamSchedule.segments`; ``"control"`` only: the
-    segments restart at frame 0 as :meth:`ArrayContract.run` does). The sink follows ``ready`` from the
-    stream's first cycle; the bench then drains ``drain`` cycles with the sink ready
-    and reads every register."""
+    segments restart at frame 0 as :meth:`ArrayContract.run` does). The sink follows
+    ``ready`` from the stream's first cycle; the bench then drains ``drain`` cycles with
+    the sink ready and reads every register."""
     dut = RvsmAxisIp(contract, lanes, fifo_depth)
     sched = dut.geometry.schedule
     rm = dut.regmap

@@ -134,7 +134,7 @@ class RvsmAxisIp(wiring.Component):
     def elaborate(self, platform: object) -> Module:
         m = Module()
         c, geo, arr = self.contract, self.geometry, self.array
-        p, n, words = geo.lanes, c.adc_bits, geo.beats_per_frame
+        p, n = geo.lanes, c.adc_bits
         m.submodules.array = arr
         m.submodules.regs = regs = AxiLiteRegisters(self.regmap)
         wiring.connect(m, wiring.flipped(self.s_axil), regs.bus)
