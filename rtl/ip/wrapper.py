@@ -101,6 +101,18 @@ class RvsmAxisIp(wiring.Component):
         self.regmap: RegisterMap = ip_register_map(
             contract, self.lanes, fifo_depth, self.rtl_digest,
             design_point_digest(contract), rvsm_version())
+        #: The register file (:class:`AxiLiteRegisters`) and the output FIFO: submodules,
+        #: attributes so that a bench can observe them.
+        self.regs = AxiLiteRegisters(self.regmap)
+        layout = spike_tdata_layout(contract.num_scales, self.lanes, contract.height,
+                                    self.geometry.groups)
+        self.fifo = SyncFIFOBuffered(width=layout.size + 2, depth=fifo_depth)
+        #: Control state (threshold initialisation, flush and clear requests) and the
+        #: drop strobe, for benches and diagrams.
+        self.init = Signal(init=1, name="init")
+        self.flush_req = Signal(name="flush_req")
+        self.clear_req = Signal(name="clear_req")
+        self.drop = Signal(name="drop")
         super().__init__(self.interface(contract, self.lanes))
 
     @staticmethod
@@ -136,14 +148,12 @@ class RvsmAxisIp(wiring.Component):
         c, geo, arr = self.contract, self.geometry, self.array
         p, n = geo.lanes, c.adc_bits
         m.submodules.array = arr
-        m.submodules.regs = regs = AxiLiteRegisters(self.regmap)
+        m.submodules.regs = regs = self.regs
         wiring.connect(m, wiring.flipped(self.s_axil), regs.bus)
         layout = spike_tdata_layout(c.num_scales, p, c.height, geo.groups)
-        m.submodules.fifo = fifo = SyncFIFOBuffered(width=layout.size + 2,
-                                                    depth=self.fifo_depth)
+        m.submodules.fifo = fifo = self.fifo
 
-        init = Signal(init=1, name="init")
-        flush_req, clear_req = Signal(name="flush_req"), Signal(name="clear_req")
+        init, flush_req, clear_req = self.init, self.flush_req, self.clear_req
         flush_left = Signal(range(self.lag + 1), name="flush_left")
         drop_policy = regs.value["CONTROL.drop"]
         busy = init | flush_req | clear_req
@@ -195,7 +205,8 @@ class RvsmAxisIp(wiring.Component):
                      beat.group.eq(sp.group), beat.eof.eq(sp.last)]
         out_sof = (sp.row == 0) & (sp.group == 0)
         out_eol = sp.group == geo.groups - 1
-        drop = arr.spikes.valid & ~fifo.w_rdy
+        drop = self.drop
+        m.d.comb += drop.eq(arr.spikes.valid & ~fifo.w_rdy)
         m.d.comb += [fifo.w_en.eq(arr.spikes.valid),
                      fifo.w_data.eq(Cat(beat.as_value(), out_sof, out_eol)),
                      self.m_axis.tvalid.eq(fifo.r_rdy),

@@ -8,6 +8,7 @@ import pytest
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.flow_files import design_point_digest
+from rvsm.rtl.ip.architecture import STREAM_AXIS
 from rvsm.rtl.ip.axi_lite import RESP_OKAY, RESP_SLVERR
 from rvsm.rtl.ip.drive import (
     Cycler,
@@ -208,8 +209,8 @@ def test_slave_errors_sticky_flags_and_framing() -> None:
     assert not seen["status_after"] & overflow and seen["status_after"] & framing
 
 
-@pytest.mark.filterwarnings("ignore::amaranth.hdl._ir.UnusedElaboratable")
 def test_fifo_depth_is_checked() -> None:
     c, _, _ = _run(model="fsm")
-    with pytest.raises(RvsmError, match="fifo_depth"):
-        RvsmAxisIp(c, LANES, fifo_depth=2)
+    with pytest.raises(RvsmError, match="fifo-depth"):
+        STREAM_AXIS.check(c, lanes=LANES, fifo_depth=RvsmAxisIp.MIN_FIFO_DEPTH - 1)
+    STREAM_AXIS.check(c, lanes=LANES, fifo_depth=RvsmAxisIp.MIN_FIFO_DEPTH)
