@@ -50,3 +50,16 @@ def test_interface_errors(tmp_path: Path, capsys: pytest.CaptureFixture) -> None
                  "-o", str(tmp_path / "b")]) == 2
     assert main(["verilog", str(point), "--size", "8x8", "--interface", "axis",
                  "--fifo-depth", "2", "-o", str(tmp_path / "c")]) == 2
+
+
+def test_verify_interface_refusals(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    point = _point(tmp_path)
+    work = str(tmp_path / "work")
+    base = ["verify", "--random", "1", "--fixed", str(point), "--size", "8x8", "--steps",
+            "20", "--work", work]
+    assert main([*base, "--interface", "axis", "--arch", "parallel"]) == 2
+    assert "--interface axis verifies" in capsys.readouterr().err
+    assert main([*base, "--fifo-depth", "8"]) == 2
+    assert "--interface axis only" in capsys.readouterr().err
+    assert main(["verify", "--interface", "axis", "--work", work]) == 2
+    assert "needs SCENE" in capsys.readouterr().err

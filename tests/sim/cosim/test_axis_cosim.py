@@ -58,3 +58,18 @@ def test_stall_policy_verilator_and_wider(small_contract, cosim_work: Path,
                         lanes=4, fifo_depth=6, work_dir=cosim_work)
         _check(r)
         assert r["counters"]["OUT_BEATS"] == 3 * 16
+
+
+@pytest.mark.slow
+def test_rvsm_verify_interface_axis(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    from rvsm.sim.cli.main import main
+
+    point = tmp_path / "point.toml"
+    assert main(["config", "new", "-o", str(point)]) == 0
+    for policy in ("stall", "drop"):
+        assert main(["verify", "--interface", "axis", "--policy", policy, "--random", "3",
+                     "--fixed", str(point), "--size", "8x8", "--steps", "20", "--lanes",
+                     "2", "--fifo-depth", "6", "--idle-out", "0.6", "--work",
+                     str(tmp_path / "work")]) == 0
+        out = capsys.readouterr().out
+        assert f"{policy} policy" in out and ", 0 mismatches" in out
