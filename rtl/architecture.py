@@ -55,7 +55,10 @@ class Architecture:
     * ``testbench``: the cocotb testbench module (a name: rtl does not import sim);
     * ``formal``: formal harness factories by check name (``"properties"``,
       ``"equivalence"``): ``factory(contract, mutation=None, **options)`` returns a
-      :class:`~rvsm.rtl.formal.FormalHarness` (``rvsm formal``).
+      :class:`~rvsm.rtl.formal.FormalHarness` (``rvsm formal``);
+    * ``extra_outputs(component, provenance)``: more files for ``rvsm verilog`` beside
+      the Verilog, ``{suffix: text}`` with the suffixes of ``extra_suffixes`` (the IP's
+      register map, :mod:`rvsm.rtl.ip.architecture`).
     """
 
     name: str
@@ -73,6 +76,8 @@ class Architecture:
     compare: Callable[..., dict]
     testbench: str
     formal: Mapping[str, Callable[..., Any]] = field(default_factory=dict)
+    extra_outputs: Callable[[Any, Mapping], dict[str, str]] | None = None
+    extra_suffixes: tuple[str, ...] = ()
 
     def resolve(self, given: Mapping[str, int | None] | None = None) -> dict[str, int]:
         """The options from ``given`` (``None`` values: not given), defaults filled in;

@@ -173,7 +173,8 @@ def write_outputs(
     as :meth:`Architecture.resolve`) into ``out_dir``: the Verilog with a provenance
     header (``command``: the command line that made it, ``None`` for a library call) and
     a ``timescale``, the port map (JSON with a ``provenance`` field, Markdown), the
-    Verilator waivers, a FuseSoC core and an SDC template clocked at ``clock_mhz``.
+    Verilator waivers, a FuseSoC core and an SDC template clocked at ``clock_mhz``, and
+    the architecture's own files (:attr:`Architecture.extra_outputs`, keyed by suffix).
     Deterministic: nothing time-dependent is written."""
     a = get_architecture(arch)
     top = check_top(top or a.default_top)
@@ -192,6 +193,10 @@ def write_outputs(
     write_text_atomic(paths["waivers"], verilator_waivers(top, prov))
     write_text_atomic(paths["core"], fusesoc_core(top, prov, prov["rvsm_version"]))
     write_text_atomic(paths["sdc"], sdc_constraints(top, prov, meta["ports"], clock_mhz))
+    if a.extra_outputs is not None:
+        for suffix, text in a.extra_outputs(dut, prov).items():
+            paths[suffix] = out / f"{top}{suffix}"
+            write_text_atomic(paths[suffix], text)
     return paths, gen
 
 

@@ -9,6 +9,7 @@ import shlex
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures import ARCHITECTURES, DEFAULT_ARCHITECTURE
 from rvsm.rtl.flow_files import DEFAULT_CLOCK_MHZ
+from rvsm.rtl.ip.architecture import INTERFACES, STREAM_AXIS, interface_architecture
 from rvsm.sim.cli.args import (
     SceneRequest,
     add_force_argument,
@@ -34,6 +35,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                        f"{a.default_top} for {a.name}" for a in ARCHITECTURES.values())
                    + ")")
     add_arch_arguments(p)
+    p.add_argument("--interface", choices=INTERFACES, default="native",
+                   help="native (default): the bare array's ports; axis: the streaming "
+                   "array as IP, AXI4-Stream video in and spikes out, AXI4-Lite "
+                   "registers, plus <top>.regs.md/.json/.h (docs/ip.md)")
+    p.add_argument("--fifo-depth", type=int, metavar="BEATS",
+                   help="--interface axis: output FIFO depth in beats (default "
+                   f"{STREAM_AXIS.options[-1].default})")
     p.add_argument("--lint", action="store_true",
                    help="lint the written files as a user would: verilator --lint-only "
                    "-Wall with the shipped <top>.vlt only, and iverilog -g2005 and -g2012 "
@@ -99,6 +107,23 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "in and keep the run's coverage.dat (docs/regressions.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_arch_arguments(p)
+    p.add_argument("--interface", choices=INTERFACES, default="native",
+                   help="axis: verify the AXI IP (rvsm verilog --interface axis) with "
+                   "cocotbext-axi under random idle cycles and back-pressure (docs/ip.md); "
+                   "with SCENE, --stimulus or --random")
+    p.add_argument("--fifo-depth", type=int, metavar="BEATS",
+                   help="--interface axis: output FIFO depth (default "
+                   f"{STREAM_AXIS.options[-1].default})")
+    p.add_argument("--policy", choices=("stall", "drop"), default="stall",
+                   help="--interface axis: output policy; drop streams without clears and "
+                   "checks the drops against the IP's cycle model (default stall)")
+    p.add_argument("--idle-in", type=float, default=0.3, metavar="P",
+                   help="--interface axis: probability of an idle source cycle (default 0.3)")
+    p.add_argument("--idle-out", type=float, default=0.3, metavar="P",
+                   help="--interface axis: probability of sink back-pressure per cycle "
+                   "(default 0.3)")
+    p.add_argument("--pause-seed", type=int, default=1, metavar="SEED",
+                   help="--interface axis: seed of the pause generators (default 1)")
     p.set_defaults(func=_verify)
 
 
@@ -136,20 +161,27 @@ def _verilog(args: argparse.Namespace) -> int:
         yosys_stats,
     )
 
-    arch = ARCHITECTURES[args.arch]
+    base = ARCHITECTURES[args.arch]
     options = arch_options(args)
     if not args.clock_mhz > 0:
         raise RvsmError(f"--clock-mhz must be > 0, got {args.clock_mhz:g}")
-    _, contract = sized_contract(args.point, args.size, arch, options)
+    _, contract = sized_contract(args.point, args.size, base, options)
+    arch = interface_architecture(base, args.interface)
+    if args.fifo_depth is not None and args.interface != "axis":
+        raise RvsmError("--fifo-depth applies to --interface axis only")
+    options = arch.resolve({**options, **({"fifo_depth": args.fifo_depth}
+                                          if arch is STREAM_AXIS else {})})
+    arch.check(contract, **options)
     args.top = args.top or arch.default_top
-    files = tuple((f"{args.top}{ext}", PLAIN) for ext in OUTPUT_SUFFIXES.values())
+    suffixes = (*OUTPUT_SUFFIXES.values(), *arch.extra_suffixes)
+    files = tuple((f"{args.top}{ext}", PLAIN) for ext in suffixes)
     check_outputs([Output(args.out, "-o", FOLDER, files)], [args.point], args.force)
     paths, gen = write_outputs(contract, args.out, arch, args.top,
                                command=getattr(args, "command_line", None),
                                clock_mhz=args.clock_mhz, **options)
     print(f"wrote {paths['verilog']} ({gen.seconds:.1f} s), "
           + ", ".join(str(p) for k, p in paths.items() if k != "verilog")
-          + f"; {_arch_text(args.arch, options)}, latency {gen.latency} cycle(s)")
+          + f"; {_arch_text(arch.name, options)}, latency {gen.latency} cycle(s)")
     if args.lint:
         verilator_lint(paths["verilog"], args.top)
         print(f"verilator --lint-only -Wall {args.top}.vlt {args.top}.v: clean")
@@ -201,6 +233,72 @@ def _check_generated(args: argparse.Namespace) -> None:
                         f"e.g. {flag} 1 --fixed point.toml --size 16x16 --steps 40")
 
 
+def _axis_stimulus(args: argparse.Namespace, options: dict[str, int]):  # noqa: ANN202
+    """The stimulus of ``rvsm verify --interface axis``: a file, a seeded corner stimulus
+    or a scene through the fixed twin; for the drop policy without its clears (the
+    expectation recomputed)."""
+    import numpy as np
+
+    from rvsm.model.fixed.point_toml import load_design_point
+    from rvsm.model.fixed.stimulus import Stimulus, make_stimulus, open_stimulus
+
+    if args.stimulus:
+        stim = open_stimulus(args.stimulus)
+        stim = (stim.first_steps(args.steps) if args.steps else stim).loaded()
+    elif args.random is not None:
+        from rvsm.model.fixed.corner_stimulus import corner_stimulus
+
+        _check_generated(args)
+        point = load_design_point(args.fixed).with_size(*parse_size_arg(args.size))
+        stim = corner_stimulus(point.contract(), args.random, args.steps)
+    elif args.scene is not None and args.fixed is not None:
+        point, scene = SceneRequest.from_args(args).load_for_point(
+            load_design_point(args.fixed))
+        stim = make_stimulus(scene, point, num_steps=args.steps)
+    else:
+        raise RvsmError("rvsm verify --interface axis needs SCENE --fixed POINT.toml, "
+                        "--stimulus FILE or --random SEED --fixed POINT.toml")
+    if args.policy == "drop" and stim.clear_before:
+        c = stim.contract
+        stim = Stimulus(stim.codes, stim.thresholds,
+                        c.run(np.asarray(stim.codes), stim.thresholds).astype(np.int8), c)
+    return stim
+
+
+def _verify_axis(args: argparse.Namespace, options: dict[str, int]) -> int:
+    """``rvsm verify --interface axis``: the IP through cocotbext-axi (docs/ip.md)."""
+    from rvsm.sim.cosim.axis_run import axis_verify
+
+    bad = [n for n, v in (("--protocol", args.protocol), ("--code-coverage",
+                                                          args.code_coverage),
+                          ("--recompute-expected", args.recompute_expected)) if v]
+    if args.arch != "stream" or args.harness == "chunk" or bad:
+        raise RvsmError("--interface axis verifies the streaming array's IP cycle by "
+                        "cycle: use --arch stream, no --harness chunk"
+                        + (f", no {', '.join(bad)}" if bad else ""))
+    stim = _axis_stimulus(args, options)
+    r = axis_verify(stim, args.sim, args.policy, args.pause_seed, args.idle_in,
+                    args.idle_out, lanes=options["lanes"], fifo_depth=args.fifo_depth,
+                    work_dir=args.work, waves=args.waves)
+    if args.json:
+        r = dict(r)
+        r["mismatch_list"] = r.get("mismatch_list", [])[:10]
+        print(json.dumps(r))
+    else:
+        c = r["counters"]
+        print(f"{args.sim}, {_arch_text(r['arch'], r['options'])}, {args.policy} policy "
+              f"(idle in {args.idle_in:g}, back-pressure {args.idle_out:g}): "
+              f"{c['IN_BEATS']} beats in, {c['OUT_BEATS']} out, {c['DROPPED']} dropped; "
+              f"{r['compared']} spikes compared, {r['mismatches']} mismatches")
+        if r["mismatches"]:
+            f = r["first_mismatch"] or {}
+            print("first mismatch: " + ", ".join(f"{k}={v}" for k, v in f.items()))
+        if r["waves"]:
+            print(f"waveform kept: {r['waves']}")
+        print(f"run folder: {r['run_dir']}")
+    return 1 if r["mismatches"] else 0
+
+
 def _verify(args: argparse.Namespace) -> int:
     from rvsm.rtl.stream.protocol import protocol_summary
     from rvsm.sim.cosim.protocol_run import protocol_verify
@@ -211,6 +309,10 @@ def _verify(args: argparse.Namespace) -> int:
     if args.steps is not None and args.steps < 1:
         raise RvsmError(f"--steps must be >= 1, got {args.steps}")
     arch, options = args.arch, arch_options(args)
+    if args.interface == "axis":
+        return _verify_axis(args, options)
+    if args.fifo_depth is not None:
+        raise RvsmError("--fifo-depth applies to --interface axis only")
     if args.chunk_steps < 1:
         raise RvsmError(f"--chunk-steps must be >= 1, got {args.chunk_steps}")
     long_run = {"harness": args.harness}

@@ -1,0 +1,106 @@
+"""The cycle-level model of :class:`~rvsm.rtl.ip.wrapper.RvsmAxisIp`'s streams.
+
+Given the input-valid pattern (the source offers its next beat in cycle ``c`` when
+``valid[c]``), the output-ready pattern (``ready[c]``), the policy and the FIFO depth,
+:func:`run_stream_model` gives, cycle by cycle, what the IP does from a quiet start
+(FIFO empty, nothing in flight, no clear since the stream's first beat): the cycle each
+input beat is accepted, the output beats delivered (by position, the twin's beat index)
+with the cycle of their ``m_axis`` handshake, and the positions dropped. The
+twin's spikes of each position come from :meth:`ArrayContract.run` through
+:class:`~rvsm.rtl.stream.schedule.StreamSchedule`; the model only says which beats
+arrive and when, so its invariants are simple: delivered positions are increasing and
+disjoint from the dropped ones, delivered + dropped = released, and under the stall
+policy nothing is dropped.
+
+The rules it states (module docstring of :mod:`rvsm.rtl.ip.wrapper`): input beat ``k``
+accepted at the edge ending cycle ``c`` releases position ``k - lag`` (if ``k >= lag``),
+which reaches the FIFO in cycle ``c + 2``; ``tready = drop or level + r1 + v <
+fifo_depth``; the FIFO is Amaranth's ``SyncFIFOBuffered`` (``depth - 1`` words of
+memory and an output register; ``w_rdy`` = memory not full; ``m_axis_tvalid`` = the
+output register is full).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["StreamOutcome", "pause_pattern", "run_stream_model"]
+
+
+@dataclass(frozen=True)
+class StreamOutcome:
+    """What the IP does with a stream: ``accepted[k]`` the cycle input beat ``k`` was
+    accepted in; ``delivered`` positions in output order and ``sent`` the cycle of each
+    one's handshake; ``dropped`` positions; ``cycles`` until the last output left."""
+
+    accepted: np.ndarray
+    delivered: np.ndarray
+    sent: np.ndarray
+    dropped: np.ndarray
+    cycles: int
+
+
+def pause_pattern(cycles: int, busy: float, seed: int) -> np.ndarray:
+    """``cycles`` booleans, each ``False`` (a pause) with probability ``busy``."""
+    return np.random.default_rng(seed).random(cycles) >= busy
+
+
+def run_stream_model(beats: int, lag: int, fifo_depth: int, drop: bool,
+                     valid: Sequence[bool], ready: Sequence[bool],
+                     max_cycles: int = 1 << 22) -> StreamOutcome:
+    """Stream ``beats`` input beats (any flush beats included) through the IP.
+
+    ``valid``/``ready`` give the source's and the sink's pattern per cycle (beyond
+    their end: always valid, always ready). Runs until every input beat is accepted
+    and every released output has been delivered or dropped.
+    """
+    def at(pattern: Sequence[bool], c: int) -> bool:
+        return bool(pattern[c]) if c < len(pattern) else True
+
+    inner: deque[int] = deque()  # the FIFO's memory (positions)
+    out_reg: int | None = None  # the FIFO's output register
+    r1: int | None = None  # beat accepted in the previous cycle (its position or -1)
+    v: int | None = None  # position the array presents this cycle
+    k = 0
+    accepted, delivered, sent, dropped = [], [], [], []
+    released = max(0, beats - lag)
+    c = 0
+    while k < beats or r1 is not None or v is not None or inner or out_reg is not None:
+        if c >= max_cycles:
+            raise RuntimeError(f"the stream did not finish within {max_cycles} cycles")
+        level = len(inner) + (out_reg is not None)
+        tready = drop or level + (r1 is not None) + (v is not None) < fifo_depth
+        fire = k < beats and at(valid, c) and tready
+        r_en = at(ready, c)
+        w_rdy = len(inner) != fifo_depth - 1
+        if out_reg is not None and r_en:
+            delivered.append(out_reg)
+            sent.append(c)
+            out_reg = None
+        # the edge: the FIFO's output register takes the memory's head when it is empty
+        # or read in this cycle (using the memory's level before this cycle's write)
+        take = bool(inner) and out_reg is None
+        if v is not None:
+            if w_rdy:
+                inner.append(v)
+            else:
+                dropped.append(v)
+        if take:
+            out_reg = inner.popleft()
+        v = r1
+        r1 = None
+        if fire:
+            accepted.append(c)
+            r1 = k - lag if k >= lag else -1
+            k += 1
+        if v is not None and v < 0:
+            v = None
+        c += 1
+    if len(delivered) + len(dropped) != released:
+        raise AssertionError("model lost a beat")
+    return StreamOutcome(np.asarray(accepted), np.asarray(delivered, dtype=np.int64),
+                         np.asarray(sent), np.asarray(dropped, dtype=np.int64), c)

@@ -1,0 +1,257 @@
+"""The streaming array as AXI IP: :class:`RvsmAxisIp` (docs/ip.md).
+
+One clock domain ``sync`` (synchronous reset ``rst``)::
+
+    s_axis (video: P codes/beat, tuser = start of frame, tlast = end of line)
+      -> input gate: tready = ~busy & (drop policy | credit)     [framing check]
+      -> RvsmStreamArray (codes, clear, thr)  <- flush beats, clear, threshold writes
+      -> spikes beat (+ tuser, tlast) -> SyncFIFOBuffered(fifo_depth) -> m_axis
+    s_axil -> AxiLiteRegisters(ip_register_map) <-> control, status, counters, THR_*
+
+**Policies** (``CONTROL.drop``). *Stall* (0, the reset value; replay from memory): the
+array has no output back-pressure and an output beat appears two cycles after the
+input beat that releases it, so the input is gated by credits, never by the FIFO's
+fullness: ``tready`` is high only while ``level + r1 + v < fifo_depth`` (``level`` the
+FIFO's beats, ``r1`` a beat accepted in the previous cycle, ``v`` the array's output
+this cycle). Every beat in flight then finds room: no beat is lost, whatever the sink
+does. *Drop* (1; a live sensor, which cannot stall): ``tready`` stays high (except
+while busy); an output beat that reaches the FIFO while it is full (``w_rdy`` low: the
+FIFO holds ``fifo_depth`` beats) is dropped whole, ``STATUS.overflow`` is set and
+``DROPPED`` counts it. The cycle model :mod:`rvsm.rtl.ip.model` gives the exact drops
+for an input-valid and output-ready pattern.
+
+**Reset.** After ``rst`` the IP writes the top rail ``2**(W-1)-1`` into every threshold
+word, one word per cycle (``S*H*G`` cycles, ``STATUS.init`` and ``busy`` high, input
+``tready`` low, threshold commits refused): the thresholds then have the same defined
+value after every reset as after configuration, on any memory technology (a block
+RAM's initial contents are an FPGA feature; an ASIC SRAM has none). Load the thresholds
+after ``STATUS.init`` falls.
+
+**Flush and clear.** ``CONTROL.flush`` inserts ``lag`` zero beats (input ``tready``
+low meanwhile), so every accepted beat's output comes out; ``CONTROL.clear`` restarts
+the stream at frame 0 (accumulators zero in the next frame, thresholds kept). Written
+together, the flush comes first: ``CONTROL = flush | clear`` ends a stream and starts
+the next. Flush beats count as the next frame's beats, so clear after a flush before
+sending a new frame.
+"""
+
+from __future__ import annotations
+
+from amaranth.hdl import Cat, Module, Mux, Signal
+from amaranth.lib import wiring
+from amaranth.lib.fifo import SyncFIFOBuffered
+from amaranth.lib.wiring import In, Out
+
+from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.infra.errors import RvsmError
+from rvsm.model.infra.versions import rvsm_version
+from rvsm.rtl.digest import rtl_digest
+from rvsm.rtl.flow_files import design_point_digest
+from rvsm.rtl.ip.axi_lite import AxiLiteRegisters, AxiLiteSignature
+from rvsm.rtl.ip.axis import AxiStreamSignature, spike_tdata_layout, video_lane_bits
+from rvsm.rtl.ip.register_map import ADDR_BITS, RegisterMap, ip_register_map
+from rvsm.rtl.stream.array import RvsmStreamArray
+from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.signatures import top_threshold_word
+
+__all__ = ["IP_ARCH", "RvsmAxisIp"]
+
+#: The architecture name of the IP in provenance, digests and ``ports.json``.
+IP_ARCH = "stream_axis"
+
+
+class RvsmAxisIp(wiring.Component):
+    """The streaming array behind AXI4-Stream video in, AXI4-Stream spikes out and
+    AXI4-Lite registers (see the module docstring).
+
+    Members: ``s_axis`` In(:class:`AxiStreamSignature`), ``m_axis``
+    Out(:class:`AxiStreamSignature`), ``s_axil`` In(:class:`AxiLiteSignature`); Verilog
+    ports ``s_axis_tdata`` ... ``s_axil_rready`` plus ``clk`` and ``rst``. ``regmap`` is
+    the register map (:func:`ip_register_map`); timing in :attr:`geometry` and the
+    properties below.
+    """
+
+    #: Smallest output FIFO (beats): the credit rule needs room for the 3 beats that
+    #: can be in flight between the input gate and the FIFO.
+    MIN_FIFO_DEPTH = 4
+    #: Smallest output FIFO that takes a beat every cycle while the sink is always ready
+    #: (two beats in the FIFO, one in the array's output, one accepted the cycle before).
+    FULL_RATE_DEPTH = 5
+    #: Default output FIFO depth (beats).
+    FIFO_DEPTH = 16
+    #: Cycles from the edge accepting a releasing input beat to the cycle its output is
+    #: offered on ``m_axis`` (FIFO empty): the array's input and output registers (2),
+    #: the FIFO write (1) and the FIFO's output register (1).
+    RELEASE_CYCLES = 4
+
+    def __init__(self, contract: ArrayContract, lanes: int = 1,
+                 fifo_depth: int = FIFO_DEPTH):
+        if not isinstance(fifo_depth, int) or not \
+                self.MIN_FIFO_DEPTH <= fifo_depth < 1 << 16:
+            raise RvsmError(f"fifo_depth must be an integer from {self.MIN_FIFO_DEPTH} to "
+                            f"65535, got {fifo_depth!r}")
+        self.array = RvsmStreamArray(contract, lanes)
+        self.contract = contract
+        self.geometry: StreamGeometry = self.array.geometry
+        self.lanes = self.geometry.lanes
+        self.fifo_depth = fifo_depth
+        #: The options that build this IP (provenance, digest).
+        self.options = {"lanes": self.lanes, "fifo_depth": fifo_depth}
+        self.rtl_digest = rtl_digest(contract, IP_ARCH, self.options)
+        self.regmap: RegisterMap = ip_register_map(
+            contract, self.lanes, fifo_depth, self.rtl_digest,
+            design_point_digest(contract), rvsm_version())
+        #: The register file (:class:`AxiLiteRegisters`) and the output FIFO: submodules,
+        #: attributes so that a bench can observe them.
+        self.regs = AxiLiteRegisters(self.regmap)
+        layout = spike_tdata_layout(contract.num_scales, self.lanes, contract.height,
+                                    self.geometry.groups)
+        self.fifo = SyncFIFOBuffered(width=layout.size + 2, depth=fifo_depth)
+        #: Control state (threshold initialisation, flush and clear requests) and the
+        #: drop strobe, for benches and diagrams.
+        self.init = Signal(init=1, name="init")
+        self.flush_req = Signal(name="flush_req")
+        self.clear_req = Signal(name="clear_req")
+        self.drop = Signal(name="drop")
+        super().__init__(self.interface(contract, self.lanes))
+
+    @staticmethod
+    def interface(contract: ArrayContract, lanes: int) -> wiring.Signature:
+        """The IP's signature for ``contract`` and ``lanes``."""
+        c, geo = contract, StreamGeometry(contract, lanes)
+        out = spike_tdata_layout(c.num_scales, geo.lanes, c.height, geo.groups)
+        return wiring.Signature({
+            "s_axis": In(AxiStreamSignature(geo.lanes * video_lane_bits(c.adc_bits))),
+            "m_axis": Out(AxiStreamSignature(out.size)),
+            "s_axil": In(AxiLiteSignature(ADDR_BITS)),
+        })
+
+    @property
+    def lag(self) -> int:
+        """Output ``p`` is released by input beat ``p + lag`` (beats; the array's)."""
+        return self.geometry.lag
+
+    @property
+    def latency(self) -> int:
+        """Cycles from the edge accepting beat ``p + window_lag`` to ``p``'s output on
+        ``m_axis`` (beats back to back, FIFO empty): the array's latency plus the FIFO's
+        two cycles."""
+        return self.geometry.latency + self.RELEASE_CYCLES - 2
+
+    @property
+    def init_cycles(self) -> int:
+        """Cycles after ``rst`` during which the thresholds are set (``S*H*G``)."""
+        return self.contract.num_scales * self.geometry.beats_per_frame
+
+    def elaborate(self, platform: object) -> Module:
+        m = Module()
+        c, geo, arr = self.contract, self.geometry, self.array
+        p, n = geo.lanes, c.adc_bits
+        m.submodules.array = arr
+        m.submodules.regs = regs = self.regs
+        wiring.connect(m, wiring.flipped(self.s_axil), regs.bus)
+        layout = spike_tdata_layout(c.num_scales, p, c.height, geo.groups)
+        m.submodules.fifo = fifo = self.fifo
+
+        init, flush_req, clear_req = self.init, self.flush_req, self.clear_req
+        flush_left = Signal(range(self.lag + 1), name="flush_left")
+        drop_policy = regs.value["CONTROL.drop"]
+        busy = init | flush_req | clear_req
+        r1 = Signal(name="accepted_r1")  # a beat entered the array in the previous cycle
+        credit = drop_policy | (fifo.level + r1 + arr.spikes.valid < self.fifo_depth)
+        s_in = self.s_axis
+        m.d.comb += s_in.tready.eq(~busy & credit)
+        fire = s_in.tvalid & s_in.tready
+        inject = ~init & flush_req & credit
+        clear_now = ~init & ~flush_req & clear_req
+        lane_bits = video_lane_bits(n)
+        codes = Cat(*(s_in.tdata[i * lane_bits:i * lane_bits + n] for i in range(p)))
+        m.d.comb += [arr.codes.valid.eq(fire | inject),
+                     arr.codes.payload.as_value().eq(Mux(inject, 0, codes)),
+                     arr.clear.eq(clear_now)]
+        m.d.sync += r1.eq(fire | inject)
+
+        # flush and clear requests (CONTROL pulses, the cycle after the write)
+        with m.If(regs.pulse["CONTROL.flush"] & ~flush_req):
+            m.d.sync += [flush_req.eq(1), flush_left.eq(self.lag)]
+        with m.If(inject):
+            m.d.sync += flush_left.eq(flush_left - 1)
+            with m.If(flush_left == 1):
+                m.d.sync += flush_req.eq(0)
+        with m.If(regs.pulse["CONTROL.clear"]):
+            m.d.sync += clear_req.eq(1)
+        with m.If(clear_now):
+            m.d.sync += clear_req.eq(0)
+
+        # input position: framing check of tuser (start of frame) and tlast (end of line)
+        in_g = Signal(range(geo.groups), name="in_group")
+        in_y = Signal(range(c.height), name="in_row")
+        g_end = in_g == geo.groups - 1
+        with m.If(clear_now):
+            m.d.sync += [in_g.eq(0), in_y.eq(0)]
+        with m.Elif(arr.codes.valid):
+            m.d.sync += [in_g.eq(Mux(g_end, 0, in_g + 1)),
+                         in_y.eq(Mux(g_end, Mux(in_y == c.height - 1, 0, in_y + 1), in_y))]
+        sof = (in_g == 0) & (in_y == 0)
+        m.d.comb += regs.set["STATUS.framing"].eq(
+            fire & ((s_in.tuser != sof) | (s_in.tlast != g_end)))
+
+        self._thresholds(m, regs, init)
+
+        # output: spikes beat -> FIFO -> m_axis
+        sp = arr.spikes.payload
+        beat = Signal(layout, name="out_beat")
+        m.d.comb += [beat.pos.eq(sp.pos), beat.neg.eq(sp.neg), beat.row.eq(sp.row),
+                     beat.group.eq(sp.group), beat.eof.eq(sp.last)]
+        out_sof = (sp.row == 0) & (sp.group == 0)
+        out_eol = sp.group == geo.groups - 1
+        drop = self.drop
+        m.d.comb += drop.eq(arr.spikes.valid & ~fifo.w_rdy)
+        m.d.comb += [fifo.w_en.eq(arr.spikes.valid),
+                     fifo.w_data.eq(Cat(beat.as_value(), out_sof, out_eol)),
+                     self.m_axis.tvalid.eq(fifo.r_rdy),
+                     self.m_axis.tdata.eq(fifo.r_data[:layout.size]),
+                     self.m_axis.tuser.eq(fifo.r_data[layout.size]),
+                     self.m_axis.tlast.eq(fifo.r_data[layout.size + 1]),
+                     fifo.r_en.eq(self.m_axis.tready),
+                     regs.set["STATUS.overflow"].eq(drop)]
+
+        # counters and status
+        sent = self.m_axis.tvalid & self.m_axis.tready
+        for name, event in (("IN_BEATS", fire), ("OUT_BEATS", sent), ("DROPPED", drop)):
+            count = regs.value[f"{name}.count"]
+            with m.If(regs.pulse["CONTROL.counters_reset"]):
+                m.d.sync += count.eq(0)
+            with m.Elif(event):
+                m.d.sync += count.eq(count + 1)
+        m.d.comb += [regs.value["STATUS.init"].eq(init),
+                     regs.value["STATUS.flushing"].eq(flush_req),
+                     regs.value["STATUS.busy"].eq(busy),
+                     regs.value["STATUS.fifo_level"].eq(fifo.level)]
+        return m
+
+    def _thresholds(self, m: Module, regs: AxiLiteRegisters, init: Signal) -> None:
+        """THR_ADDR (auto-incrementing), the commit of THR_DATA chunks, and the walk
+        that sets every threshold word to the top rail after reset."""
+        c, geo, arr, rm = self.contract, self.geometry, self.array, self.regmap
+        word = regs.value["THR_ADDR.word"]
+        scale = regs.value["THR_ADDR.scale"]
+        last_word = word == geo.beats_per_frame - 1
+        last_scale = scale == c.num_scales - 1
+        chunks = [regs.value[f"{r.name}.data"] for r in rm.thr_data_registers()]
+        commit = regs.written[rm.thr_data_registers()[-1].name]
+        for name in ("THR_ADDR", rm.thr_data_registers()[-1].name):
+            m.d.comb += regs.refuse[name].eq(init)
+        step = init | commit
+        m.d.comb += [arr.thr.we.eq(step), arr.thr.addr.eq(Cat(word, scale)),
+                     arr.thr.data.eq(Mux(init, top_threshold_word(c.threshold_bits,
+                                                                   geo.lanes),
+                                         Cat(*chunks)[:len(arr.thr.data)]))]
+        with m.If(step):
+            m.d.sync += [word.eq(Mux(last_word, 0, word + 1)),
+                         scale.eq(Mux(last_word, Mux(last_scale, 0, scale + 1), scale))]
+            with m.If(last_word & last_scale):
+                m.d.sync += init.eq(0)
+        with m.Elif(regs.written["THR_ADDR"]):
+            m.d.sync += [word.eq(regs.wdata[:len(word)]),
+                         scale.eq(regs.wdata[16:16 + len(scale)])]

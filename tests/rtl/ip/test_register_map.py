@@ -1,0 +1,69 @@
+"""The IP's register map: one declaration, its Markdown, JSON and C header."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.ip.register_map import (
+    ID_MAGIC,
+    ip_register_map,
+    pack_version,
+    regs_c_header,
+    regs_json,
+    regs_markdown,
+)
+from tests.conftest import model_contract
+
+
+def _map(lanes: int = 2, model: str = "dog4"):  # noqa: ANN202
+    c = model_contract(model, 4, 8)
+    return c, ip_register_map(c, lanes, 16, "0123456789abcdef", "fedcba9876543210", "1.2.3")
+
+
+def test_constants_and_packing() -> None:
+    c, rm = _map()
+    assert rm["ID"].reset == ID_MAGIC
+    assert rm["VERSION"].reset == pack_version("1.2.3") == 0x010203
+    assert pack_version("0.1.dev3") == 0
+    assert rm["DIGEST_RTL"].reset == 0x01234567
+    assert rm["GEOMETRY0"].reset == c.height | c.width << 16
+    assert rm.thr_chunks == -(-2 * c.threshold_bits // 32)
+    assert [r.commit for r in rm.thr_data_registers()] == [False] * (rm.thr_chunks - 1) + [True]
+    assert rm.field("THR_ADDR", "word").max == 4 * 8 // 2 - 1
+    assert rm.field("THR_ADDR", "scale").max == c.num_scales - 1
+    assert rm["CONTROL"].access == "mixed" and rm["ID"].access == "RO"
+
+
+def test_too_many_lanes_for_the_window_is_refused() -> None:
+    c = model_contract("fsm", 8, 4096, acc_bits=30)  # 2048 x 29 bits: 1856 chunks
+    with pytest.raises(RvsmError, match="data registers"):
+        ip_register_map(c, 2048, 16, "0" * 16, "0" * 16, "0.1.0")
+
+
+def test_markdown_json_header_agree(tmp_path: Path) -> None:
+    _, rm = _map()
+    md = regs_markdown(rm, "ip")
+    data = json.loads(regs_json(rm, {"top": "ip"}))
+    header = regs_c_header(rm, "ip")
+    for r in rm.registers:
+        assert f"| 0x{r.offset:03X} | `{r.name}` |" in md
+        assert f"#define IP_{r.name}_OFFSET 0x{r.offset:03X}u" in header
+    by_name = {r["name"]: r for r in data["registers"]}
+    assert by_name["STATUS"]["offset"] == rm["STATUS"].offset
+    assert {f["name"] for f in by_name["STATUS"]["fields"]} == \
+        {f.name for f in rm["STATUS"].fields}
+    assert header.startswith("#ifndef IP_REGS_H\n#define IP_REGS_H\n")
+    if shutil.which("gcc"):
+        src = tmp_path / "use.c"
+        (tmp_path / "ip.regs.h").write_text(header)
+        src.write_text('#include "ip.regs.h"\n#include "ip.regs.h"\n'
+                       "unsigned f(void) { return IP_STATUS_OVERFLOW_MASK | "
+                       "IP_THR_DATA0_OFFSET; }\n")
+        subprocess.run(["gcc", "-Wall", "-Wextra", "-Werror", "-c", "-o",
+                        str(tmp_path / "use.o"), str(src)], check=True)
