@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 import shlex
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures import ARCHITECTURES, DEFAULT_ARCHITECTURE
@@ -19,6 +21,9 @@ from rvsm.sim.cli.args import (
 )
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.cosim import SIMULATORS
+
+if TYPE_CHECKING:
+    from rvsm.rtl.verilog import GeneratedVerilog
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -181,7 +186,7 @@ def _verilog(args: argparse.Namespace) -> int:
                                clock_mhz=args.clock_mhz, **options)
     print(f"wrote {paths['verilog']} ({gen.seconds:.1f} s), "
           + ", ".join(str(p) for k, p in paths.items() if k != "verilog")
-          + f"; {_arch_text(arch.name, options)}, latency {gen.latency} cycle(s)")
+          + f"; {_arch_text(arch.name, options)}, {_timing_text(paths['ports_json'], gen)}")
     if args.lint:
         verilator_lint(paths["verilog"], args.top)
         print(f"verilator --lint-only -Wall {args.top}.vlt {args.top}.v: clean")
@@ -194,6 +199,19 @@ def _verilog(args: argparse.Namespace) -> int:
               f"({st['cells'] / pixels:.1f} cells, {st['flip_flops'] / pixels:.1f} FFs "
               f"per pixel; {st['seconds']:.1f} s)")
     return 0
+
+
+def _timing_text(ports_json: Path, gen: GeneratedVerilog) -> str:
+    """What a user needs of the timing: for a streaming build the lag (input beats from a
+    pixel's beat to the beat releasing its spikes) and the pixel-to-spike delay back to
+    back, else the latency in cycles (``ports.json`` has every figure)."""
+    timing = json.loads(Path(ports_json).read_text()).get("timing", {})
+    if "lag" not in timing:
+        return f"latency {gen.latency} cycle(s)"
+    lag, release = timing["lag"], timing.get("release_cycles", 2)
+    return (f"lag {lag} beats (the spikes of input beat p come out {release} cycles after "
+            f"beat p + {lag} is accepted: {lag + release - 1} cycles after beat p when "
+            f"beats come back to back; the port map has every figure)")
 
 
 def _arch_text(name: str, options: dict[str, int]) -> str:

@@ -126,9 +126,13 @@ def test_every_command_defaults_to_the_stream_array_and_names_it(
     point = tmp_path / "p.toml"
     save_design_point(point, replace(default_design_point().with_size(4, 6), model="fsm"))
     assert main(["verilog", str(point), "-o", str(tmp_path / "out")]) == 0
-    assert "architecture stream (lanes 1)" in capsys.readouterr().out
+    printed = capsys.readouterr().out
     meta = json.loads((tmp_path / "out" / "rvsm_stream_array.ports.json").read_text())
     assert meta["arch"] == "stream"
+    lag = meta["timing"]["lag"]
+    assert "architecture stream (lanes 1)" in printed
+    assert (f"lag {lag} beats (the spikes of input beat p come out 2 cycles after beat "
+            f"p + {lag} is accepted: {lag + 1} cycles after beat p") in printed
     assert main(["verilog", str(point), "-o", str(tmp_path / "par"), "--arch",
                  "parallel"]) == 0
     assert "architecture parallel," in capsys.readouterr().out
