@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Write ``model/sampling/orbit_kernels.py``: the per-half-width orbit sums, unrolled for numba.
+"""Write ``model/sampling/orbit_kernels.py``: the per-half-width orbit sums and the ladder
+sums (every scale of a ``1..S`` ladder in one pass), unrolled for numba.
 
 Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
 ``model/kernels/orbits.py``; ``tests/model/sampling/test_fused.py`` checks the file is up to date.
@@ -20,6 +21,12 @@ operations in the same order as :func:`rvsm.model.kernels.orbits.orbit_receptive
 starts at ``w[0] - w[0]``, i.e. 0 of the weights' type, so the same code sums integers
 exactly for the fixed twin). The weighted sum stays in a register, so the loop over
 ``x`` vectorises.
+
+``ladder_sum_S(pairs, pr, w, width, out, orb)``: ``out[s, x]`` for every scale ``s`` of
+a ladder of half-widths ``1..S`` (weights ``w (S, N)``): each orbit is formed once into
+``orb (N, W)`` and added to every scale that uses it, each scale's sum in its own order,
+so every ``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and
+additions.
 """
 
 from numba import njit
@@ -69,7 +76,34 @@ def generate() -> str:
         for n, e in enumerate(exprs):
             out.append(f"        t = t + w[{n}] * {e}")
         out.append("        out[x] = t")
+    for scales in range(1, MAX_HALF + 1):
+        out += ["", ""] + ladder_sum(scales)
     return "\n".join(out).rstrip("\n") + "\n"
+
+
+def ladder_sum(scales: int) -> list[str]:
+    """The lines of ``ladder_sum_S`` for the ladder of half-widths ``1..S``: one loop per
+    orbit into ``orb``, then one loop over every scale (one loop forming the orbits and
+    summing all scales has too many possibly aliasing rows for LLVM to vectorise it)."""
+    orbits = [(a, b) for a in range(scales + 1) for b in range(a + 1)]
+    lines = ['@njit(inline="always", cache=True)',
+             f"def ladder_sum_{scales}(pairs, pr, w, width, out, orb):"]
+    for n, (a, b) in enumerate(orbits):
+        expr, rows = orbit_expr(a, b)
+        for pb, d in sorted(rows):
+            lines.append(f"    {_row(pb, d)} = pairs[{pb}, pr {'-' if d < 0 else '+'} {abs(d)}]")
+        lines += [f"    o{n} = orb[{n}]", "    for x in range(width):", f"        o{n}[x] = {expr}"]
+    for s in range(scales):
+        lines.append(f"    out{s} = out[{s}]")
+        lines += [f"    w{s}_{n} = w[{s}, {n}]" for n in range((s + 2) * (s + 3) // 2)]
+    lines.append("    for x in range(width):")
+    lines += [f"        t{s} = w0_0 - w0_0" for s in range(scales)]
+    for n in range(len(orbits)):
+        lines.append(f"        o = o{n}[x]")
+        lines += [f"        t{s} = t{s} + w{s}_{n} * o" for s in range(scales)
+                  if n < (s + 2) * (s + 3) // 2]
+    lines += [f"        out{s}[x] = t{s}" for s in range(scales)]
+    return lines
 
 
 def main() -> None:

@@ -17,16 +17,15 @@ height, chunk length and thread count.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit, prange
 
 from rvsm.model.events.config import EventConfig
+from rvsm.model.events.log_intensity import log_intensity_value
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, normal_row
 from rvsm.model.sampling.fused import chunk_frames, dark_current_stream
-from rvsm.model.sampling.row_sums import row_pairs, scale_sum
+from rvsm.model.sampling.row_sums import is_ladder, ladder_sum, row_pairs, scale_sum
 from rvsm.model.scene.scene import Scene
 
 __all__ = ["DEFAULT_TILE_ROWS", "FusedEventSampler"]
@@ -37,28 +36,26 @@ DEFAULT_TILE_ROWS = 32
 
 @njit(inline="always", cache=True)
 def _events_row(resp, th, rf, out, width, capture):
-    """The event rule on one row of one scale (``capture``: store the references)."""
+    """The event rule on one row of one scale (``capture``: store the references);
+    branch-free, so the loop vectorises."""
     if capture:
         for x in range(width):
             rf[x] = resp[x]
             out[x] = 0
         return
     for x in range(width):
-        d = resp[x] - rf[x]
+        r = rf[x]
+        d = resp[x] - r
         c = th[x]
-        if d >= c:
-            out[x] = 1
-            rf[x] = rf[x] + c
-        elif d <= -c:
-            out[x] = -1
-            rf[x] = rf[x] - c
-        else:
-            out[x] = 0
+        on = d >= c
+        off = (d <= -c) & (not on)
+        out[x] = np.int8(on) - np.int8(off)
+        rf[x] = r + c if on else (r - c if off else r)
 
 
-@njit(parallel=True, cache=True)
+@njit(parallel=True, cache=True, error_model="numpy")
 def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean, sd,
-                 zx, zr, weights, halves, lmax, tile_rows, out):
+                 zx, zr, weights, halves, ladder, lmax, tile_rows, out):
     num_scales, height, width = thr.shape
     num_steps = fidx.shape[0]
     num_tiles = (height + tile_rows - 1) // tile_rows
@@ -69,7 +66,8 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
         pad = np.zeros((prow, width + 2 * lmax))
         pairs = np.empty((lmax + 1, prow, width))
         dark = np.empty(width)
-        resp = np.empty(width)
+        resp = np.empty((num_scales, width))
+        orb = np.empty((weights.shape[1], width))
         for b in range(num_steps):
             f = fidx[b]
             a = aw[b]
@@ -80,27 +78,32 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
                     continue  # zero padding: L = 0
                 dst = pad[r, lmax:lmax + width]
                 f0 = frames[f, y]
-                if a == 0.0:
-                    for x in range(width):
-                        dst[x] = f0[x]
-                else:
-                    f1 = frames[f + 1, y]
-                    for x in range(width):
-                        dst[x] = oma * f0[x] + a * f1[x]
+                f1 = frames[f + 1, y] if a != 0.0 else f0
                 if noisy:
                     normal_row(key, t0 + b, y, width, mean, sd, zx, zr, dark, 0)
+                    if a == 0.0:
+                        for x in range(width):
+                            dst[x] = log_intensity_value(f0[x] + dark[x])
+                    else:
+                        for x in range(width):
+                            dst[x] = log_intensity_value((oma * f0[x] + a * f1[x]) + dark[x])
+                elif a == 0.0:
                     for x in range(width):
-                        dst[x] = dst[x] + dark[x]
-                for x in range(width):
-                    v = dst[x]
-                    dst[x] = math.log((v if v > 0.0 else 0.0) + 1.0)
+                        dst[x] = log_intensity_value(f0[x])
+                else:
+                    for x in range(width):
+                        dst[x] = log_intensity_value(oma * f0[x] + a * f1[x])
             row_pairs(pad, prow, lmax, width, pairs)
             capture = capture_first and b == 0
             for r in range(rows):
                 y = y0 + r
+                if ladder:
+                    ladder_sum(pairs, lmax + r, weights, width, resp, orb)
+                else:
+                    for s in range(num_scales):
+                        scale_sum(pairs, lmax + r, weights[s], halves[s], width, resp[s])
                 for s in range(num_scales):
-                    scale_sum(pairs, lmax + r, weights[s], halves[s], width, resp)
-                    _events_row(resp, thr[s, y], ref[s, y], out[b, s, y], width, capture)
+                    _events_row(resp[s], thr[s, y], ref[s, y], out[b, s, y], width, capture)
 
 
 class FusedEventSampler:
@@ -114,6 +117,7 @@ class FusedEventSampler:
         self.scene = scene
         _, self.weights, self.halves, self.lmax = kernel_orbits(spec.kernels())
         self.weights = np.ascontiguousarray(self.weights, dtype=np.float64)
+        self.ladder = is_ladder(self.halves)
         self.thr = np.ascontiguousarray(thresholds, dtype=np.float64)
         self.ref = np.zeros_like(self.thr)
         self.captured: np.ndarray | None = None
@@ -149,5 +153,6 @@ class FusedEventSampler:
         frames, fidx, aw = chunk_frames(self.scene, t0, t1)
         _event_chunk(np.ascontiguousarray(frames, dtype=np.float64), fidx, aw, self.thr,
                      self.ref, t0 == 0, self.noisy, self.key, int(t0), self.mean, self.sd,
-                     ZIG_X, ZIG_RATIO, self.weights, self.halves, self.lmax, self.tile_rows,
+                     ZIG_X, ZIG_RATIO, self.weights, self.halves, self.ladder, self.lmax,
+                     self.tile_rows,
                      out)
