@@ -24,7 +24,7 @@ exactly for the fixed twin). The weighted sum stays in a register, so the loop o
 
 ``ladder_sum_S(pairs, pr, w, width, out, orb)``: ``out[s, x]`` for every scale ``s`` of
 a ladder of half-widths ``1..S`` (weights ``w (S, N)``): each orbit is formed once into
-``orb (N, W)`` and added to every scale that uses it, each scale's sum in its own order,
+``orb (N, W)`` (row 0 unused: orbit ``(0, 0)`` is the value) and added to every scale that uses it, each scale's sum in its own order,
 so every ``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and
 additions.
 """
@@ -83,12 +83,13 @@ def generate() -> str:
 
 def ladder_sum(scales: int) -> list[str]:
     """The lines of ``ladder_sum_S`` for the ladder of half-widths ``1..S``: one loop per
-    orbit into ``orb``, then one loop over every scale (one loop forming the orbits and
+    orbit after ``(0, 0)`` (the value itself) into ``orb``, then one loop over every scale (one loop forming the orbits and
     summing all scales has too many possibly aliasing rows for LLVM to vectorise it)."""
     orbits = [(a, b) for a in range(scales + 1) for b in range(a + 1)]
     lines = ['@njit(inline="always", cache=True)',
              f"def ladder_sum_{scales}(pairs, pr, w, width, out, orb):"]
-    for n, (a, b) in enumerate(orbits):
+    lines.append("    o0 = pairs[0, pr]")  # orbit (0, 0): the value itself
+    for n, (a, b) in enumerate(orbits[1:], start=1):
         expr, rows = orbit_expr(a, b)
         for pb, d in sorted(rows):
             lines.append(f"    {_row(pb, d)} = pairs[{pb}, pr {'-' if d < 0 else '+'} {abs(d)}]")

@@ -25,7 +25,7 @@ from rvsm.model.events.log_intensity import log_intensity_value
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, normal_row
 from rvsm.model.sampling.fused import chunk_frames, dark_current_stream
-from rvsm.model.sampling.row_sums import is_ladder, ladder_sum, row_pairs, scale_sum
+from rvsm.model.sampling.row_sums import is_ladder, ladder_sum, scale_sum
 from rvsm.model.scene.scene import Scene
 
 __all__ = ["DEFAULT_TILE_ROWS", "FusedEventSampler"]
@@ -53,57 +53,92 @@ def _events_row(resp, th, rf, out, width, capture):
         rf[x] = r + c if on else (r - c if off else r)
 
 
+@njit(inline="always", cache=True)
+def _log_row(frames, f, a, y, noisy, key, t, mean, sd, zx, zr, dark, width, dst):
+    """``dst[x] = L`` of row ``y`` at one step: brightness interpolated between frames
+    ``f`` and ``f + 1`` with weight ``a`` (plus the dark current), then its log."""
+    f0 = frames[f, y]
+    f1 = frames[f + 1, y] if a != 0.0 else f0
+    oma = 1.0 - a
+    if noisy:
+        normal_row(key, t, y, width, mean, sd, zx, zr, dark, 0)
+        if a == 0.0:
+            for x in range(width):
+                dst[x] = log_intensity_value(f0[x] + dark[x])
+        else:
+            for x in range(width):
+                dst[x] = log_intensity_value((oma * f0[x] + a * f1[x]) + dark[x])
+    elif a == 0.0:
+        for x in range(width):
+            dst[x] = log_intensity_value(f0[x])
+    else:
+        for x in range(width):
+            dst[x] = log_intensity_value(oma * f0[x] + a * f1[x])
+
+
+@njit(inline="always", cache=True)
+def _ring_pairs(pad, lmax, width, ring, k, pairs):
+    """Row pairs of the padded row ``pad (W + 2L,)`` (:func:`.row_sums.row_pairs`) into
+    ring slots ``k`` and ``k + ring`` of ``pairs (L + 1, 2 ring, W)``."""
+    mid = pad[lmax:lmax + width]
+    d0 = pairs[0, k]
+    d1 = pairs[0, k + ring]
+    for x in range(width):
+        v = mid[x]
+        d0[x] = v
+        d1[x] = v
+    for b in range(1, lmax + 1):
+        left = pad[lmax - b:lmax - b + width]
+        right = pad[lmax + b:lmax + b + width]
+        d0 = pairs[b, k]
+        d1 = pairs[b, k + ring]
+        for x in range(width):
+            v = left[x] + right[x]
+            d0[x] = v
+            d1[x] = v
+
+
 @njit(parallel=True, cache=True, error_model="numpy")
 def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean, sd,
                  zx, zr, weights, halves, ladder, lmax, tile_rows, out):
     num_scales, height, width = thr.shape
     num_steps = fidx.shape[0]
     num_tiles = (height + tile_rows - 1) // tile_rows
+    ring = 2 * lmax + 1  # the rows one output row's sums read
     for ti in prange(num_tiles):
         y0 = ti * tile_rows
         rows = min(height, y0 + tile_rows) - y0
-        prow = rows + 2 * lmax
-        pad = np.zeros((prow, width + 2 * lmax))
-        pairs = np.empty((lmax + 1, prow, width))
+        pad = np.zeros(width + 2 * lmax)  # one row of L, zero margins
+        # Each padded row's pairs go to ring slots k and k + ring, so the 2L + 1 rows
+        # around any output row are consecutive slots (what the row sums index).
+        pairs = np.zeros((lmax + 1, 2 * ring, width))
         dark = np.empty(width)
         resp = np.empty((num_scales, width))
         orb = np.empty((weights.shape[1], width))
         for b in range(num_steps):
-            f = fidx[b]
-            a = aw[b]
-            oma = 1.0 - a
-            for r in range(prow):
-                y = y0 - lmax + r
-                if y < 0 or y >= height:
-                    continue  # zero padding: L = 0
-                dst = pad[r, lmax:lmax + width]
-                f0 = frames[f, y]
-                f1 = frames[f + 1, y] if a != 0.0 else f0
-                if noisy:
-                    normal_row(key, t0 + b, y, width, mean, sd, zx, zr, dark, 0)
-                    if a == 0.0:
-                        for x in range(width):
-                            dst[x] = log_intensity_value(f0[x] + dark[x])
-                    else:
-                        for x in range(width):
-                            dst[x] = log_intensity_value((oma * f0[x] + a * f1[x]) + dark[x])
-                elif a == 0.0:
-                    for x in range(width):
-                        dst[x] = log_intensity_value(f0[x])
-                else:
-                    for x in range(width):
-                        dst[x] = log_intensity_value(oma * f0[x] + a * f1[x])
-            row_pairs(pad, prow, lmax, width, pairs)
             capture = capture_first and b == 0
-            for r in range(rows):
-                y = y0 + r
+            for r in range(rows + 2 * lmax):
+                y = y0 - lmax + r
+                k = r % ring
+                if y < 0 or y >= height:  # zero padding: L = 0
+                    pairs[:, k] = 0.0
+                    pairs[:, k + ring] = 0.0
+                else:
+                    _log_row(frames, fidx[b], aw[b], y, noisy, key, t0 + b, mean, sd, zx,
+                             zr, dark, width, pad[lmax:lmax + width])
+                    _ring_pairs(pad, lmax, width, ring, k, pairs)
+                if r < 2 * lmax:
+                    continue
+                yo = y - lmax  # the output row whose window ends at row y
+                pr = (r - 2 * lmax) % ring + lmax
                 if ladder:
-                    ladder_sum(pairs, lmax + r, weights, width, resp, orb)
+                    ladder_sum(pairs, pr, weights, width, resp, orb)
                 else:
                     for s in range(num_scales):
-                        scale_sum(pairs, lmax + r, weights[s], halves[s], width, resp[s])
+                        scale_sum(pairs, pr, weights[s], halves[s], width, resp[s])
                 for s in range(num_scales):
-                    _events_row(resp[s], thr[s, y], ref[s, y], out[b, s, y], width, capture)
+                    _events_row(resp[s], thr[s, yo], ref[s, yo], out[b, s, yo], width,
+                                capture)
 
 
 class FusedEventSampler:

@@ -10,7 +10,7 @@ exactly for the fixed twin). The weighted sum stays in a register, so the loop o
 
 ``ladder_sum_S(pairs, pr, w, width, out, orb)``: ``out[s, x]`` for every scale ``s`` of
 a ladder of half-widths ``1..S`` (weights ``w (S, N)``): each orbit is formed once into
-``orb (N, W)`` and added to every scale that uses it, each scale's sum in its own order,
+``orb (N, W)`` (row 0 unused: orbit ``(0, 0)`` is the value) and added to every scale that uses it, each scale's sum in its own order,
 so every ``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and
 additions.
 """
@@ -185,10 +185,7 @@ def scale_sum_4(pairs, pr, w, width, out):
 
 @njit(inline="always", cache=True)
 def ladder_sum_1(pairs, pr, w, width, out, orb):
-    r0_p0 = pairs[0, pr + 0]
-    o0 = orb[0]
-    for x in range(width):
-        o0[x] = r0_p0[x]
+    o0 = pairs[0, pr]
     r0_m1 = pairs[0, pr - 1]
     r0_p1 = pairs[0, pr + 1]
     r1_p0 = pairs[1, pr + 0]
@@ -217,10 +214,7 @@ def ladder_sum_1(pairs, pr, w, width, out, orb):
 
 @njit(inline="always", cache=True)
 def ladder_sum_2(pairs, pr, w, width, out, orb):
-    r0_p0 = pairs[0, pr + 0]
-    o0 = orb[0]
-    for x in range(width):
-        o0[x] = r0_p0[x]
+    o0 = pairs[0, pr]
     r0_m1 = pairs[0, pr - 1]
     r0_p1 = pairs[0, pr + 1]
     r1_p0 = pairs[1, pr + 0]
@@ -285,10 +279,7 @@ def ladder_sum_2(pairs, pr, w, width, out, orb):
 
 @njit(inline="always", cache=True)
 def ladder_sum_3(pairs, pr, w, width, out, orb):
-    r0_p0 = pairs[0, pr + 0]
-    o0 = orb[0]
-    for x in range(width):
-        o0[x] = r0_p0[x]
+    o0 = pairs[0, pr]
     r0_m1 = pairs[0, pr - 1]
     r0_p1 = pairs[0, pr + 1]
     r1_p0 = pairs[1, pr + 0]
@@ -405,10 +396,7 @@ def ladder_sum_3(pairs, pr, w, width, out, orb):
 
 @njit(inline="always", cache=True)
 def ladder_sum_4(pairs, pr, w, width, out, orb):
-    r0_p0 = pairs[0, pr + 0]
-    o0 = orb[0]
-    for x in range(width):
-        o0[x] = r0_p0[x]
+    o0 = pairs[0, pr]
     r0_m1 = pairs[0, pr - 1]
     r0_p1 = pairs[0, pr + 1]
     r1_p0 = pairs[1, pr + 0]
