@@ -24,9 +24,9 @@ exactly for the fixed twin). The weighted sum stays in a register, so the loop o
 
 ``ladder_sum_S(pairs, pr, w, width, out, orb)``: ``out[s, x]`` for every scale ``s`` of
 a ladder of half-widths ``1..S`` (weights ``w (S, N)``): each orbit is formed once into
-``orb (N, W)`` (row 0 unused: orbit ``(0, 0)`` is the value) and added to every scale that uses it, each scale's sum in its own order,
-so every ``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and
-additions.
+``orb (N, W)`` (row 0 unused: orbit ``(0, 0)`` is the value) and added to every scale
+that uses it, each scale's sum in its own order, so every ``out[s]`` equals
+``scale_sum_{s + 1}`` bit for bit with fewer loads and additions.
 """
 
 from numba import njit
@@ -83,8 +83,10 @@ def generate() -> str:
 
 def ladder_sum(scales: int) -> list[str]:
     """The lines of ``ladder_sum_S`` for the ladder of half-widths ``1..S``: one loop per
-    orbit after ``(0, 0)`` (the value itself) into ``orb``, then one loop over every scale (one loop forming the orbits and
-    summing all scales has too many possibly aliasing rows for LLVM to vectorise it)."""
+    orbit after ``(0, 0)`` (the value itself) into ``orb``, then one loop over every
+    scale (a single loop forming the orbits and summing all scales reads and writes too
+    many possibly aliasing rows: LLVM gives up its runtime alias checks and leaves it
+    scalar, 2x slower)."""
     orbits = [(a, b) for a in range(scales + 1) for b in range(a + 1)]
     lines = ['@njit(inline="always", cache=True)',
              f"def ladder_sum_{scales}(pairs, pr, w, width, out, orb):"]

@@ -10,9 +10,9 @@ exactly for the fixed twin). The weighted sum stays in a register, so the loop o
 
 ``ladder_sum_S(pairs, pr, w, width, out, orb)``: ``out[s, x]`` for every scale ``s`` of
 a ladder of half-widths ``1..S`` (weights ``w (S, N)``): each orbit is formed once into
-``orb (N, W)`` (row 0 unused: orbit ``(0, 0)`` is the value) and added to every scale that uses it, each scale's sum in its own order,
-so every ``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and
-additions.
+``orb (N, W)`` (row 0 unused: orbit ``(0, 0)`` is the value) and added to every scale
+that uses it, each scale's sum in its own order, so every ``out[s]`` equals
+``scale_sum_{s + 1}`` bit for bit with fewer loads and additions.
 """
 
 from numba import njit
