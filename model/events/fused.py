@@ -2,17 +2,21 @@
 parallel, everything of a tile in cache.
 
 :func:`_event_chunk` processes tiles of ``tile_rows`` rows in parallel (``prange``); per
-tile and step it forms the brightness of the tile's rows plus a halo of ``L`` rows
-(interpolated between the chunk's frames, plus the dark current drawn inside the tile from
-the counter-based streams of :mod:`rvsm.model.noise.streams`), the log intensity, the row
-pairs and every scale's receptive sum of each row (the shared kernels of
-:mod:`rvsm.model.sampling.row_sums`, the orbit order), and applies the event rule to the
-tile's accumulators and references.
+tile and step it streams the tile's rows plus a halo of ``L`` rows, one at a time: the
+brightness (interpolated between the chunk's frames, plus the dark current drawn inside
+the tile from the counter-based streams of :mod:`rvsm.model.noise.streams`) and its log
+(:func:`.log_intensity.log_intensity_value`) in one vectorised loop, then the row's pairs
+into a ring of ``2L + 1`` rows (each stored twice, so the window around any output row is
+consecutive). Once a row's window is complete it forms every scale's receptive sum of it
+(:func:`~rvsm.model.sampling.row_sums.ladder_sum` for the ``1..S`` ladders, else
+:func:`~rvsm.model.sampling.row_sums.scale_sum` per scale; the orbit order) and applies
+the event rule to the row's accumulators and references.
 
 Every float operation is the one :mod:`.numpy_engine` does, in the same order, the log
-is the formula of :mod:`.log_intensity`, and every pixel's arithmetic depends on nothing
-but its own coordinates, so the events are bit-identical to the numpy engine for any tile
-height, chunk length and thread count.
+is the same inlined function, no loop runs under ``fastmath``, and every pixel's
+arithmetic depends on nothing but its own coordinates, so the events are bit-identical to
+the numpy engine for any tile height, chunk length and thread count. Speed and where the
+time goes: ``docs/events.md`` (section "Speed").
 """
 
 from __future__ import annotations
@@ -30,7 +34,8 @@ from rvsm.model.scene.scene import Scene
 
 __all__ = ["DEFAULT_TILE_ROWS", "FusedEventSampler"]
 
-#: Rows per tile (the log of the ``2L`` halo rows is recomputed per tile).
+#: Rows per tile (the log of the ``2L`` halo rows is recomputed per tile; a tile's
+#: references and thresholds, ``16 S W`` bytes a row, stay in L2 across steps).
 DEFAULT_TILE_ROWS = 32
 
 
