@@ -119,7 +119,6 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
         pairs = np.zeros((lmax + 1, 2 * ring, width))
         dark = np.empty(width)
         resp = np.empty((num_scales, width))
-        orb = np.empty((weights.shape[1], width))
         for b in range(num_steps):
             capture = capture_first and b == 0
             for r in range(rows + 2 * lmax):
@@ -137,7 +136,7 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
                 yo = y - lmax  # the output row whose window ends at row y
                 pr = (r - 2 * lmax) % ring + lmax
                 if ladder:
-                    ladder_sum(pairs, pr, weights, width, resp, orb)
+                    ladder_sum(pairs, pr, weights, width, resp)
                 else:
                     for s in range(num_scales):
                         scale_sum(pairs, pr, weights[s], halves[s], width, resp[s])

@@ -8,11 +8,10 @@ starts at ``w[0] - w[0]``, i.e. 0 of the weights' type, so the same code sums in
 exactly for the fixed twin). The weighted sum stays in a register, so the loop over
 ``x`` vectorises.
 
-``ladder_sum_S(pairs, pr, w, width, out, orb)``: ``out[s, x]`` for every scale ``s`` of
-a ladder of half-widths ``1..S`` (weights ``w (S, N)``): each orbit is formed once into
-``orb (N, W)`` (row 0 unused: orbit ``(0, 0)`` is the value) and added to every scale
-that uses it, each scale's sum in its own order, so every ``out[s]`` equals
-``scale_sum_{s + 1}`` bit for bit with fewer loads and additions.
+``ladder_sum_S(pairs, pr, w, width, out)``: ``out[s, x]`` for every scale ``s`` of a
+ladder of half-widths ``1..S`` (weights ``w (S, N)``), two scales a loop: each orbit is
+formed once per loop and added to both scales' sums, each sum in its own order, so every
+``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and additions.
 """
 
 from numba import njit
@@ -184,66 +183,45 @@ def scale_sum_4(pairs, pr, w, width, out):
 
 
 @njit(inline="always", cache=True)
-def ladder_sum_1(pairs, pr, w, width, out, orb):
-    o0 = pairs[0, pr]
+def ladder_sum_1(pairs, pr, w, width, out):
     r0_m1 = pairs[0, pr - 1]
+    r0_p0 = pairs[0, pr + 0]
     r0_p1 = pairs[0, pr + 1]
-    r1_p0 = pairs[1, pr + 0]
-    o1 = orb[1]
-    for x in range(width):
-        o1[x] = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
     r1_m1 = pairs[1, pr - 1]
+    r1_p0 = pairs[1, pr + 0]
     r1_p1 = pairs[1, pr + 1]
-    o2 = orb[2]
-    for x in range(width):
-        o2[x] = (r1_m1[x] + r1_p1[x])
     out0 = out[0]
     w0_0 = w[0, 0]
     w0_1 = w[0, 1]
     w0_2 = w[0, 2]
     for x in range(width):
         t0 = w0_0 - w0_0
-        o = o0[x]
+        o = r0_p0[x]
         t0 = t0 + w0_0 * o
-        o = o1[x]
+        o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
         t0 = t0 + w0_1 * o
-        o = o2[x]
+        o = (r1_m1[x] + r1_p1[x])
         t0 = t0 + w0_2 * o
         out0[x] = t0
 
 
 @njit(inline="always", cache=True)
-def ladder_sum_2(pairs, pr, w, width, out, orb):
-    o0 = pairs[0, pr]
-    r0_m1 = pairs[0, pr - 1]
-    r0_p1 = pairs[0, pr + 1]
-    r1_p0 = pairs[1, pr + 0]
-    o1 = orb[1]
-    for x in range(width):
-        o1[x] = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
-    r1_m1 = pairs[1, pr - 1]
-    r1_p1 = pairs[1, pr + 1]
-    o2 = orb[2]
-    for x in range(width):
-        o2[x] = (r1_m1[x] + r1_p1[x])
+def ladder_sum_2(pairs, pr, w, width, out):
     r0_m2 = pairs[0, pr - 2]
+    r0_m1 = pairs[0, pr - 1]
+    r0_p0 = pairs[0, pr + 0]
+    r0_p1 = pairs[0, pr + 1]
     r0_p2 = pairs[0, pr + 2]
-    r2_p0 = pairs[2, pr + 0]
-    o3 = orb[3]
-    for x in range(width):
-        o3[x] = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
     r1_m2 = pairs[1, pr - 2]
+    r1_m1 = pairs[1, pr - 1]
+    r1_p0 = pairs[1, pr + 0]
+    r1_p1 = pairs[1, pr + 1]
     r1_p2 = pairs[1, pr + 2]
-    r2_m1 = pairs[2, pr - 1]
-    r2_p1 = pairs[2, pr + 1]
-    o4 = orb[4]
-    for x in range(width):
-        o4[x] = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
     r2_m2 = pairs[2, pr - 2]
+    r2_m1 = pairs[2, pr - 1]
+    r2_p0 = pairs[2, pr + 0]
+    r2_p1 = pairs[2, pr + 1]
     r2_p2 = pairs[2, pr + 2]
-    o5 = orb[5]
-    for x in range(width):
-        o5[x] = (r2_m2[x] + r2_p2[x])
     out0 = out[0]
     w0_0 = w[0, 0]
     w0_1 = w[0, 1]
@@ -257,83 +235,43 @@ def ladder_sum_2(pairs, pr, w, width, out, orb):
     w1_5 = w[1, 5]
     for x in range(width):
         t0 = w0_0 - w0_0
-        t1 = w0_0 - w0_0
-        o = o0[x]
+        t1 = w1_0 - w1_0
+        o = r0_p0[x]
         t0 = t0 + w0_0 * o
         t1 = t1 + w1_0 * o
-        o = o1[x]
+        o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
         t0 = t0 + w0_1 * o
         t1 = t1 + w1_1 * o
-        o = o2[x]
+        o = (r1_m1[x] + r1_p1[x])
         t0 = t0 + w0_2 * o
         t1 = t1 + w1_2 * o
-        o = o3[x]
+        o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
         t1 = t1 + w1_3 * o
-        o = o4[x]
+        o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
         t1 = t1 + w1_4 * o
-        o = o5[x]
+        o = (r2_m2[x] + r2_p2[x])
         t1 = t1 + w1_5 * o
         out0[x] = t0
         out1[x] = t1
 
 
 @njit(inline="always", cache=True)
-def ladder_sum_3(pairs, pr, w, width, out, orb):
-    o0 = pairs[0, pr]
-    r0_m1 = pairs[0, pr - 1]
-    r0_p1 = pairs[0, pr + 1]
-    r1_p0 = pairs[1, pr + 0]
-    o1 = orb[1]
-    for x in range(width):
-        o1[x] = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
-    r1_m1 = pairs[1, pr - 1]
-    r1_p1 = pairs[1, pr + 1]
-    o2 = orb[2]
-    for x in range(width):
-        o2[x] = (r1_m1[x] + r1_p1[x])
+def ladder_sum_3(pairs, pr, w, width, out):
     r0_m2 = pairs[0, pr - 2]
+    r0_m1 = pairs[0, pr - 1]
+    r0_p0 = pairs[0, pr + 0]
+    r0_p1 = pairs[0, pr + 1]
     r0_p2 = pairs[0, pr + 2]
-    r2_p0 = pairs[2, pr + 0]
-    o3 = orb[3]
-    for x in range(width):
-        o3[x] = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
     r1_m2 = pairs[1, pr - 2]
+    r1_m1 = pairs[1, pr - 1]
+    r1_p0 = pairs[1, pr + 0]
+    r1_p1 = pairs[1, pr + 1]
     r1_p2 = pairs[1, pr + 2]
-    r2_m1 = pairs[2, pr - 1]
-    r2_p1 = pairs[2, pr + 1]
-    o4 = orb[4]
-    for x in range(width):
-        o4[x] = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
     r2_m2 = pairs[2, pr - 2]
+    r2_m1 = pairs[2, pr - 1]
+    r2_p0 = pairs[2, pr + 0]
+    r2_p1 = pairs[2, pr + 1]
     r2_p2 = pairs[2, pr + 2]
-    o5 = orb[5]
-    for x in range(width):
-        o5[x] = (r2_m2[x] + r2_p2[x])
-    r0_m3 = pairs[0, pr - 3]
-    r0_p3 = pairs[0, pr + 3]
-    r3_p0 = pairs[3, pr + 0]
-    o6 = orb[6]
-    for x in range(width):
-        o6[x] = ((r0_m3[x] + r0_p3[x]) + r3_p0[x])
-    r1_m3 = pairs[1, pr - 3]
-    r1_p3 = pairs[1, pr + 3]
-    r3_m1 = pairs[3, pr - 1]
-    r3_p1 = pairs[3, pr + 1]
-    o7 = orb[7]
-    for x in range(width):
-        o7[x] = ((r1_m3[x] + r1_p3[x]) + (r3_m1[x] + r3_p1[x]))
-    r2_m3 = pairs[2, pr - 3]
-    r2_p3 = pairs[2, pr + 3]
-    r3_m2 = pairs[3, pr - 2]
-    r3_p2 = pairs[3, pr + 2]
-    o8 = orb[8]
-    for x in range(width):
-        o8[x] = ((r2_m3[x] + r2_p3[x]) + (r3_m2[x] + r3_p2[x]))
-    r3_m3 = pairs[3, pr - 3]
-    r3_p3 = pairs[3, pr + 3]
-    o9 = orb[9]
-    for x in range(width):
-        o9[x] = (r3_m3[x] + r3_p3[x])
     out0 = out[0]
     w0_0 = w[0, 0]
     w0_1 = w[0, 1]
@@ -345,6 +283,54 @@ def ladder_sum_3(pairs, pr, w, width, out, orb):
     w1_3 = w[1, 3]
     w1_4 = w[1, 4]
     w1_5 = w[1, 5]
+    for x in range(width):
+        t0 = w0_0 - w0_0
+        t1 = w1_0 - w1_0
+        o = r0_p0[x]
+        t0 = t0 + w0_0 * o
+        t1 = t1 + w1_0 * o
+        o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
+        t0 = t0 + w0_1 * o
+        t1 = t1 + w1_1 * o
+        o = (r1_m1[x] + r1_p1[x])
+        t0 = t0 + w0_2 * o
+        t1 = t1 + w1_2 * o
+        o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
+        t1 = t1 + w1_3 * o
+        o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
+        t1 = t1 + w1_4 * o
+        o = (r2_m2[x] + r2_p2[x])
+        t1 = t1 + w1_5 * o
+        out0[x] = t0
+        out1[x] = t1
+    r0_m3 = pairs[0, pr - 3]
+    r0_m2 = pairs[0, pr - 2]
+    r0_m1 = pairs[0, pr - 1]
+    r0_p0 = pairs[0, pr + 0]
+    r0_p1 = pairs[0, pr + 1]
+    r0_p2 = pairs[0, pr + 2]
+    r0_p3 = pairs[0, pr + 3]
+    r1_m3 = pairs[1, pr - 3]
+    r1_m2 = pairs[1, pr - 2]
+    r1_m1 = pairs[1, pr - 1]
+    r1_p0 = pairs[1, pr + 0]
+    r1_p1 = pairs[1, pr + 1]
+    r1_p2 = pairs[1, pr + 2]
+    r1_p3 = pairs[1, pr + 3]
+    r2_m3 = pairs[2, pr - 3]
+    r2_m2 = pairs[2, pr - 2]
+    r2_m1 = pairs[2, pr - 1]
+    r2_p0 = pairs[2, pr + 0]
+    r2_p1 = pairs[2, pr + 1]
+    r2_p2 = pairs[2, pr + 2]
+    r2_p3 = pairs[2, pr + 3]
+    r3_m3 = pairs[3, pr - 3]
+    r3_m2 = pairs[3, pr - 2]
+    r3_m1 = pairs[3, pr - 1]
+    r3_p0 = pairs[3, pr + 0]
+    r3_p1 = pairs[3, pr + 1]
+    r3_p2 = pairs[3, pr + 2]
+    r3_p3 = pairs[3, pr + 3]
     out2 = out[2]
     w2_0 = w[2, 0]
     w2_1 = w[2, 1]
@@ -357,132 +343,47 @@ def ladder_sum_3(pairs, pr, w, width, out, orb):
     w2_8 = w[2, 8]
     w2_9 = w[2, 9]
     for x in range(width):
-        t0 = w0_0 - w0_0
-        t1 = w0_0 - w0_0
-        t2 = w0_0 - w0_0
-        o = o0[x]
-        t0 = t0 + w0_0 * o
-        t1 = t1 + w1_0 * o
+        t2 = w2_0 - w2_0
+        o = r0_p0[x]
         t2 = t2 + w2_0 * o
-        o = o1[x]
-        t0 = t0 + w0_1 * o
-        t1 = t1 + w1_1 * o
+        o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
         t2 = t2 + w2_1 * o
-        o = o2[x]
-        t0 = t0 + w0_2 * o
-        t1 = t1 + w1_2 * o
+        o = (r1_m1[x] + r1_p1[x])
         t2 = t2 + w2_2 * o
-        o = o3[x]
-        t1 = t1 + w1_3 * o
+        o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
         t2 = t2 + w2_3 * o
-        o = o4[x]
-        t1 = t1 + w1_4 * o
+        o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
         t2 = t2 + w2_4 * o
-        o = o5[x]
-        t1 = t1 + w1_5 * o
+        o = (r2_m2[x] + r2_p2[x])
         t2 = t2 + w2_5 * o
-        o = o6[x]
+        o = ((r0_m3[x] + r0_p3[x]) + r3_p0[x])
         t2 = t2 + w2_6 * o
-        o = o7[x]
+        o = ((r1_m3[x] + r1_p3[x]) + (r3_m1[x] + r3_p1[x]))
         t2 = t2 + w2_7 * o
-        o = o8[x]
+        o = ((r2_m3[x] + r2_p3[x]) + (r3_m2[x] + r3_p2[x]))
         t2 = t2 + w2_8 * o
-        o = o9[x]
+        o = (r3_m3[x] + r3_p3[x])
         t2 = t2 + w2_9 * o
-        out0[x] = t0
-        out1[x] = t1
         out2[x] = t2
 
 
 @njit(inline="always", cache=True)
-def ladder_sum_4(pairs, pr, w, width, out, orb):
-    o0 = pairs[0, pr]
-    r0_m1 = pairs[0, pr - 1]
-    r0_p1 = pairs[0, pr + 1]
-    r1_p0 = pairs[1, pr + 0]
-    o1 = orb[1]
-    for x in range(width):
-        o1[x] = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
-    r1_m1 = pairs[1, pr - 1]
-    r1_p1 = pairs[1, pr + 1]
-    o2 = orb[2]
-    for x in range(width):
-        o2[x] = (r1_m1[x] + r1_p1[x])
+def ladder_sum_4(pairs, pr, w, width, out):
     r0_m2 = pairs[0, pr - 2]
+    r0_m1 = pairs[0, pr - 1]
+    r0_p0 = pairs[0, pr + 0]
+    r0_p1 = pairs[0, pr + 1]
     r0_p2 = pairs[0, pr + 2]
-    r2_p0 = pairs[2, pr + 0]
-    o3 = orb[3]
-    for x in range(width):
-        o3[x] = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
     r1_m2 = pairs[1, pr - 2]
+    r1_m1 = pairs[1, pr - 1]
+    r1_p0 = pairs[1, pr + 0]
+    r1_p1 = pairs[1, pr + 1]
     r1_p2 = pairs[1, pr + 2]
-    r2_m1 = pairs[2, pr - 1]
-    r2_p1 = pairs[2, pr + 1]
-    o4 = orb[4]
-    for x in range(width):
-        o4[x] = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
     r2_m2 = pairs[2, pr - 2]
+    r2_m1 = pairs[2, pr - 1]
+    r2_p0 = pairs[2, pr + 0]
+    r2_p1 = pairs[2, pr + 1]
     r2_p2 = pairs[2, pr + 2]
-    o5 = orb[5]
-    for x in range(width):
-        o5[x] = (r2_m2[x] + r2_p2[x])
-    r0_m3 = pairs[0, pr - 3]
-    r0_p3 = pairs[0, pr + 3]
-    r3_p0 = pairs[3, pr + 0]
-    o6 = orb[6]
-    for x in range(width):
-        o6[x] = ((r0_m3[x] + r0_p3[x]) + r3_p0[x])
-    r1_m3 = pairs[1, pr - 3]
-    r1_p3 = pairs[1, pr + 3]
-    r3_m1 = pairs[3, pr - 1]
-    r3_p1 = pairs[3, pr + 1]
-    o7 = orb[7]
-    for x in range(width):
-        o7[x] = ((r1_m3[x] + r1_p3[x]) + (r3_m1[x] + r3_p1[x]))
-    r2_m3 = pairs[2, pr - 3]
-    r2_p3 = pairs[2, pr + 3]
-    r3_m2 = pairs[3, pr - 2]
-    r3_p2 = pairs[3, pr + 2]
-    o8 = orb[8]
-    for x in range(width):
-        o8[x] = ((r2_m3[x] + r2_p3[x]) + (r3_m2[x] + r3_p2[x]))
-    r3_m3 = pairs[3, pr - 3]
-    r3_p3 = pairs[3, pr + 3]
-    o9 = orb[9]
-    for x in range(width):
-        o9[x] = (r3_m3[x] + r3_p3[x])
-    r0_m4 = pairs[0, pr - 4]
-    r0_p4 = pairs[0, pr + 4]
-    r4_p0 = pairs[4, pr + 0]
-    o10 = orb[10]
-    for x in range(width):
-        o10[x] = ((r0_m4[x] + r0_p4[x]) + r4_p0[x])
-    r1_m4 = pairs[1, pr - 4]
-    r1_p4 = pairs[1, pr + 4]
-    r4_m1 = pairs[4, pr - 1]
-    r4_p1 = pairs[4, pr + 1]
-    o11 = orb[11]
-    for x in range(width):
-        o11[x] = ((r1_m4[x] + r1_p4[x]) + (r4_m1[x] + r4_p1[x]))
-    r2_m4 = pairs[2, pr - 4]
-    r2_p4 = pairs[2, pr + 4]
-    r4_m2 = pairs[4, pr - 2]
-    r4_p2 = pairs[4, pr + 2]
-    o12 = orb[12]
-    for x in range(width):
-        o12[x] = ((r2_m4[x] + r2_p4[x]) + (r4_m2[x] + r4_p2[x]))
-    r3_m4 = pairs[3, pr - 4]
-    r3_p4 = pairs[3, pr + 4]
-    r4_m3 = pairs[4, pr - 3]
-    r4_p3 = pairs[4, pr + 3]
-    o13 = orb[13]
-    for x in range(width):
-        o13[x] = ((r3_m4[x] + r3_p4[x]) + (r4_m3[x] + r4_p3[x]))
-    r4_m4 = pairs[4, pr - 4]
-    r4_p4 = pairs[4, pr + 4]
-    o14 = orb[14]
-    for x in range(width):
-        o14[x] = (r4_m4[x] + r4_p4[x])
     out0 = out[0]
     w0_0 = w[0, 0]
     w0_1 = w[0, 1]
@@ -494,6 +395,71 @@ def ladder_sum_4(pairs, pr, w, width, out, orb):
     w1_3 = w[1, 3]
     w1_4 = w[1, 4]
     w1_5 = w[1, 5]
+    for x in range(width):
+        t0 = w0_0 - w0_0
+        t1 = w1_0 - w1_0
+        o = r0_p0[x]
+        t0 = t0 + w0_0 * o
+        t1 = t1 + w1_0 * o
+        o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
+        t0 = t0 + w0_1 * o
+        t1 = t1 + w1_1 * o
+        o = (r1_m1[x] + r1_p1[x])
+        t0 = t0 + w0_2 * o
+        t1 = t1 + w1_2 * o
+        o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
+        t1 = t1 + w1_3 * o
+        o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
+        t1 = t1 + w1_4 * o
+        o = (r2_m2[x] + r2_p2[x])
+        t1 = t1 + w1_5 * o
+        out0[x] = t0
+        out1[x] = t1
+    r0_m4 = pairs[0, pr - 4]
+    r0_m3 = pairs[0, pr - 3]
+    r0_m2 = pairs[0, pr - 2]
+    r0_m1 = pairs[0, pr - 1]
+    r0_p0 = pairs[0, pr + 0]
+    r0_p1 = pairs[0, pr + 1]
+    r0_p2 = pairs[0, pr + 2]
+    r0_p3 = pairs[0, pr + 3]
+    r0_p4 = pairs[0, pr + 4]
+    r1_m4 = pairs[1, pr - 4]
+    r1_m3 = pairs[1, pr - 3]
+    r1_m2 = pairs[1, pr - 2]
+    r1_m1 = pairs[1, pr - 1]
+    r1_p0 = pairs[1, pr + 0]
+    r1_p1 = pairs[1, pr + 1]
+    r1_p2 = pairs[1, pr + 2]
+    r1_p3 = pairs[1, pr + 3]
+    r1_p4 = pairs[1, pr + 4]
+    r2_m4 = pairs[2, pr - 4]
+    r2_m3 = pairs[2, pr - 3]
+    r2_m2 = pairs[2, pr - 2]
+    r2_m1 = pairs[2, pr - 1]
+    r2_p0 = pairs[2, pr + 0]
+    r2_p1 = pairs[2, pr + 1]
+    r2_p2 = pairs[2, pr + 2]
+    r2_p3 = pairs[2, pr + 3]
+    r2_p4 = pairs[2, pr + 4]
+    r3_m4 = pairs[3, pr - 4]
+    r3_m3 = pairs[3, pr - 3]
+    r3_m2 = pairs[3, pr - 2]
+    r3_m1 = pairs[3, pr - 1]
+    r3_p0 = pairs[3, pr + 0]
+    r3_p1 = pairs[3, pr + 1]
+    r3_p2 = pairs[3, pr + 2]
+    r3_p3 = pairs[3, pr + 3]
+    r3_p4 = pairs[3, pr + 4]
+    r4_m4 = pairs[4, pr - 4]
+    r4_m3 = pairs[4, pr - 3]
+    r4_m2 = pairs[4, pr - 2]
+    r4_m1 = pairs[4, pr - 1]
+    r4_p0 = pairs[4, pr + 0]
+    r4_p1 = pairs[4, pr + 1]
+    r4_p2 = pairs[4, pr + 2]
+    r4_p3 = pairs[4, pr + 3]
+    r4_p4 = pairs[4, pr + 4]
     out2 = out[2]
     w2_0 = w[2, 0]
     w2_1 = w[2, 1]
@@ -522,60 +488,47 @@ def ladder_sum_4(pairs, pr, w, width, out, orb):
     w3_13 = w[3, 13]
     w3_14 = w[3, 14]
     for x in range(width):
-        t0 = w0_0 - w0_0
-        t1 = w0_0 - w0_0
-        t2 = w0_0 - w0_0
-        t3 = w0_0 - w0_0
-        o = o0[x]
-        t0 = t0 + w0_0 * o
-        t1 = t1 + w1_0 * o
+        t2 = w2_0 - w2_0
+        t3 = w3_0 - w3_0
+        o = r0_p0[x]
         t2 = t2 + w2_0 * o
         t3 = t3 + w3_0 * o
-        o = o1[x]
-        t0 = t0 + w0_1 * o
-        t1 = t1 + w1_1 * o
+        o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
         t2 = t2 + w2_1 * o
         t3 = t3 + w3_1 * o
-        o = o2[x]
-        t0 = t0 + w0_2 * o
-        t1 = t1 + w1_2 * o
+        o = (r1_m1[x] + r1_p1[x])
         t2 = t2 + w2_2 * o
         t3 = t3 + w3_2 * o
-        o = o3[x]
-        t1 = t1 + w1_3 * o
+        o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
         t2 = t2 + w2_3 * o
         t3 = t3 + w3_3 * o
-        o = o4[x]
-        t1 = t1 + w1_4 * o
+        o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
         t2 = t2 + w2_4 * o
         t3 = t3 + w3_4 * o
-        o = o5[x]
-        t1 = t1 + w1_5 * o
+        o = (r2_m2[x] + r2_p2[x])
         t2 = t2 + w2_5 * o
         t3 = t3 + w3_5 * o
-        o = o6[x]
+        o = ((r0_m3[x] + r0_p3[x]) + r3_p0[x])
         t2 = t2 + w2_6 * o
         t3 = t3 + w3_6 * o
-        o = o7[x]
+        o = ((r1_m3[x] + r1_p3[x]) + (r3_m1[x] + r3_p1[x]))
         t2 = t2 + w2_7 * o
         t3 = t3 + w3_7 * o
-        o = o8[x]
+        o = ((r2_m3[x] + r2_p3[x]) + (r3_m2[x] + r3_p2[x]))
         t2 = t2 + w2_8 * o
         t3 = t3 + w3_8 * o
-        o = o9[x]
+        o = (r3_m3[x] + r3_p3[x])
         t2 = t2 + w2_9 * o
         t3 = t3 + w3_9 * o
-        o = o10[x]
+        o = ((r0_m4[x] + r0_p4[x]) + r4_p0[x])
         t3 = t3 + w3_10 * o
-        o = o11[x]
+        o = ((r1_m4[x] + r1_p4[x]) + (r4_m1[x] + r4_p1[x]))
         t3 = t3 + w3_11 * o
-        o = o12[x]
+        o = ((r2_m4[x] + r2_p4[x]) + (r4_m2[x] + r4_p2[x]))
         t3 = t3 + w3_12 * o
-        o = o13[x]
+        o = ((r3_m4[x] + r3_p4[x]) + (r4_m3[x] + r4_p3[x]))
         t3 = t3 + w3_13 * o
-        o = o14[x]
+        o = (r4_m4[x] + r4_p4[x])
         t3 = t3 + w3_14 * o
-        out0[x] = t0
-        out1[x] = t1
         out2[x] = t2
         out3[x] = t3
