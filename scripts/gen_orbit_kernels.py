@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Write ``model/sampling/orbit_kernels.py``: the per-half-width orbit sums, unrolled for numba.
+"""Write ``model/sampling/orbit_kernels.py``: the per-half-width orbit sums and the ladder
+sums (every scale of a ``1..S`` ladder in one pass), unrolled for numba.
 
 Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
 ``model/kernels/orbits.py``; ``tests/model/sampling/test_fused.py`` checks the file is up to date.
@@ -20,6 +21,11 @@ operations in the same order as :func:`rvsm.model.kernels.orbits.orbit_receptive
 starts at ``w[0] - w[0]``, i.e. 0 of the weights' type, so the same code sums integers
 exactly for the fixed twin). The weighted sum stays in a register, so the loop over
 ``x`` vectorises.
+
+``ladder_sum_S(pairs, pr, w, width, out)``: ``out[s, x]`` for every scale ``s`` of a
+ladder of half-widths ``1..S`` (weights ``w (S, N)``), two scales a loop: each orbit is
+formed once per loop and added to both scales' sums, each sum in its own order, so every
+``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and additions.
 """
 
 from numba import njit
@@ -69,7 +75,39 @@ def generate() -> str:
         for n, e in enumerate(exprs):
             out.append(f"        t = t + w[{n}] * {e}")
         out.append("        out[x] = t")
+    for scales in range(1, MAX_HALF + 1):
+        out += ["", ""] + ladder_sum(scales)
     return "\n".join(out).rstrip("\n") + "\n"
+
+
+def ladder_sum(scales: int) -> list[str]:
+    """The lines of ``ladder_sum_S`` for the ladder of half-widths ``1..S``: one loop per
+    pair of scales, forming each orbit the pair uses once and adding it to both sums (a
+    loop over more scales stores to more rows than LLVM's runtime alias checks allow: it
+    stays scalar, 2x slower; forming the orbits into a buffer first is 10 % slower)."""
+    orbits = [(a, b) for a in range(scales + 1) for b in range(a + 1)]
+    lines = ['@njit(inline="always", cache=True)',
+             f"def ladder_sum_{scales}(pairs, pr, w, width, out):"]
+    for group in [range(s0, min(s0 + 2, scales)) for s0 in range(0, scales, 2)]:
+        used = [(s + 2) * (s + 3) // 2 for s in group]  # orbits of half-width s + 1
+        exprs, rows = [], set()
+        for a, b in orbits[:max(used)]:
+            expr, r = orbit_expr(a, b)
+            exprs.append(expr)
+            rows |= r
+        for pb, d in sorted(rows):
+            lines.append(f"    {_row(pb, d)} = pairs[{pb}, pr {'-' if d < 0 else '+'} {abs(d)}]")
+        for s, n_s in zip(group, used, strict=True):
+            lines.append(f"    out{s} = out[{s}]")
+            lines += [f"    w{s}_{n} = w[{s}, {n}]" for n in range(n_s)]
+        lines.append("    for x in range(width):")
+        lines += [f"        t{s} = w{s}_0 - w{s}_0" for s in group]
+        for n, expr in enumerate(exprs):
+            lines.append(f"        o = {expr}")
+            lines += [f"        t{s} = t{s} + w{s}_{n} * o"
+                      for s, n_s in zip(group, used, strict=True) if n < n_s]
+        lines += [f"        out{s}[x] = t{s}" for s in group]
+    return lines
 
 
 def main() -> None:

@@ -2,105 +2,147 @@
 parallel, everything of a tile in cache.
 
 :func:`_event_chunk` processes tiles of ``tile_rows`` rows in parallel (``prange``); per
-tile and step it forms the brightness of the tile's rows plus a halo of ``L`` rows
-(interpolated between the chunk's frames, plus the dark current drawn inside the tile from
-the counter-based streams of :mod:`rvsm.model.noise.streams`), the log intensity, the row
-pairs and every scale's receptive sum of each row (the shared kernels of
-:mod:`rvsm.model.sampling.row_sums`, the orbit order), and applies the event rule to the
-tile's accumulators and references.
+tile and step it streams the tile's rows plus a halo of ``L`` rows, one at a time: the
+brightness (interpolated between the chunk's frames, plus the dark current drawn inside
+the tile from the counter-based streams of :mod:`rvsm.model.noise.streams`) and its log
+(:func:`.log_intensity.log_intensity_value`) in one vectorised loop, then the row's pairs
+into a ring of ``2L + 1`` rows (each stored twice, so the window around any output row is
+consecutive). Once a row's window is complete it forms every scale's receptive sum of it
+(:func:`~rvsm.model.sampling.row_sums.ladder_sum` for the ``1..S`` ladders, else
+:func:`~rvsm.model.sampling.row_sums.scale_sum` per scale; the orbit order) and applies
+the event rule to the row's accumulators and references.
 
 Every float operation is the one :mod:`.numpy_engine` does, in the same order, the log
-is the formula of :mod:`.log_intensity`, and every pixel's arithmetic depends on nothing
-but its own coordinates, so the events are bit-identical to the numpy engine for any tile
-height, chunk length and thread count.
+is the same inlined function, no loop runs under ``fastmath``, and every pixel's
+arithmetic depends on nothing but its own coordinates, so the events are bit-identical to
+the numpy engine for any tile height, chunk length and thread count. Speed and where the
+time goes: ``docs/events.md`` (section "Speed").
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 from numba import njit, prange
 
 from rvsm.model.events.config import EventConfig
+from rvsm.model.events.log_intensity import log_intensity_value
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, normal_row
 from rvsm.model.sampling.fused import chunk_frames, dark_current_stream
-from rvsm.model.sampling.row_sums import row_pairs, scale_sum
+from rvsm.model.sampling.row_sums import is_ladder, ladder_sum, scale_sum
 from rvsm.model.scene.scene import Scene
 
 __all__ = ["DEFAULT_TILE_ROWS", "FusedEventSampler"]
 
-#: Rows per tile (the log of the ``2L`` halo rows is recomputed per tile).
+#: Rows per tile (the log of the ``2L`` halo rows is recomputed per tile; a tile's
+#: references and thresholds, ``16 S W`` bytes a row, stay in L2 across steps).
 DEFAULT_TILE_ROWS = 32
 
 
 @njit(inline="always", cache=True)
 def _events_row(resp, th, rf, out, width, capture):
-    """The event rule on one row of one scale (``capture``: store the references)."""
+    """The event rule on one row of one scale (``capture``: store the references);
+    branch-free, so the loop vectorises."""
     if capture:
         for x in range(width):
             rf[x] = resp[x]
             out[x] = 0
         return
     for x in range(width):
-        d = resp[x] - rf[x]
+        r = rf[x]
+        d = resp[x] - r
         c = th[x]
-        if d >= c:
-            out[x] = 1
-            rf[x] = rf[x] + c
-        elif d <= -c:
-            out[x] = -1
-            rf[x] = rf[x] - c
+        on = d >= c
+        off = (d <= -c) & (not on)
+        out[x] = np.int8(on) - np.int8(off)
+        rf[x] = r + c if on else (r - c if off else r)
+
+
+@njit(inline="always", cache=True)
+def _log_row(frames, f, a, y, noisy, key, t, mean, sd, zx, zr, dark, width, dst):
+    """``dst[x] = L`` of row ``y`` at one step: brightness interpolated between frames
+    ``f`` and ``f + 1`` with weight ``a`` (plus the dark current), then its log."""
+    f0 = frames[f, y]
+    f1 = frames[f + 1, y] if a != 0.0 else f0
+    oma = 1.0 - a
+    if noisy:
+        normal_row(key, t, y, width, mean, sd, zx, zr, dark, 0)
+        if a == 0.0:
+            for x in range(width):
+                dst[x] = log_intensity_value(f0[x] + dark[x])
         else:
-            out[x] = 0
+            for x in range(width):
+                dst[x] = log_intensity_value((oma * f0[x] + a * f1[x]) + dark[x])
+    elif a == 0.0:
+        for x in range(width):
+            dst[x] = log_intensity_value(f0[x])
+    else:
+        for x in range(width):
+            dst[x] = log_intensity_value(oma * f0[x] + a * f1[x])
 
 
-@njit(parallel=True, cache=True)
+@njit(inline="always", cache=True)
+def _ring_pairs(pad, lmax, width, ring, k, pairs):
+    """Row pairs of the padded row ``pad (W + 2L,)`` (:func:`.row_sums.row_pairs`) into
+    ring slots ``k`` and ``k + ring`` of ``pairs (L + 1, 2 ring, W)``."""
+    mid = pad[lmax:lmax + width]
+    d0 = pairs[0, k]
+    d1 = pairs[0, k + ring]
+    for x in range(width):
+        v = mid[x]
+        d0[x] = v
+        d1[x] = v
+    for b in range(1, lmax + 1):
+        left = pad[lmax - b:lmax - b + width]
+        right = pad[lmax + b:lmax + b + width]
+        d0 = pairs[b, k]
+        d1 = pairs[b, k + ring]
+        for x in range(width):
+            v = left[x] + right[x]
+            d0[x] = v
+            d1[x] = v
+
+
+@njit(parallel=True, cache=True, error_model="numpy")
 def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean, sd,
-                 zx, zr, weights, halves, lmax, tile_rows, out):
+                 zx, zr, weights, halves, ladder, lmax, tile_rows, out):
     num_scales, height, width = thr.shape
     num_steps = fidx.shape[0]
     num_tiles = (height + tile_rows - 1) // tile_rows
+    ring = 2 * lmax + 1  # the rows one output row's sums read
     for ti in prange(num_tiles):
         y0 = ti * tile_rows
         rows = min(height, y0 + tile_rows) - y0
-        prow = rows + 2 * lmax
-        pad = np.zeros((prow, width + 2 * lmax))
-        pairs = np.empty((lmax + 1, prow, width))
+        pad = np.zeros(width + 2 * lmax)  # one row of L, zero margins
+        # Each padded row's pairs go to ring slots k and k + ring, so the 2L + 1 rows
+        # around any output row are consecutive slots (what the row sums index).
+        pairs = np.zeros((lmax + 1, 2 * ring, width))
         dark = np.empty(width)
-        resp = np.empty(width)
+        resp = np.empty((num_scales, width))
         for b in range(num_steps):
-            f = fidx[b]
-            a = aw[b]
-            oma = 1.0 - a
-            for r in range(prow):
-                y = y0 - lmax + r
-                if y < 0 or y >= height:
-                    continue  # zero padding: L = 0
-                dst = pad[r, lmax:lmax + width]
-                f0 = frames[f, y]
-                if a == 0.0:
-                    for x in range(width):
-                        dst[x] = f0[x]
-                else:
-                    f1 = frames[f + 1, y]
-                    for x in range(width):
-                        dst[x] = oma * f0[x] + a * f1[x]
-                if noisy:
-                    normal_row(key, t0 + b, y, width, mean, sd, zx, zr, dark, 0)
-                    for x in range(width):
-                        dst[x] = dst[x] + dark[x]
-                for x in range(width):
-                    v = dst[x]
-                    dst[x] = math.log((v if v > 0.0 else 0.0) + 1.0)
-            row_pairs(pad, prow, lmax, width, pairs)
             capture = capture_first and b == 0
-            for r in range(rows):
-                y = y0 + r
+            for r in range(rows + 2 * lmax):
+                y = y0 - lmax + r
+                k = r % ring
+                if y < 0 or y >= height:  # zero padding: L = 0
+                    pairs[:, k] = 0.0
+                    pairs[:, k + ring] = 0.0
+                else:
+                    _log_row(frames, fidx[b], aw[b], y, noisy, key, t0 + b, mean, sd, zx,
+                             zr, dark, width, pad[lmax:lmax + width])
+                    _ring_pairs(pad, lmax, width, ring, k, pairs)
+                if r < 2 * lmax:
+                    continue
+                yo = y - lmax  # the output row whose window ends at row y
+                pr = (r - 2 * lmax) % ring + lmax
+                if ladder:
+                    ladder_sum(pairs, pr, weights, width, resp)
+                else:
+                    for s in range(num_scales):
+                        scale_sum(pairs, pr, weights[s], halves[s], width, resp[s])
                 for s in range(num_scales):
-                    scale_sum(pairs, lmax + r, weights[s], halves[s], width, resp)
-                    _events_row(resp, thr[s, y], ref[s, y], out[b, s, y], width, capture)
+                    _events_row(resp[s], thr[s, yo], ref[s, yo], out[b, s, yo], width,
+                                capture)
 
 
 class FusedEventSampler:
@@ -114,6 +156,7 @@ class FusedEventSampler:
         self.scene = scene
         _, self.weights, self.halves, self.lmax = kernel_orbits(spec.kernels())
         self.weights = np.ascontiguousarray(self.weights, dtype=np.float64)
+        self.ladder = is_ladder(self.halves)
         self.thr = np.ascontiguousarray(thresholds, dtype=np.float64)
         self.ref = np.zeros_like(self.thr)
         self.captured: np.ndarray | None = None
@@ -149,5 +192,6 @@ class FusedEventSampler:
         frames, fidx, aw = chunk_frames(self.scene, t0, t1)
         _event_chunk(np.ascontiguousarray(frames, dtype=np.float64), fidx, aw, self.thr,
                      self.ref, t0 == 0, self.noisy, self.key, int(t0), self.mean, self.sd,
-                     ZIG_X, ZIG_RATIO, self.weights, self.halves, self.lmax, self.tile_rows,
+                     ZIG_X, ZIG_RATIO, self.weights, self.halves, self.ladder, self.lmax,
+                     self.tile_rows,
                      out)

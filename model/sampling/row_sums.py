@@ -4,8 +4,10 @@ A receptive sum of a ``(2L+1) x (2L+1)`` kernel with the 8-fold symmetry of
 :mod:`rvsm.model.kernels.orbits` needs, per padded row ``r``, the pair sums
 ``pairs[b, r, x] = v(r, x - b) + v(r, x + b)`` (``b = 0``: the value itself);
 :func:`scale_sum` then forms one scale's sum of one row from them with the unrolled orbit
-sums of :mod:`.orbit_kernels`. The same operations in the same order sum floats for
-:mod:`.fused` and exact integers for :mod:`rvsm.model.fixed.fused`.
+sums of :mod:`.orbit_kernels`, and :func:`ladder_sum` every scale of a ``1..S`` ladder
+in one pass (the same results, each orbit formed once). The same operations in the same
+order sum floats for :mod:`.fused` and :mod:`rvsm.model.events.fused` and exact integers
+for :mod:`rvsm.model.fixed.fused`.
 """
 
 from __future__ import annotations
@@ -13,6 +15,10 @@ from __future__ import annotations
 from numba import njit
 
 from rvsm.model.sampling.orbit_kernels import (
+    ladder_sum_1,
+    ladder_sum_2,
+    ladder_sum_3,
+    ladder_sum_4,
     scale_sum_0,
     scale_sum_1,
     scale_sum_2,
@@ -55,3 +61,25 @@ def scale_sum(pairs, pr, w, half, width, out):
         scale_sum_3(pairs, pr, w, width, out)
     else:
         scale_sum_4(pairs, pr, w, width, out)
+
+
+def is_ladder(halves) -> bool:
+    """True when the half-widths are ``1, 2, .., S`` (``S <= 4``): :func:`ladder_sum`
+    serves them."""
+    return 1 <= len(halves) <= 4 and [int(h) for h in halves] == list(range(1, len(halves) + 1))
+
+
+@njit(inline="always", cache=True)
+def ladder_sum(pairs, pr, w, width, out):
+    """``out[s, x]``: every scale's receptive sum of padded row ``pr`` for a ladder of
+    half-widths ``1..S`` (:func:`is_ladder`) with orbit weights ``w (S, N)``, two scales a
+    pass; equal bit for bit to :func:`scale_sum` per scale, about 2x faster for four."""
+    num_scales = w.shape[0]
+    if num_scales == 1:
+        ladder_sum_1(pairs, pr, w, width, out)
+    elif num_scales == 2:
+        ladder_sum_2(pairs, pr, w, width, out)
+    elif num_scales == 3:
+        ladder_sum_3(pairs, pr, w, width, out)
+    else:
+        ladder_sum_4(pairs, pr, w, width, out)

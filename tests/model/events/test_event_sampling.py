@@ -1,15 +1,18 @@
 """The event sensor's float model (SPEC section 7, :mod:`rvsm.model.events`): a
 hand-computed plain DVS, RVSM-DVS references and integrability, the fused engine against
-the numpy reference (bit-identical for every chunking, model and noise), validation."""
+the numpy reference (bit-identical for every chunking, tile height, thread count, model and
+noise), validation."""
 
 from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 import pytest
 
 from rvsm.model.events.config import EventConfig, contrast_thresholds
+from rvsm.model.events.fused import FusedEventSampler
 from rvsm.model.events.numpy_engine import log_brightness
 from rvsm.model.events.twin import sample_events
 from rvsm.model.infra.errors import RvsmError
@@ -68,6 +71,28 @@ def test_fused_equals_numpy(model: str, noisy: bool) -> None:
         assert np.array_equal(got.events, ref.events)
         assert np.array_equal(got.references, ref.references)
     assert np.count_nonzero(ref.events) > 0
+
+
+@pytest.mark.parametrize("noisy", [False, True])
+def test_fused_any_tile_height_and_thread_count(noisy: bool) -> None:
+    """dog4 (L = 4) on 5 rows (fewer than the 2L + 1 rows a sum reads: zero rows in the
+    fused kernel's ring) and on 20 rows, tiles of 1, 3 and 64 rows, 1 and 2 threads."""
+    cfg = EventConfig("dog4", noise=NoiseParams(k=4, seed=5) if noisy else None)
+    threads = numba.get_num_threads()
+    try:
+        for size in ((5, 11), (20, 28)):
+            scene = load_scene("flyball", size=size, num_frames=3)
+            ref = sample_events(scene, cfg, engine="numpy")
+            thr = contrast_thresholds(cfg, scene.shape)
+            for tile in (1, 3, 64):
+                for n in range(1, min(2, numba.config.NUMBA_NUM_THREADS) + 1):
+                    numba.set_num_threads(n)
+                    fused = FusedEventSampler(scene, cfg, thr, tile_rows=tile)
+                    assert np.array_equal(fused.run(0, scene.num_steps), ref.events)
+                    assert np.array_equal(fused.references, ref.references)
+            assert np.count_nonzero(ref.events) > 0
+    finally:
+        numba.set_num_threads(threads)
 
 
 def test_noise_adds_events_and_gain_scales_thresholds() -> None:
