@@ -86,9 +86,9 @@ bench-rtl: setup
 bench-sweep: setup
 	$(BIN)/python scripts/bench_sweep.py --rounds $(or $(ROUNDS),1)
 
-# the integration guide's timing diagrams, recorded from amaranth.sim (docs/integration.md)
+# the guides' timing diagrams, recorded from amaranth.sim (docs/integration.md, docs/ip.md)
 diagrams: setup
-	$(BIN)/python scripts/timing_diagrams.py --out docs/diagrams
+	$(BIN)/python scripts/timing_diagrams.py --out docs/diagrams --ip-out docs/ip
 
 lint: setup
 	$(BIN)/ruff check .

@@ -8,14 +8,13 @@ cycle; :func:`scenario_waves` turns the recording into WaveJSON (one row per sig
 renders. The diagrams are therefore the RTL's behaviour, not a drawing of it:
 ``tests/rtl/ip/test_waves.py`` regenerates them and compares with ``docs/ip/*.json``.
 
-``python -m rvsm.rtl.ip.waves docs/ip`` rewrites the JSON files and, when the
+``make diagrams`` (``scripts/timing_diagrams.py``) rewrites the JSON files and, when the
 ``wavedrom`` package is installed, their SVG renderings.
 """
 
 from __future__ import annotations
 
 import json
-import sys
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +34,7 @@ from rvsm.rtl.ip.drive import (
     wait_idle,
 )
 from rvsm.rtl.ip.wrapper import RvsmAxisIp
+from rvsm.rtl.wavejson import CycleTable
 
 __all__ = ["SCENARIOS", "diagram_contract", "scenario_waves", "write_diagrams"]
 
@@ -266,35 +266,17 @@ SCENARIOS: dict[str, tuple] = {
 }
 
 
-def _wave(row: _Row, values: list[int]) -> dict:
-    wave, data, prev = [], [], object()
-    for v in values:
-        text = row.label(v) if row.label else None
-        key = text if row.label else v
-        if key == prev:
-            wave.append(".")
-        elif row.label is None:
-            wave.append(str(v))
-        elif text is None:
-            wave.append("x")
-        else:
-            wave.append("=")
-            data.append(text)
-        prev = key
-    out = {"name": row.name, "wave": "".join(wave)}
-    if data:
-        out["data"] = data
-    return out
-
-
 def scenario_waves(name: str) -> dict:
     """The WaveJSON of scenario ``name`` (:data:`SCENARIOS`), from a fresh simulation."""
     title, depth, rows, body, steps, flush = SCENARIOS[name]
     _, chosen, samples = _record(depth, rows, body, steps, flush)
-    columns = list(zip(*samples, strict=True))
-    signal = [{"name": "clk", "wave": "p" + "." * (len(samples) - 1)}]
-    signal += [_wave(r, list(col)) for r, col in zip(chosen, columns, strict=True)]
-    return {"signal": signal, "head": {"text": title}, "config": {"hscale": 1}}
+    table = CycleTable()
+    for sample in samples:
+        table.record({r.name: (r.label(v) if r.label else bool(v))
+                      for r, v in zip(chosen, sample, strict=True)})
+    waves = table.wavejson(title)
+    waves["config"] = {"hscale": 1}
+    return waves
 
 
 def write_diagrams(out_dir: str | Path, render: bool = True) -> list[Path]:
@@ -317,8 +299,3 @@ def write_diagrams(out_dir: str | Path, render: bool = True) -> list[Path]:
             wavedrom.render(json.dumps(waves)).saveas(str(svg))
             written.append(svg)
     return written
-
-
-if __name__ == "__main__":  # pragma: no cover - the docs' regeneration command
-    for path in write_diagrams(sys.argv[1] if len(sys.argv) > 1 else "docs/ip"):
-        print(f"wrote {path}")

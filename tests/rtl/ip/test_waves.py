@@ -16,5 +16,5 @@ DOCS = Path(__file__).resolve().parents[3] / "docs" / "ip"
 def test_diagram_is_up_to_date(name: str) -> None:
     committed = json.loads((DOCS / f"{name}.json").read_text())
     assert scenario_waves(name) == committed, (
-        f"docs/ip/{name}.json is stale: python -m rvsm.rtl.ip.waves docs/ip")
+        f"docs/ip/{name}.json is stale: run `make diagrams`")
     assert (DOCS / f"{name}.svg").is_file()
