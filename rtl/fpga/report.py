@@ -192,6 +192,7 @@ class FpgaReport:
     seconds: dict[str, float] = field(default_factory=dict)
     work_dir: str = ""
     netlist: str = "verilog"
+    memory: str = "dp16kd"
     step_hz: float = CAMERA_STEP_HZ
 
     @property

@@ -280,11 +280,14 @@ class RvsmStreamArray(wiring.Component):
         r, e = geo.radius, geo.edge_groups
         row_bits = p * n
         g_in = Signal(range(g_count), name="in_group")
-        g_in_next = Mux(g_in == g_count - 1, 0, g_in + 1)
+        # g_in's successor, kept in its own register (the line buffer's read address):
+        # no counter carry chain in front of the distributed RAM's read.
+        g_in_next = Signal(range(g_count), name="in_group_next", init=1 % g_count)
         with m.If(clear):
-            m.d.sync += g_in.eq(0)
+            m.d.sync += [g_in.eq(0), g_in_next.eq(1 % g_count)]
         with m.Elif(advance):
-            m.d.sync += g_in.eq(g_in_next)
+            m.d.sync += [g_in.eq(g_in_next),
+                         g_in_next.eq(Mux(g_in_next == g_count - 1, 0, g_in_next + 1))]
         if r == 0:
             stored = Const(0, 0)
         elif g_count == 1:
@@ -349,21 +352,43 @@ class RvsmStreamArray(wiring.Component):
                 with m.If(step & last0):
                     m.d.sync += fresh0.eq(0)
         m.d.sync += [yc.eq(ny), gc.eq(ng), ac.eq(na)]
-        row_ok = Signal(2 * r + 1, name="row_mask")
-        col_ok = Signal(p + 2 * r, name="col_mask")
+        # The padding masks of the next position, from the current one: the masks of
+        # row y + 1 (column group g + 1) are constant compares of y (g), so no
+        # counter's carry chain precedes them. Held otherwise; reset to position (0, 0).
         top = 1 if self.mutation == "stream.top_padding_off_by_one" else 0
-        row_next = [(ny >= r - d - top) if d < r else (ny <= h - 1 - (d - r)) if d > r
-                    else Const(1) for d in range(2 * r + 1)]
-        col_next = []
-        for j in range(p + 2 * r):
-            if j < r:
-                col_next.append(ng >= -(-(r - j) // p))
-            elif j >= p + r:
-                right = 0 if self.mutation == "stream.right_padding_off_by_one" else 1
-                col_next.append(ng <= -(-(c.width + r - j) // p) - right)
-            else:
-                col_next.append(Const(1))
-        m.d.sync += [row_ok.eq(Cat(*row_next)), col_ok.eq(Cat(*col_next))]
+        right = 0 if self.mutation == "stream.right_padding_off_by_one" else 1
+
+        def at_least(v: Value | int, k: int) -> Value | bool:
+            return v >= k if isinstance(v, int) else (Const(1) if k <= 0 else v >= k)
+
+        def at_most(v: Value | int, k: int) -> Value | bool:
+            return v <= k if isinstance(v, int) else v <= k
+
+        def rows(y: Value | int, plus: int) -> list:
+            return [at_least(y, r - d - top - plus) if d < r
+                    else at_most(y, h - 1 - (d - r) - plus) if d > r else 1
+                    for d in range(2 * r + 1)]
+
+        def cols(g: Value | int, plus: int) -> list:
+            return [at_least(g, -(-(r - j) // p) - plus) if j < r
+                    else at_most(g, -(-(c.width + r - j) // p) - right - plus)
+                    if j >= p + r else 1 for j in range(p + 2 * r)]
+
+        def bits(values: list) -> Value:
+            return Cat(*[Const(int(v), 1) if isinstance(v, (bool, int)) else v
+                         for v in values])
+
+        def word(values: list) -> int:
+            return sum(int(v) << i for i, v in enumerate(values))
+
+        row_ok = Signal(2 * r + 1, name="row_mask", init=word(rows(0, 0)))
+        col_ok = Signal(p + 2 * r, name="col_mask", init=word(cols(0, 0)))
+        with m.If(clear):
+            m.d.sync += [row_ok.eq(row_ok.init), col_ok.eq(col_ok.init)]
+        with m.Elif(step):
+            m.d.sync += col_ok.eq(Mux(g_end, col_ok.init, bits(cols(gc, 1))))
+            with m.If(g_end):
+                m.d.sync += row_ok.eq(Mux(yc == h - 1, row_ok.init, bits(rows(yc, 1))))
         return _Centre(valid0, yc, gc, ac, fresh0, last0, row_ok, col_ok)
 
     def _window_sums(self, pipe: Pipeline, slabs: list[Signal], centre: _Centre

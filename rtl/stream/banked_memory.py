@@ -22,6 +22,10 @@ array's beat advance), so stages count beats:
   writes never match in those bits.
 * **Initial contents.** ``init_word``: every word's value at configuration (block-RAM
   initialisation; 0 by default). No reset reloads it.
+* **ECP5 block RAMs.** Elaborated for ``platform=ECP5_PLATFORM``
+  (:mod:`rvsm.rtl.fpga.ecp5_memory`, ``rvsm fpga``), each bank is an
+  :class:`~rvsm.rtl.fpga.ecp5_memory.Ecp5BlockRam`: DP16KD primitives whose output
+  register (``REGMODE_B = "OUTREG"``) is the bank register, same cycle behaviour.
 * **Formal observation.** For the ``"formal"`` platform only, ``probe_data`` shows the
   word at ``probe_addr`` (asynchronous read ports), for harnesses to state what the
   memory holds; other platforms elaborate no such port.
@@ -33,6 +37,8 @@ from amaranth.hdl import Const, Module, Mux, Shape, Signal, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
+
+from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM, Ecp5BlockRam
 
 __all__ = ["BankedMemory"]
 
@@ -79,32 +85,44 @@ class BankedMemory(wiring.Component):
         banked = len(self.bank_sizes) > 1
         offset_bits = (self.bank_words - 1).bit_length()
         outs, probes = [], []
+        ecp5 = platform == ECP5_PLATFORM
         for b, depth in enumerate(self.bank_sizes):
-            mem = Memory(shape=unsigned(self.width), depth=depth,
-                         init=[self.init_word] * depth if self.init_word else [])
-            m.submodules[f"b{b}"] = mem
-            wp = mem.write_port()
             hit = (self.write_addr >> offset_bits) == b if banked else Const(1)
-            m.d.comb += [wp.addr.eq(self.write_addr[:offset_bits] if banked
-                                    else self.write_addr),
-                         wp.data.eq(self.write_data), wp.en.eq(self.write_en & hit)]
-            if platform == "formal":
-                probe = mem.read_port(domain="comb")
-                m.d.comb += probe.addr.eq(self.probe_addr[:offset_bits] if banked
-                                          else self.probe_addr)
-                probes.append(probe.data)
-            rp = mem.read_port()
-            m.d.comb += rp.addr.eq(self.read_addr[:offset_bits] if banked else self.read_addr)
-            if self.guard_bits is None:
-                collide = wp.en & (wp.addr == rp.addr)
+            wr_en = self.write_en & hit
+            if ecp5:  # the bank register is the block RAM's output register
+                ram = Ecp5BlockRam(self.width, depth, self.init_word)
+                m.submodules[f"b{b}"] = ram
+                wr_addr, rd_addr, rd_en = ram.write_addr, ram.read_addr, ram.read_en
+                m.d.comb += [ram.write_en.eq(wr_en), ram.write_data.eq(self.write_data),
+                             ram.out_en.eq(self.advance)]
+                outs.append(ram.data)
             else:
-                k = min(self.guard_bits, len(rp.addr))
-                collide = self.may_write & hit & (wp.addr[:k] == rp.addr[:k])
-            m.d.comb += rp.en.eq(self.advance & ~collide)
-            reg = Signal(unsigned(self.width), name=f"b{b}_q", reset_less=True)
-            with m.If(self.advance):
-                m.d.sync += reg.eq(rp.data)
-            outs.append(reg)
+                mem = Memory(shape=unsigned(self.width), depth=depth,
+                             init=[self.init_word] * depth if self.init_word else [])
+                m.submodules[f"b{b}"] = mem
+                wp = mem.write_port()
+                m.d.comb += [wp.data.eq(self.write_data), wp.en.eq(wr_en)]
+                if platform == "formal":
+                    probe = mem.read_port(domain="comb")
+                    m.d.comb += probe.addr.eq(self.probe_addr[:offset_bits] if banked
+                                              else self.probe_addr)
+                    probes.append(probe.data)
+                rp = mem.read_port()
+                wr_addr, rd_addr, rd_en = wp.addr, rp.addr, rp.en
+                reg = Signal(unsigned(self.width), name=f"b{b}_q", reset_less=True)
+                with m.If(self.advance):
+                    m.d.sync += reg.eq(rp.data)
+                outs.append(reg)
+            m.d.comb += [wr_addr.eq(self.write_addr[:offset_bits] if banked
+                                    else self.write_addr),
+                         rd_addr.eq(self.read_addr[:offset_bits] if banked
+                                    else self.read_addr)]
+            if self.guard_bits is None:
+                collide = wr_en & (wr_addr == rd_addr)
+            else:
+                k = min(self.guard_bits, len(rd_addr))
+                collide = self.may_write & hit & (wr_addr[:k] == rd_addr[:k])
+            m.d.comb += rd_en.eq(self.advance & ~collide)
         out = outs[-1]
         for b in range(len(outs) - 2, -1, -1):
             out = Mux(self.read_bank == b, outs[b], out)

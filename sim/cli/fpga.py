@@ -41,8 +41,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--synth-only", action="store_true",
                    help="stop after synthesis: area from yosys, no Fmax")
     p.add_argument("--rtlil", action="store_true",
-                   help="hand yosys Amaranth's RTLIL instead of Verilog (faster to read; "
-                   "the same netlist)")
+                   help="hand yosys Amaranth's RTLIL instead of Verilog (faster to read, "
+                   "but yosys then keeps every inferred memory read port's read-first "
+                   "behaviour and emulates it: see docs/fpga.md)")
+    p.add_argument("--memory", choices=("dp16kd", "inferred"), default="dp16kd",
+                   help="state memories as DP16KD instances with the output register on "
+                   "(default) or inferred by yosys (the bank register in fabric)")
     p.add_argument("--seed", type=int, default=1, help="placer seed (default 1)")
     p.add_argument("--timeout", type=float, metavar="S",
                    help="stop a tool that runs longer than S seconds (exit 3)")
@@ -75,7 +79,8 @@ def _fpga(args: argparse.Namespace) -> int:
                       size=args.size,
                       device=args.device, speed=args.speed, target_mhz=args.freq,
                       synth_only=args.synth_only, seed=args.seed,
-                      netlist="rtlil" if args.rtlil else "verilog", on_progress=progress,
+                      netlist="rtlil" if args.rtlil else "verilog", memory=args.memory,
+                      on_progress=progress,
                       timeout=args.timeout)
     print(report.to_json() if args.json else report.table())
     return 0
