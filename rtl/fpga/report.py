@@ -193,6 +193,7 @@ class FpgaReport:
     work_dir: str = ""
     netlist: str = "verilog"
     memory: str = "dp16kd"
+    seed: int | None = None
     step_hz: float = CAMERA_STEP_HZ
 
     @property

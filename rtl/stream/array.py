@@ -78,7 +78,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from amaranth.hdl import Cat, Const, Module, Mux, Signal, Value, signed, unsigned
+from amaranth.hdl import Cat, Const, Module, Mux, ResetSignal, Signal, Value, signed, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -114,6 +114,7 @@ class _Centre:
     last0: Value
     row_ok: Signal
     col_ok: Signal
+    next_addr: Value
 
 
 @dataclass(frozen=True)
@@ -121,6 +122,7 @@ class _Tail:
     """What the state memories and the tail need from the position pipeline."""
 
     rd_addr: Value
+    rd_addr_next: Value
     rd_valid: Value
     bank_q: Value
     fresh_q: Value
@@ -389,7 +391,7 @@ class RvsmStreamArray(wiring.Component):
             m.d.sync += col_ok.eq(Mux(g_end, col_ok.init, bits(cols(gc, 1))))
             with m.If(g_end):
                 m.d.sync += row_ok.eq(Mux(yc == h - 1, row_ok.init, bits(rows(yc, 1))))
-        return _Centre(valid0, yc, gc, ac, fresh0, last0, row_ok, col_ok)
+        return _Centre(valid0, yc, gc, ac, fresh0, last0, row_ok, col_ok, na)
 
     def _window_sums(self, pipe: Pipeline, slabs: list[Signal], centre: _Centre
                      ) -> tuple[list[list[Timed]], int]:
@@ -431,6 +433,11 @@ class RvsmStreamArray(wiring.Component):
         addr0, fresh_t, row_t = pipe.timed(ac), pipe.timed(fresh0), pipe.timed(yc)
         group_t, last_t = pipe.timed(gc), pipe.timed(last0)
         rd_addr = pipe.at(addr0, stage_q - 2).value
+        # the value rd_addr takes at the next edge (for comparators registered ahead)
+        if stage_q == 2:  # rd_addr is the centre address itself (reset to 0)
+            rd_addr_next = Mux(ResetSignal(), 0, centre.next_addr)
+        else:
+            rd_addr_next = Mux(advance, pipe.at(addr0, stage_q - 3).value, rd_addr)
         bank_q = pipe.at(addr0, stage_q).value >> (geo.bank_words - 1).bit_length()
         fresh_q = pipe.at(fresh_t, stage_q).value
         tail = stage_q + geo.TAIL_STAGES - 1  # the stage that writes back
@@ -438,7 +445,7 @@ class RvsmStreamArray(wiring.Component):
         out_row, out_group = pipe.at(row_t, tail).value, pipe.at(group_t, tail).value
         out_last = pipe.at(last_t, tail).value
         wr_en = advance & valid[tail]
-        return _Tail(rd_addr, valid[stage_q - 2], bank_q, fresh_q, wr_addr, wr_en,
+        return _Tail(rd_addr, rd_addr_next, valid[stage_q - 2], bank_q, fresh_q, wr_addr, wr_en,
                      valid[tail], out_row, out_group, out_last)
 
     def _state_and_output(self, m: Module, advance: Signal, sums: list[list[Timed]],
@@ -464,6 +471,11 @@ class RvsmStreamArray(wiring.Component):
         m.d.sync += [bus_we.eq(bus.we), bus_addr.eq(bus.addr), bus_data.eq(bus.data)]
         bus_word = bus_addr[:word_bits]
         bus_scale = bus_addr[word_bits:]
+        # bus_addr == rd_addr, registered: compared one edge ahead from the values both
+        # take at that edge (the bus register loads every cycle), so no comparator sits
+        # between the read address and the block RAMs' read enables or the forwarding.
+        rd_match = Signal(name="thr_rd_match", init=1, reset_less=True)
+        m.d.sync += rd_match.eq(bus.addr[:word_bits] == tail.rd_addr_next)
         fwd_data = [Signal.like(bus.data, name=f"thr_fwd{k}_data", reset_less=True)
                     for k in (1, 2)]  # shared by the scales
         with m.If(advance):
@@ -476,15 +488,17 @@ class RvsmStreamArray(wiring.Component):
             after_lanes = []
             probes.append([])
             thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True,
-                                   init_word=top_threshold_word(tw, p))  # module docstring
+                                   init_word=top_threshold_word(tw, p),  # module docstring
+                                   same_addr=True)
             m.submodules[f"thr_s{s}"] = thr_mem
             thr_memories.append(thr_mem)
             m.d.comb += [thr_mem.advance.eq(advance), thr_mem.read_addr.eq(rd_addr),
                          thr_mem.read_bank.eq(bank_q),
                          thr_mem.write_en.eq(bus_we & (bus_scale == s)),
                          thr_mem.write_addr.eq(bus_word), thr_mem.write_data.eq(bus_data),
+                         thr_mem.same_addr.eq(rd_match),
                          thr_mem.forward_hit.eq(
-                             bus_we & (bus_scale == s) & (bus_word == rd_addr)
+                             bus_we & (bus_scale == s) & rd_match
                              if self.mutation != "stream.no_threshold_forwarding" else 0),
                          thr_mem.forward_data.eq(fwd_data[1])]
             thr_q = thr_mem.data

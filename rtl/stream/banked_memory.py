@@ -19,7 +19,10 @@ array's beat advance), so stages count beats:
   alike: two ``advance`` edges) instead of the read. ``guard_bits = k`` adds
   ``may_write`` and gates the read where ``may_write`` holds and the low ``k`` address
   bits match: a cheaper superset of the collisions, for a memory whose valid reads and
-  writes never match in those bits.
+  writes never match in those bits. ``same_addr=True`` adds ``same_addr``: the user's
+  own (e.g. registered) ``write_addr == read_addr``, used instead of the comparator in
+  the ECP5 build (the generic build keeps its comparator, from which yosys proves the
+  collisions harmless).
 * **Initial contents.** ``init_word``: every word's value at configuration (block-RAM
   initialisation; 0 by default). No reset reloads it.
 * **ECP5 block RAMs.** Elaborated for ``platform=ECP5_PLATFORM``
@@ -47,10 +50,12 @@ class BankedMemory(wiring.Component):
     """``depth`` words of ``width`` bits in banks of ``bank_words``; see the module
     docstring for the ports ``advance``, ``read_addr``, ``read_bank``, ``write_en``,
     ``write_addr``, ``write_data``, ``data`` and the optional ``forward_hit``,
-    ``forward_data`` (``forward=True``) and ``may_write`` (``guard_bits``)."""
+    ``forward_data`` (``forward=True``), ``may_write`` (``guard_bits``) and ``same_addr``
+    (``same_addr=True``)."""
 
     def __init__(self, width: int, depth: int, bank_words: int, forward: bool = False,
-                 guard_bits: int | None = None, init_word: int = 0):
+                 guard_bits: int | None = None, init_word: int = 0,
+                 same_addr: bool = False):
         self.width = width
         self.init_word = init_word
         self.depth = depth
@@ -77,6 +82,9 @@ class BankedMemory(wiring.Component):
             members.update(forward_hit=In(1), forward_data=In(unsigned(width)))
         if guard_bits is not None:
             members["may_write"] = In(1)
+        if same_addr:
+            members["same_addr"] = In(1)
+        self.same_addr_input = same_addr
         super().__init__(members)
 
     def elaborate(self, platform: object) -> Module:
@@ -117,7 +125,9 @@ class BankedMemory(wiring.Component):
                                     else self.write_addr),
                          rd_addr.eq(self.read_addr[:offset_bits] if banked
                                     else self.read_addr)]
-            if self.guard_bits is None:
+            if ecp5 and self.same_addr_input:
+                collide = wr_en & self.same_addr
+            elif self.guard_bits is None:
                 collide = wr_en & (wr_addr == rd_addr)
             else:
                 k = min(self.guard_bits, len(rd_addr))
