@@ -432,20 +432,22 @@ class RvsmStreamArray(wiring.Component):
             valid.append(v)
         addr0, fresh_t, row_t = pipe.timed(ac), pipe.timed(fresh0), pipe.timed(yc)
         group_t, last_t = pipe.timed(gc), pipe.timed(last0)
-        rd_addr = pipe.at(addr0, stage_q - 2).value
+        read = geo.read_stage
+        rd_addr = pipe.at(addr0, read).value
         # the value rd_addr takes at the next edge (for comparators registered ahead)
-        if stage_q == 2:  # rd_addr is the centre address itself (reset to 0)
+        if read == 0:  # rd_addr is the centre address itself (reset to 0)
             rd_addr_next = Mux(ResetSignal(), 0, centre.next_addr)
         else:
-            rd_addr_next = Mux(advance, pipe.at(addr0, stage_q - 3).value, rd_addr)
-        bank_q = pipe.at(addr0, stage_q).value >> (geo.bank_words - 1).bit_length()
+            rd_addr_next = Mux(advance, pipe.at(addr0, read - 1).value, rd_addr)
+        # the banks' output registers hold the read two edges on: select among them there
+        bank_q = pipe.at(addr0, read + 2).value >> (geo.bank_words - 1).bit_length()
         fresh_q = pipe.at(fresh_t, stage_q).value
         tail = stage_q + geo.TAIL_STAGES - 1  # the stage that writes back
         wr_addr = pipe.at(addr0, tail).value
         out_row, out_group = pipe.at(row_t, tail).value, pipe.at(group_t, tail).value
         out_last = pipe.at(last_t, tail).value
         wr_en = advance & valid[tail]
-        return _Tail(rd_addr, rd_addr_next, valid[stage_q - 2], bank_q, fresh_q, wr_addr, wr_en,
+        return _Tail(rd_addr, rd_addr_next, valid[read], bank_q, fresh_q, wr_addr, wr_en,
                      valid[tail], out_row, out_group, out_last)
 
     def _state_and_output(self, m: Module, advance: Signal, sums: list[list[Timed]],
@@ -489,7 +491,7 @@ class RvsmStreamArray(wiring.Component):
             probes.append([])
             thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True,
                                    init_word=top_threshold_word(tw, p),  # module docstring
-                                   same_addr=True)
+                                   same_addr=True, read_stages=geo.READ_STAGES)
             m.submodules[f"thr_s{s}"] = thr_mem
             thr_memories.append(thr_mem)
             m.d.comb += [thr_mem.advance.eq(advance), thr_mem.read_addr.eq(rd_addr),
@@ -504,7 +506,7 @@ class RvsmStreamArray(wiring.Component):
             thr_q = thr_mem.data
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
             acc_mem = BankedMemory(p * wa, words, geo.bank_words,
-                                   guard_bits=geo.rmw_guard_bits)
+                                   guard_bits=geo.rmw_guard_bits, read_stages=geo.READ_STAGES)
             m.submodules[f"acc_s{s}"] = acc_mem
             m.d.comb += [acc_mem.advance.eq(advance), acc_mem.read_addr.eq(rd_addr),
                          acc_mem.read_bank.eq(bank_q), acc_mem.write_en.eq(wr_en),

@@ -8,7 +8,8 @@ array's beat advance), so stages count beats:
 * **Read.** ``read_addr`` is sampled at an ``advance`` edge; the bank's data is
   registered at the next ``advance`` edge and multiplexed by ``read_bank``, which must
   be the bank of that address delayed alike (one ``advance`` edge). ``data`` is the
-  result.
+  result (``read_stages=2``), or that result registered at the third ``advance`` edge
+  (``read_stages=3``: a registered bank multiplexer, forwarding included).
 * **Write.** One port: ``write_en``, ``write_addr``, ``write_data`` (the enable is used
   as given; gate it with ``advance`` outside).
 * **Collisions.** A bank's read is disabled at an edge where the write port writes its
@@ -55,7 +56,10 @@ class BankedMemory(wiring.Component):
 
     def __init__(self, width: int, depth: int, bank_words: int, forward: bool = False,
                  guard_bits: int | None = None, init_word: int = 0,
-                 same_addr: bool = False):
+                 same_addr: bool = False, read_stages: int = 2):
+        if read_stages not in (2, 3):
+            raise ValueError(f"read_stages must be 2 or 3, got {read_stages}")
+        self.read_stages = read_stages
         self.width = width
         self.init_word = init_word
         self.depth = depth
@@ -147,5 +151,10 @@ class BankedMemory(wiring.Component):
             with m.If(self.advance):
                 m.d.sync += [hit1.eq(self.forward_hit), hit2.eq(hit1)]
             out = Mux(hit2, self.forward_data, out)
+        if self.read_stages == 3:  # the registered bank multiplexer
+            muxed = Signal(unsigned(self.width), name="data_q", reset_less=True)
+            with m.If(self.advance):
+                m.d.sync += muxed.eq(out)
+            out = muxed
         m.d.comb += self.data.eq(out)
         return m
