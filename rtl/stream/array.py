@@ -537,6 +537,7 @@ class RvsmStreamArray(wiring.Component):
                 else:
                     tail_stmts += self._spike_tail(acc, shifted, thr_q[i * tw:(i + 1) * tw],
                                                    total, thr1, sat, thr2, pos, neg)
+                    neg = neg & ~pos  # the register holds the compare alone (docstring)
                     if self.mutation == "stream.no_reset_on_spike":
                         after = sat
                     elif c.reset == "zero" or \
@@ -566,8 +567,10 @@ class RvsmStreamArray(wiring.Component):
                     thr1: Signal, sat: Signal, thr2: Signal, pos: Signal, neg: Signal
                     ) -> list:
         """The spike camera's tail for one lane and scale: stage 1 ``total = acc +
-        shifted`` and the threshold; stage 2 saturation, fire and the threshold kept for
-        the reset (the caller's ``after``)."""
+        shifted``, the threshold and its negation; stage 2 saturation, ``pos = total >=
+        thr``, ``neg = total <= -thr`` (the caller masks it with ``~pos``: the two compares
+        are independent carry chains) and the threshold kept for the reset (the caller's
+        ``after``)."""
         c = self.contract
         wa = c.accumulator_bits
         lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
@@ -577,9 +580,10 @@ class RvsmStreamArray(wiring.Component):
         elif self.mutation == "stream.stale_threshold":
             fire_pos = total >= thr2  # the previous position's threshold
         # -thr is registered beside thr (stage 1), so the negative compare is one carry
-        # chain like the positive one (not a negation chain followed by a compare)
+        # chain like the positive one (not a negation chain followed by a compare); the
+        # neg register holds that compare alone, and the caller takes ~pos & neg
         neg_thr1 = Signal(signed(len(thr) + 1), name=f"n{thr1.name}", reset_less=True)
-        fire_neg = (~fire_pos & (total <= neg_thr1)) if c.signed else Const(0)
+        fire_neg = (total <= neg_thr1) if c.signed else Const(0)
         if self.mutation == "stream.no_negative_spikes":
             fire_neg = Const(0)
         return [
