@@ -118,7 +118,7 @@ def _run(tmp_path: Path, generic: str, fpga: str, tb: str) -> dict[str, int]:
                          capture_output=True, text=True, timeout=120).stdout
     found = re.search(r"RESULT errors=(\d+) valid=(\d+) fired=(\d+)", out)
     assert found, out
-    return dict(zip(("errors", "valid", "fired"), map(int, found.groups())))
+    return dict(zip(("errors", "valid", "fired"), map(int, found.groups()), strict=True))
 
 
 @pytest.mark.skipif(shutil.which("iverilog") is None, reason="needs Icarus Verilog")
