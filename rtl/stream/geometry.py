@@ -34,8 +34,10 @@ class StreamGeometry:
     schedule or the named timing properties are needed (e.g. by a testbench).
     """
 
-    #: Adder levels between pipeline registers in the receptive-sum trees.
-    LEVELS_PER_STAGE = 2
+    #: Adder levels between pipeline registers in the receptive-sum trees (1: one carry
+    #: chain per register stage, the ECP5 timing at 150 MHz; 2 placed P = 1 at 145 MHz,
+    #: two chained adders being the critical path).
+    LEVELS_PER_STAGE = 1
     #: Default largest number of words in one bank of a state memory (one ECP5 DP16KD
     #: holds 1024 words of up to 18 bits; wider words use several in parallel).
     BANK_WORDS = 1024
@@ -66,7 +68,7 @@ class StreamGeometry:
         self.edge_groups = -(-self.radius // self.lanes)
         self.orbits = weighted_orbits(c.weights)
         self.beats_per_frame = c.height * self.groups
-        self.sum_stage = self.build_sums(Pipeline(None), None)[1]
+        self.sum_stage = self.build_sums(Pipeline(None, None, self.LEVELS_PER_STAGE), None)[1]
         if self.beats_per_frame <= self.rmw_depth:
             raise RvsmError(
                 f"the stream array needs more than {self.rmw_depth} beats per frame (its "
