@@ -567,29 +567,30 @@ class RvsmStreamArray(wiring.Component):
                     thr1: Signal, sat: Signal, thr2: Signal, pos: Signal, neg: Signal
                     ) -> list:
         """The spike camera's tail for one lane and scale: stage 1 ``total = acc +
-        shifted``, the threshold and its negation; stage 2 saturation, ``pos = total >=
+        shifted``, the threshold and the threshold less one; stage 2 saturation, ``pos = total >=
         thr``, ``neg = total <= -thr`` (the caller masks it with ``~pos``: the two compares
         are independent carry chains) and the threshold kept for the reset (the caller's
         ``after``)."""
         c = self.contract
         wa = c.accumulator_bits
         lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
-        fire_pos = total >= thr1
+        # Both compares are the sign of one subtraction (one carry chain each, no
+        # sign-extension logic after it): total >= thr is ~sign(total - thr), and
+        # total <= -thr is sign(total + (thr - 1)), thr - 1 registered beside thr. The
+        # neg register holds that compare alone; the caller takes ~pos & neg.
+        fire_pos = ~(total - thr1)[-1]
         if self.mutation == "stream.threshold_off_by_one":
             fire_pos = total > thr1
         elif self.mutation == "stream.stale_threshold":
             fire_pos = total >= thr2  # the previous position's threshold
-        # -thr is registered beside thr (stage 1), so the negative compare is one carry
-        # chain like the positive one (not a negation chain followed by a compare); the
-        # neg register holds that compare alone, and the caller takes ~pos & neg
-        neg_thr1 = Signal(signed(len(thr) + 1), name=f"n{thr1.name}", reset_less=True)
-        fire_neg = (total <= neg_thr1) if c.signed else Const(0)
+        thr1_m1 = Signal(signed(len(thr) + 1), name=f"{thr1.name}_m1", reset_less=True)
+        fire_neg = (total + thr1_m1)[-1] if c.signed else Const(0)
         if self.mutation == "stream.no_negative_spikes":
             fire_neg = Const(0)
         return [
             total.eq(acc + shifted),
             thr1.eq(thr),
-            *([neg_thr1.eq(-thr)] if c.signed else []),
+            *([thr1_m1.eq(thr.as_unsigned() - 1)] if c.signed else []),
             sat.eq(total[:wa].as_signed()
                    if self.mutation == "stream.no_saturation"  # wraps around
                    else Mux(total > hi, hi, Mux(total < lo, lo, total))),
