@@ -80,7 +80,7 @@ def test_depth_is_two_frames_plus_the_lag(formal_point):
     contract = _contract(formal_point)
     geo = StreamGeometry(contract, 2)
     for harness in (StreamProperties(contract, 2), StreamEquivalence(contract, 2)):
-        assert harness.depth == 2 * geo.beats_per_frame + geo.lag + 2 == 23
+        assert harness.depth == 2 * geo.beats_per_frame + geo.lag + 2 == 25
         harness.statements()
 
 
