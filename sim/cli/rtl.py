@@ -159,9 +159,9 @@ def _verilog(args: argparse.Namespace) -> int:
     if args.stats:
         st = yosys_stats(paths["verilog"], args.top)
         pixels = contract.height * contract.width
-        print(f"yosys synth (generic gates, memories kept as memories): {st['cells']} "
-              f"cells, {st['flip_flops']} flip-flops, {st['memories']} memories of "
-              f"{st['memory_bits']:,} bits in all ({st['cells'] / pixels:.1f} cells, "
+        print(f"yosys synth: {st['cells']} cells, {st['flip_flops']} flip-flops, "
+              f"{st['memories']} memories of {st['memory_bits']:,} bits in all (generic "
+              f"gates, memories kept as memories; {st['cells'] / pixels:.1f} cells, "
               f"{st['flip_flops'] / pixels:.1f} FFs and {st['memory_bits'] / pixels:.1f} "
               f"memory bits per pixel; {st['seconds']:.1f} s)")
         for mem in st["memory_list"]:
