@@ -276,14 +276,22 @@ def icarus_lint(verilog_path: str | os.PathLike) -> str:
 _FF_RE = re.compile(r"^\$_(S?DFF|DFFE|SDFFE|SDFFCE|DFFSR|DFFSRE|ALDFF|ALDFFE|DLATCH)")
 
 
-def yosys_stats(verilog_path: str | os.PathLike, top: str | None = None) -> dict:
-    """Synthesise with the system ``yosys`` (``synth -flatten``); cells and flip-flops.
+_MEMORY_RE = re.compile(r"cell \$mem_v2 (\S+)\n(.*?)\n  end", re.S)
 
-    ``top`` defaults to the file's name without ``.v``.
+
+def yosys_stats(verilog_path: str | os.PathLike, top: str | None = None) -> dict:
+    """Synthesise with the system ``yosys`` to generic gates, memories kept as memories.
+
+    ``synth -flatten -run :fine`` (the coarse passes, memories as ``$mem_v2`` cells),
+    then the fine passes without ``memory_map``: the state memories are counted as
+    memory bits instead of being turned into flip-flops. ``top`` defaults to the file's
+    name without ``.v``.
 
     The Verilog path reaches yosys as its own argument (never inside the script text), so
     any path works and none is interpreted. Returns ``{"cells", "flip_flops",
-    "cell_types", "seconds"}``. Raises :class:`RvsmError` if ``yosys`` is missing, a
+    "memories", "memory_bits", "memory_list", "cell_types", "seconds"}`` (``cells``
+    counts each memory as one cell; ``memory_list``: name, words, width). Raises
+    :class:`RvsmError` if ``yosys`` is missing, a
     :class:`~rvsm.model.infra.tools.ToolFailure` (exit 3) if it fails or is killed.
     """
     exe = shutil.which("yosys")
@@ -293,16 +301,28 @@ def yosys_stats(verilog_path: str | os.PathLike, top: str | None = None) -> dict
     if path.suffix != ".v" or not path.is_file():
         raise RvsmError(f"yosys_stats needs an existing .v file, got {path}")
     t0 = time.perf_counter()
-    script = (f"synth -flatten -top {check_top(top or path.stem)}; "
-              "tee -q -o /dev/stdout stat -json")
+    script = (f"synth -flatten -top {check_top(top or path.stem)} -run :fine; "
+              "opt -fast -full; techmap; opt -fast; abc -fast; opt -fast; "
+              "tee -q -a /dev/stdout stat -json; tee -q -a /dev/stdout dump t:$mem_v2")
     proc = run_tool([exe, "-q", "-p", script, str(path.resolve())], tool="yosys",
                     capture=True)
     text = proc.stdout
     if "{" not in text:
         raise ToolError(f"yosys printed no statistics for {path}")
-    data = json.loads(text[text.index("{"):])
+    data, end = json.JSONDecoder().raw_decode(text[text.index("{"):])
     design = data.get("design") or next(iter(data["modules"].values()))
     types: dict[str, int] = design.get("num_cells_by_type", {})
     ffs = sum(n for t, n in types.items() if _FF_RE.match(t))
+    memories = []
+    for name, body in _MEMORY_RE.findall(text[text.index("{") + end:]):
+        params = dict(re.findall(r"parameter \\(SIZE|WIDTH) (\d+)\n", body + "\n"))
+        memories.append({"name": name.lstrip("\\"), "words": int(params["SIZE"]),
+                         "width": int(params["WIDTH"])})
+    if len(memories) != types.get("$mem_v2", 0):
+        raise ToolError(f"yosys listed {len(memories)} of {types.get('$mem_v2', 0)} "
+                        f"memories for {path}")
     return {"cells": int(design["num_cells"]), "flip_flops": int(ffs),
+            "memories": len(memories),
+            "memory_bits": sum(m["words"] * m["width"] for m in memories),
+            "memory_list": memories,
             "cell_types": types, "seconds": time.perf_counter() - t0}

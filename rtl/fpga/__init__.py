@@ -3,6 +3,7 @@
 Modules (import them directly; this package imports nothing, so the CLI starts fast):
 :mod:`.harness` (I/O harness for any component), :mod:`.devices` (ECP5 parts),
 :mod:`.tools` (running the tools), :mod:`.flow` (Verilog -> synthesis -> place and
-route), :mod:`.report` (parsing, :class:`~.report.FpgaReport`), :mod:`.sensor` (camera
+route, several placer seeds), :mod:`.ecp5_memory` (state-memory banks as DP16KD with the
+output register), :mod:`.report` (parsing, :class:`~.report.FpgaReport`), :mod:`.sensor` (camera
 throughput and state-memory arithmetic).
 """

@@ -121,8 +121,9 @@ def lane_synthesis(
     with tempfile.TemporaryDirectory(prefix="rvsm-lane-cost-") as tmp:
         root = Path(work_dir) if work_dir is not None else Path(tmp)
         component, _ = build_component(contract, "stream", lanes=lanes)
+        # inferred memories: the figures sweeps have always stored (bank registers in FF)
         syn = synthesise(component, root / f"p{lanes}", netlist="verilog",
-                         on_progress=on_progress, timeout=timeout)
+                         memory="inferred", on_progress=on_progress, timeout=timeout)
         fmax_mhz = None
         if fmax:
             pnr, _ = place_and_route(syn, get_device(device), on_progress=on_progress,

@@ -31,6 +31,7 @@ from rvsm.rtl.fpga.sensor import (
 __all__ = [
     "CriticalPath",
     "FpgaReport",
+    "LaneSlope",
     "Usage",
     "parse_nextpnr_report",
     "parse_yosys_stat",
@@ -159,6 +160,43 @@ def parse_nextpnr_report(data: dict) -> dict[str, Any]:
     }
 
 
+@dataclass(frozen=True)
+class LaneSlope:
+    """Logic per lane as the slope between two lane counts (yosys counts, harness
+    excluded): ``lanes`` (P1, P2), LUT4 sites (``LUT4 + 2 CCU2C + 4 TRELLIS_DPR16X4``)
+    and flip-flops at each, the per-lane slopes and the fixed part at zero lanes."""
+
+    lanes: tuple[int, int]
+    lut4: tuple[int, int]
+    ff: tuple[int, int]
+
+    @property
+    def lut4_per_lane(self) -> float:
+        """``(LUT4(P2) - LUT4(P1)) / (P2 - P1)``."""
+        return (self.lut4[1] - self.lut4[0]) / (self.lanes[1] - self.lanes[0])
+
+    @property
+    def ff_per_lane(self) -> float:
+        """``(FF(P2) - FF(P1)) / (P2 - P1)``."""
+        return (self.ff[1] - self.ff[0]) / (self.lanes[1] - self.lanes[0])
+
+    @property
+    def lut4_fixed(self) -> float:
+        """LUT4 at zero lanes: ``LUT4(P1) - P1 * slope``."""
+        return self.lut4[0] - self.lanes[0] * self.lut4_per_lane
+
+    @property
+    def ff_fixed(self) -> float:
+        """Flip-flops at zero lanes."""
+        return self.ff[0] - self.lanes[0] * self.ff_per_lane
+
+    def to_dict(self) -> dict[str, Any]:
+        """Fields and the derived slopes and fixed parts."""
+        return {"lanes": list(self.lanes), "lut4": list(self.lut4), "ff": list(self.ff),
+                "lut4_per_lane": self.lut4_per_lane, "ff_per_lane": self.ff_per_lane,
+                "lut4_fixed": self.lut4_fixed, "ff_fixed": self.ff_fixed}
+
+
 @dataclass
 class FpgaReport:
     """Area, timing and sensor arithmetic of one array on one ECP5.
@@ -192,11 +230,15 @@ class FpgaReport:
     seconds: dict[str, float] = field(default_factory=dict)
     work_dir: str = ""
     netlist: str = "verilog"
+    memory: str = "dp16kd"
+    seed: int | None = None
+    slope: LaneSlope | None = None
     step_hz: float = CAMERA_STEP_HZ
 
     @property
     def lut4_per_lane(self) -> float:
-        """LUT4 sites per lane, harness included."""
+        """LUT4 sites divided by the lanes, harness and fixed part included (the slope
+        without them is :attr:`slope`, when measured)."""
         return self.lut4.used / self.lanes
 
     @property
@@ -243,7 +285,16 @@ class FpgaReport:
         )
         if self.critical_path is not None:
             d["critical_path"]["summary"] = self.critical_path.summary()
+        d["slope"] = self.slope.to_dict() if self.slope is not None else None
+        d["sensor_lanes_extrapolated"] = self.lanes_extrapolated
         return json.dumps(d)
+
+    @property
+    def lanes_extrapolated(self) -> bool | None:
+        """Whether :attr:`lanes_needed` differs from the lanes Fmax was measured at (an
+        extrapolation: a wider array routes longer nets); ``None`` without Fmax."""
+        need = self.lanes_needed
+        return None if self.fmax_mhz is None else need != self.lanes
 
     def table(self) -> str:
         """Human-readable report (one fact per line)."""
@@ -258,22 +309,33 @@ class FpgaReport:
         ]
         if self.fmax_mhz is not None:
             ok = "meets" if self.fmax_mhz >= self.target_mhz else "misses"
+            seed = f", placer seed {self.seed}" if self.seed is not None else ""
             rows.append(f"Fmax          {self.fmax_mhz:.1f} MHz ({ok} the {self.target_mhz:g} "
-                        "MHz target)")
-            if self.critical_path is not None and self.fmax_mhz < self.target_mhz:
-                rows.append(f"critical path {self.critical_path.summary()}")
+                        f"MHz target{seed})")
+            rows.append("critical path " + (self.critical_path.summary()
+                                            if self.critical_path is not None else
+                                            "not in nextpnr's report"))
         else:
             rows.append("Fmax          not measured (synthesis only; area from yosys)")
         src = "nextpnr" if self.mode == "place-and-route" else "yosys"
         rows += [
             f"LUT4          {self.lut4.used:,} / {self.lut4.available:,} "
-            f"({self.lut4.percent:.1f} %, {src}); {self.lut4_per_lane:,.0f} per lane",
+            f"({self.lut4.percent:.1f} %, {src}); {self.lut4_per_lane:,.0f} per lane with "
+            "the fixed part" + ("" if self.slope else " (--slope-lanes: the slope)"),
             f"FF            {self.ff.used:,} / {self.ff.available:,} ({self.ff.percent:.1f} %)",
             f"block RAM     {self.bram.used} / {self.bram.available} DP16KD "
-            f"({self.bram.percent:.1f} %)",
+            f"({self.bram.percent:.1f} %), state memories "
+            + ("instantiated with the output register" if self.memory == "dp16kd"
+               else "inferred by yosys"),
             f"I/O harness   {self.harness_ff:,} FF and about {self.harness_lut4:,} LUT4 of "
             "the above (LFSR stimulus, XOR-compacted outputs)",
         ]
+        if self.slope is not None:
+            sl = self.slope
+            rows.append(
+                f"per lane      {sl.lut4_per_lane:,.0f} LUT4 and {sl.ff_per_lane:,.0f} FF "
+                f"(slope between P = {sl.lanes[0]} and {sl.lanes[1]}, yosys, harness "
+                f"excluded); fixed part {sl.lut4_fixed:,.0f} LUT4 and {sl.ff_fixed:,.0f} FF")
         if self.pixel_steps_per_s is not None:
             rows.append(f"throughput    {self.pixel_steps_per_s:.3g} pixel-steps/s "
                         f"({self.lanes} x {self.fmax_mhz:.1f} MHz)")
@@ -284,10 +346,19 @@ class FpgaReport:
             f"{self.clock_needed_mhz:,.1f} MHz")
         if self.fmax_mhz is not None:
             need = self.lanes_needed
-            rows.append(
-                f"              at {self.fmax_mhz:.1f} MHz it needs "
-                + (f"{need} lanes (clock {clock_needed_hz(sh, sw, need, self.step_hz) / 1e6:.1f}"
-                   " MHz)" if need else "more lanes than pixels in a row"))
+            where = (f"the {self.fmax_mhz:.1f} MHz measured at P = {self.lanes}, "
+                     f"{self.height}x{self.width}")
+            if need is None:
+                rows.append(f"              at {where}: more lanes than pixels in a row")
+            else:
+                rows.append(
+                    f"              at {where}: {need} lanes (clock "
+                    f"{clock_needed_hz(sh, sw, need, self.step_hz) / 1e6:.1f} MHz)")
+                if self.lanes_extrapolated:
+                    rows.append(
+                        f"              (extrapolated from P = {self.lanes}: {need} lanes "
+                        "route longer nets and may not reach this Fmax; place and route "
+                        f"--lanes {need} to confirm)")
         holders = st.holders()
         rows += [
             f"sensor state  {sh}x{sw} x {st.num_scales} scales: accumulators "

@@ -78,7 +78,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from amaranth.hdl import Cat, Const, Module, Mux, Signal, Value, signed, unsigned
+from amaranth.hdl import Cat, Const, Module, Mux, ResetSignal, Signal, Value, signed, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -114,6 +114,7 @@ class _Centre:
     last0: Value
     row_ok: Signal
     col_ok: Signal
+    next_addr: Value
 
 
 @dataclass(frozen=True)
@@ -121,6 +122,7 @@ class _Tail:
     """What the state memories and the tail need from the position pipeline."""
 
     rd_addr: Value
+    rd_addr_next: Value
     rd_valid: Value
     bank_q: Value
     fresh_q: Value
@@ -280,11 +282,14 @@ class RvsmStreamArray(wiring.Component):
         r, e = geo.radius, geo.edge_groups
         row_bits = p * n
         g_in = Signal(range(g_count), name="in_group")
-        g_in_next = Mux(g_in == g_count - 1, 0, g_in + 1)
+        # g_in's successor, kept in its own register (the line buffer's read address):
+        # no counter carry chain in front of the distributed RAM's read.
+        g_in_next = Signal(range(g_count), name="in_group_next", init=1 % g_count)
         with m.If(clear):
-            m.d.sync += g_in.eq(0)
+            m.d.sync += [g_in.eq(0), g_in_next.eq(1 % g_count)]
         with m.Elif(advance):
-            m.d.sync += g_in.eq(g_in_next)
+            m.d.sync += [g_in.eq(g_in_next),
+                         g_in_next.eq(Mux(g_in_next == g_count - 1, 0, g_in_next + 1))]
         if r == 0:
             stored = Const(0, 0)
         elif g_count == 1:
@@ -349,22 +354,44 @@ class RvsmStreamArray(wiring.Component):
                 with m.If(step & last0):
                     m.d.sync += fresh0.eq(0)
         m.d.sync += [yc.eq(ny), gc.eq(ng), ac.eq(na)]
-        row_ok = Signal(2 * r + 1, name="row_mask")
-        col_ok = Signal(p + 2 * r, name="col_mask")
+        # The padding masks of the next position, from the current one: the masks of
+        # row y + 1 (column group g + 1) are constant compares of y (g), so no
+        # counter's carry chain precedes them. Held otherwise; reset to position (0, 0).
         top = 1 if self.mutation == "stream.top_padding_off_by_one" else 0
-        row_next = [(ny >= r - d - top) if d < r else (ny <= h - 1 - (d - r)) if d > r
-                    else Const(1) for d in range(2 * r + 1)]
-        col_next = []
-        for j in range(p + 2 * r):
-            if j < r:
-                col_next.append(ng >= -(-(r - j) // p))
-            elif j >= p + r:
-                right = 0 if self.mutation == "stream.right_padding_off_by_one" else 1
-                col_next.append(ng <= -(-(c.width + r - j) // p) - right)
-            else:
-                col_next.append(Const(1))
-        m.d.sync += [row_ok.eq(Cat(*row_next)), col_ok.eq(Cat(*col_next))]
-        return _Centre(valid0, yc, gc, ac, fresh0, last0, row_ok, col_ok)
+        right = 0 if self.mutation == "stream.right_padding_off_by_one" else 1
+
+        def at_least(v: Value | int, k: int) -> Value | bool:
+            return v >= k if isinstance(v, int) else (Const(1) if k <= 0 else v >= k)
+
+        def at_most(v: Value | int, k: int) -> Value | bool:
+            return v <= k if isinstance(v, int) else v <= k
+
+        def rows(y: Value | int, plus: int) -> list:
+            return [at_least(y, r - d - top - plus) if d < r
+                    else at_most(y, h - 1 - (d - r) - plus) if d > r else 1
+                    for d in range(2 * r + 1)]
+
+        def cols(g: Value | int, plus: int) -> list:
+            return [at_least(g, -(-(r - j) // p) - plus) if j < r
+                    else at_most(g, -(-(c.width + r - j) // p) - right - plus)
+                    if j >= p + r else 1 for j in range(p + 2 * r)]
+
+        def bits(values: list) -> Value:
+            return Cat(*[Const(int(v), 1) if isinstance(v, (bool, int)) else v
+                         for v in values])
+
+        def word(values: list) -> int:
+            return sum(int(v) << i for i, v in enumerate(values))
+
+        row_ok = Signal(2 * r + 1, name="row_mask", init=word(rows(0, 0)))
+        col_ok = Signal(p + 2 * r, name="col_mask", init=word(cols(0, 0)))
+        with m.If(clear):
+            m.d.sync += [row_ok.eq(row_ok.init), col_ok.eq(col_ok.init)]
+        with m.Elif(step):
+            m.d.sync += col_ok.eq(Mux(g_end, col_ok.init, bits(cols(gc, 1))))
+            with m.If(g_end):
+                m.d.sync += row_ok.eq(Mux(yc == h - 1, row_ok.init, bits(rows(yc, 1))))
+        return _Centre(valid0, yc, gc, ac, fresh0, last0, row_ok, col_ok, na)
 
     def _window_sums(self, pipe: Pipeline, slabs: list[Signal], centre: _Centre
                      ) -> tuple[list[list[Timed]], int]:
@@ -405,15 +432,22 @@ class RvsmStreamArray(wiring.Component):
             valid.append(v)
         addr0, fresh_t, row_t = pipe.timed(ac), pipe.timed(fresh0), pipe.timed(yc)
         group_t, last_t = pipe.timed(gc), pipe.timed(last0)
-        rd_addr = pipe.at(addr0, stage_q - 2).value
-        bank_q = pipe.at(addr0, stage_q).value >> (geo.bank_words - 1).bit_length()
+        read = geo.read_stage
+        rd_addr = pipe.at(addr0, read).value
+        # the value rd_addr takes at the next edge (for comparators registered ahead)
+        if read == 0:  # rd_addr is the centre address itself (reset to 0)
+            rd_addr_next = Mux(ResetSignal(), 0, centre.next_addr)
+        else:
+            rd_addr_next = Mux(advance, pipe.at(addr0, read - 1).value, rd_addr)
+        # the banks' output registers hold the read two edges on: select among them there
+        bank_q = pipe.at(addr0, read + 2).value >> (geo.bank_words - 1).bit_length()
         fresh_q = pipe.at(fresh_t, stage_q).value
         tail = stage_q + geo.TAIL_STAGES - 1  # the stage that writes back
         wr_addr = pipe.at(addr0, tail).value
         out_row, out_group = pipe.at(row_t, tail).value, pipe.at(group_t, tail).value
         out_last = pipe.at(last_t, tail).value
         wr_en = advance & valid[tail]
-        return _Tail(rd_addr, valid[stage_q - 2], bank_q, fresh_q, wr_addr, wr_en,
+        return _Tail(rd_addr, rd_addr_next, valid[read], bank_q, fresh_q, wr_addr, wr_en,
                      valid[tail], out_row, out_group, out_last)
 
     def _state_and_output(self, m: Module, advance: Signal, sums: list[list[Timed]],
@@ -439,6 +473,11 @@ class RvsmStreamArray(wiring.Component):
         m.d.sync += [bus_we.eq(bus.we), bus_addr.eq(bus.addr), bus_data.eq(bus.data)]
         bus_word = bus_addr[:word_bits]
         bus_scale = bus_addr[word_bits:]
+        # bus_addr == rd_addr, registered: compared one edge ahead from the values both
+        # take at that edge (the bus register loads every cycle), so no comparator sits
+        # between the read address and the block RAMs' read enables or the forwarding.
+        rd_match = Signal(name="thr_rd_match", init=1, reset_less=True)
+        m.d.sync += rd_match.eq(bus.addr[:word_bits] == tail.rd_addr_next)
         fwd_data = [Signal.like(bus.data, name=f"thr_fwd{k}_data", reset_less=True)
                     for k in (1, 2)]  # shared by the scales
         with m.If(advance):
@@ -451,21 +490,23 @@ class RvsmStreamArray(wiring.Component):
             after_lanes = []
             probes.append([])
             thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True,
-                                   init_word=top_threshold_word(tw, p))  # module docstring
+                                   init_word=top_threshold_word(tw, p),  # module docstring
+                                   same_addr=True, read_stages=geo.READ_STAGES)
             m.submodules[f"thr_s{s}"] = thr_mem
             thr_memories.append(thr_mem)
             m.d.comb += [thr_mem.advance.eq(advance), thr_mem.read_addr.eq(rd_addr),
                          thr_mem.read_bank.eq(bank_q),
                          thr_mem.write_en.eq(bus_we & (bus_scale == s)),
                          thr_mem.write_addr.eq(bus_word), thr_mem.write_data.eq(bus_data),
+                         thr_mem.same_addr.eq(rd_match),
                          thr_mem.forward_hit.eq(
-                             bus_we & (bus_scale == s) & (bus_word == rd_addr)
+                             bus_we & (bus_scale == s) & rd_match
                              if self.mutation != "stream.no_threshold_forwarding" else 0),
                          thr_mem.forward_data.eq(fwd_data[1])]
             thr_q = thr_mem.data
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
             acc_mem = BankedMemory(p * wa, words, geo.bank_words,
-                                   guard_bits=geo.rmw_guard_bits)
+                                   guard_bits=geo.rmw_guard_bits, read_stages=geo.READ_STAGES)
             m.submodules[f"acc_s{s}"] = acc_mem
             m.d.comb += [acc_mem.advance.eq(advance), acc_mem.read_addr.eq(rd_addr),
                          acc_mem.read_bank.eq(bank_q), acc_mem.write_en.eq(wr_en),
@@ -496,6 +537,7 @@ class RvsmStreamArray(wiring.Component):
                 else:
                     tail_stmts += self._spike_tail(acc, shifted, thr_q[i * tw:(i + 1) * tw],
                                                    total, thr1, sat, thr2, pos, neg)
+                    neg = neg & ~pos  # the register holds the compare alone (docstring)
                     if self.mutation == "stream.no_reset_on_spike":
                         after = sat
                     elif c.reset == "zero" or \
@@ -525,22 +567,30 @@ class RvsmStreamArray(wiring.Component):
                     thr1: Signal, sat: Signal, thr2: Signal, pos: Signal, neg: Signal
                     ) -> list:
         """The spike camera's tail for one lane and scale: stage 1 ``total = acc +
-        shifted`` and the threshold; stage 2 saturation, fire and the threshold kept for
-        the reset (the caller's ``after``)."""
+        shifted``, the threshold and the threshold less one; stage 2 saturation, ``pos = total >=
+        thr``, ``neg = total <= -thr`` (the caller masks it with ``~pos``: the two compares
+        are independent carry chains) and the threshold kept for the reset (the caller's
+        ``after``)."""
         c = self.contract
         wa = c.accumulator_bits
         lo, hi = -(1 << (wa - 1)), (1 << (wa - 1)) - 1
-        fire_pos = total >= thr1
+        # Both compares are the sign of one subtraction (one carry chain each, no
+        # sign-extension logic after it): total >= thr is ~sign(total - thr), and
+        # total <= -thr is sign(total + (thr - 1)), thr - 1 registered beside thr. The
+        # neg register holds that compare alone; the caller takes ~pos & neg.
+        fire_pos = ~(total - thr1)[-1]
         if self.mutation == "stream.threshold_off_by_one":
             fire_pos = total > thr1
         elif self.mutation == "stream.stale_threshold":
             fire_pos = total >= thr2  # the previous position's threshold
-        fire_neg = (~fire_pos & (total <= -thr1)) if c.signed else Const(0)
+        thr1_m1 = Signal(signed(len(thr) + 1), name=f"{thr1.name}_m1", reset_less=True)
+        fire_neg = (total + thr1_m1)[-1] if c.signed else Const(0)
         if self.mutation == "stream.no_negative_spikes":
             fire_neg = Const(0)
         return [
             total.eq(acc + shifted),
             thr1.eq(thr),
+            *([thr1_m1.eq(thr.as_unsigned() - 1)] if c.signed else []),
             sat.eq(total[:wa].as_signed()
                    if self.mutation == "stream.no_saturation"  # wraps around
                    else Mux(total > hi, hi, Mux(total < lo, lo, total))),

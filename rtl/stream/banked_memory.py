@@ -8,7 +8,8 @@ array's beat advance), so stages count beats:
 * **Read.** ``read_addr`` is sampled at an ``advance`` edge; the bank's data is
   registered at the next ``advance`` edge and multiplexed by ``read_bank``, which must
   be the bank of that address delayed alike (one ``advance`` edge). ``data`` is the
-  result.
+  result (``read_stages=2``), or that result registered at the third ``advance`` edge
+  (``read_stages=3``: a registered bank multiplexer, forwarding included).
 * **Write.** One port: ``write_en``, ``write_addr``, ``write_data`` (the enable is used
   as given; gate it with ``advance`` outside).
 * **Collisions.** A bank's read is disabled at an edge where the write port writes its
@@ -19,9 +20,16 @@ array's beat advance), so stages count beats:
   alike: two ``advance`` edges) instead of the read. ``guard_bits = k`` adds
   ``may_write`` and gates the read where ``may_write`` holds and the low ``k`` address
   bits match: a cheaper superset of the collisions, for a memory whose valid reads and
-  writes never match in those bits.
+  writes never match in those bits. ``same_addr=True`` adds ``same_addr``: the user's
+  own (e.g. registered) ``write_addr == read_addr``, used instead of the comparator in
+  the ECP5 build (the generic build keeps its comparator, from which yosys proves the
+  collisions harmless).
 * **Initial contents.** ``init_word``: every word's value at configuration (block-RAM
   initialisation; 0 by default). No reset reloads it.
+* **ECP5 block RAMs.** Elaborated for ``platform=ECP5_PLATFORM``
+  (:mod:`rvsm.rtl.fpga.ecp5_memory`, ``rvsm fpga``), each bank is an
+  :class:`~rvsm.rtl.fpga.ecp5_memory.Ecp5BlockRam`: DP16KD primitives whose output
+  register (``REGMODE_B = "OUTREG"``) is the bank register, same cycle behaviour.
 * **Formal observation.** For the ``"formal"`` platform only, ``probe_data`` shows the
   word at ``probe_addr`` (asynchronous read ports), for harnesses to state what the
   memory holds; other platforms elaborate no such port.
@@ -34,6 +42,8 @@ from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
+from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM, Ecp5BlockRam
+
 __all__ = ["BankedMemory"]
 
 
@@ -41,10 +51,15 @@ class BankedMemory(wiring.Component):
     """``depth`` words of ``width`` bits in banks of ``bank_words``; see the module
     docstring for the ports ``advance``, ``read_addr``, ``read_bank``, ``write_en``,
     ``write_addr``, ``write_data``, ``data`` and the optional ``forward_hit``,
-    ``forward_data`` (``forward=True``) and ``may_write`` (``guard_bits``)."""
+    ``forward_data`` (``forward=True``), ``may_write`` (``guard_bits``) and ``same_addr``
+    (``same_addr=True``)."""
 
     def __init__(self, width: int, depth: int, bank_words: int, forward: bool = False,
-                 guard_bits: int | None = None, init_word: int = 0):
+                 guard_bits: int | None = None, init_word: int = 0,
+                 same_addr: bool = False, read_stages: int = 2):
+        if read_stages not in (2, 3):
+            raise ValueError(f"read_stages must be 2 or 3, got {read_stages}")
+        self.read_stages = read_stages
         self.width = width
         self.init_word = init_word
         self.depth = depth
@@ -71,6 +86,9 @@ class BankedMemory(wiring.Component):
             members.update(forward_hit=In(1), forward_data=In(unsigned(width)))
         if guard_bits is not None:
             members["may_write"] = In(1)
+        if same_addr:
+            members["same_addr"] = In(1)
+        self.same_addr_input = same_addr
         super().__init__(members)
 
     def elaborate(self, platform: object) -> Module:
@@ -79,32 +97,46 @@ class BankedMemory(wiring.Component):
         banked = len(self.bank_sizes) > 1
         offset_bits = (self.bank_words - 1).bit_length()
         outs, probes = [], []
+        ecp5 = platform == ECP5_PLATFORM
         for b, depth in enumerate(self.bank_sizes):
-            mem = Memory(shape=unsigned(self.width), depth=depth,
-                         init=[self.init_word] * depth if self.init_word else [])
-            m.submodules[f"b{b}"] = mem
-            wp = mem.write_port()
             hit = (self.write_addr >> offset_bits) == b if banked else Const(1)
-            m.d.comb += [wp.addr.eq(self.write_addr[:offset_bits] if banked
-                                    else self.write_addr),
-                         wp.data.eq(self.write_data), wp.en.eq(self.write_en & hit)]
-            if platform == "formal":
-                probe = mem.read_port(domain="comb")
-                m.d.comb += probe.addr.eq(self.probe_addr[:offset_bits] if banked
-                                          else self.probe_addr)
-                probes.append(probe.data)
-            rp = mem.read_port()
-            m.d.comb += rp.addr.eq(self.read_addr[:offset_bits] if banked else self.read_addr)
-            if self.guard_bits is None:
-                collide = wp.en & (wp.addr == rp.addr)
+            wr_en = self.write_en & hit
+            if ecp5:  # the bank register is the block RAM's output register
+                ram = Ecp5BlockRam(self.width, depth, self.init_word)
+                m.submodules[f"b{b}"] = ram
+                wr_addr, rd_addr, rd_en = ram.write_addr, ram.read_addr, ram.read_en
+                m.d.comb += [ram.write_en.eq(wr_en), ram.write_data.eq(self.write_data),
+                             ram.out_en.eq(self.advance)]
+                outs.append(ram.data)
             else:
-                k = min(self.guard_bits, len(rp.addr))
-                collide = self.may_write & hit & (wp.addr[:k] == rp.addr[:k])
-            m.d.comb += rp.en.eq(self.advance & ~collide)
-            reg = Signal(unsigned(self.width), name=f"b{b}_q", reset_less=True)
-            with m.If(self.advance):
-                m.d.sync += reg.eq(rp.data)
-            outs.append(reg)
+                mem = Memory(shape=unsigned(self.width), depth=depth,
+                             init=[self.init_word] * depth if self.init_word else [])
+                m.submodules[f"b{b}"] = mem
+                wp = mem.write_port()
+                m.d.comb += [wp.data.eq(self.write_data), wp.en.eq(wr_en)]
+                if platform == "formal":
+                    probe = mem.read_port(domain="comb")
+                    m.d.comb += probe.addr.eq(self.probe_addr[:offset_bits] if banked
+                                              else self.probe_addr)
+                    probes.append(probe.data)
+                rp = mem.read_port()
+                wr_addr, rd_addr, rd_en = wp.addr, rp.addr, rp.en
+                reg = Signal(unsigned(self.width), name=f"b{b}_q", reset_less=True)
+                with m.If(self.advance):
+                    m.d.sync += reg.eq(rp.data)
+                outs.append(reg)
+            m.d.comb += [wr_addr.eq(self.write_addr[:offset_bits] if banked
+                                    else self.write_addr),
+                         rd_addr.eq(self.read_addr[:offset_bits] if banked
+                                    else self.read_addr)]
+            if ecp5 and self.same_addr_input:
+                collide = wr_en & self.same_addr
+            elif self.guard_bits is None:
+                collide = wr_en & (wr_addr == rd_addr)
+            else:
+                k = min(self.guard_bits, len(rd_addr))
+                collide = self.may_write & hit & (wr_addr[:k] == rd_addr[:k])
+            m.d.comb += rd_en.eq(self.advance & ~collide)
         out = outs[-1]
         for b in range(len(outs) - 2, -1, -1):
             out = Mux(self.read_bank == b, outs[b], out)
@@ -119,5 +151,10 @@ class BankedMemory(wiring.Component):
             with m.If(self.advance):
                 m.d.sync += [hit1.eq(self.forward_hit), hit2.eq(hit1)]
             out = Mux(hit2, self.forward_data, out)
+        if self.read_stages == 3:  # the registered bank multiplexer
+            muxed = Signal(unsigned(self.width), name="data_q", reset_less=True)
+            with m.If(self.advance):
+                m.d.sync += muxed.eq(out)
+            out = muxed
         m.d.comb += self.data.eq(out)
         return m

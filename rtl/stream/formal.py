@@ -310,21 +310,22 @@ class StreamProperties(_StreamHarness):
         by_scale = [probes.lanes[s] for s in range(c.num_scales)]
         thr2 = Array(Cat(*[lane["thr2"] for lane in lanes]) for lanes in by_scale)[scale]
         # more stepping stones: the watched position's threshold word at each stage
-        # of the tail (memory output after the second advance edge from the read,
-        # thr1 after the third), tracked by tags moving at advance edges; a read a
+        # of the tail (memory output after READ_STAGES advance edges from the read,
+        # thr1 one edge later), tracked by tags moving at advance edges; a read a
         # stage on is one capture further down the delay line
-        tags = [Signal(name=f"thr_tag{k}") for k in range(1, 4)]
+        rs = geo.READ_STAGES
+        tags = [Signal(name=f"thr_tag{k}") for k in range(1, rs + 2)]
         with m.If(probes.advance):
-            m.d.sync += [tags[0].eq(r1 & (r1_pos == watch)), tags[1].eq(tags[0]),
-                         tags[2].eq(tags[1])]
+            m.d.sync += [tags[0].eq(r1 & (r1_pos == watch))] + [
+                tags[k].eq(tags[k - 1]) for k in range(1, len(tags))]
         with m.If(probes.clear):
             m.d.sync += [tag.eq(0) for tag in tags]
         self.check(m, "threshold.read_stage",
-                   ~tags[1] | (Array(memory.data for memory in memories)[scale]
-                               == line[1]),
+                   ~tags[rs - 1] | (Array(memory.data for memory in memories)[scale]
+                                    == line[rs - 1]),
                    "the memories deliver the watched position's threshold word as read")
         thr1 = Array(Cat(*[lane["thr1"] for lane in lanes]) for lanes in by_scale)[scale]
-        self.check(m, "threshold.compare_stage", ~tags[2] | (thr1 == line[2]),
+        self.check(m, "threshold.compare_stage", ~tags[rs] | (thr1 == line[rs]),
                    "the tail's first stage holds the watched position's threshold word")
         self.check(m, "threshold.timing", ~watched | (thr2 == seen),
                    "a position compares against the threshold written last before the "

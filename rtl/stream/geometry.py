@@ -34,8 +34,10 @@ class StreamGeometry:
     schedule or the named timing properties are needed (e.g. by a testbench).
     """
 
-    #: Adder levels between pipeline registers in the receptive-sum trees.
-    LEVELS_PER_STAGE = 2
+    #: Adder levels between pipeline registers in the receptive-sum trees (1: one carry
+    #: chain per register stage, the ECP5 timing at 150 MHz; 2 placed P = 1 at 145 MHz,
+    #: two chained adders being the critical path).
+    LEVELS_PER_STAGE = 1
     #: Default largest number of words in one bank of a state memory (one ECP5 DP16KD
     #: holds 1024 words of up to 18 bits; wider words use several in parallel).
     BANK_WORDS = 1024
@@ -43,6 +45,11 @@ class StreamGeometry:
     TAIL_STAGES = 3
     #: Registers between the input ports and the datapath (accepted beat, clear).
     INPUT_STAGES = 1
+    #: Advance edges from a state-memory read address to its data: the block-RAM read
+    #: latch, the bank's output register (the DP16KD output register in the ECP5 build)
+    #: and the registered bank multiplexer
+    #: (:class:`~rvsm.rtl.stream.banked_memory.BankedMemory` ``read_stages``).
+    READ_STAGES = 3
 
     def __init__(self, contract: ArrayContract, lanes: int = 1,
                  bank_words: int = BANK_WORDS):
@@ -61,7 +68,7 @@ class StreamGeometry:
         self.edge_groups = -(-self.radius // self.lanes)
         self.orbits = weighted_orbits(c.weights)
         self.beats_per_frame = c.height * self.groups
-        self.sum_stage = self.build_sums(Pipeline(None), None)[1]
+        self.sum_stage = self.build_sums(Pipeline(None, None, self.LEVELS_PER_STAGE), None)[1]
         if self.beats_per_frame <= self.rmw_depth:
             raise RvsmError(
                 f"the stream array needs more than {self.rmw_depth} beats per frame (its "
@@ -93,7 +100,7 @@ class StreamGeometry:
     @property
     def rmw_depth(self) -> int:
         """Beats from an accumulator read (address sampled) to its write-back."""
-        return self.TAIL_STAGES + 1
+        return self.TAIL_STAGES + self.READ_STAGES - 1
 
     @property
     def rmw_guard_bits(self) -> int:
@@ -113,7 +120,13 @@ class StreamGeometry:
     def threshold_lag(self) -> int:
         """Position ``p`` reads its thresholds at the edge after the one accepting input
         beat ``p + threshold_lag``."""
-        return self.window_lag + self.sum_stage - 1
+        return self.window_lag + self.read_stage + 1
+
+    @property
+    def read_stage(self) -> int:
+        """The pipeline stage whose position addresses the state memories: the sums'
+        stage less :attr:`READ_STAGES`, so the data arrives with the sums."""
+        return self.sum_stage - self.READ_STAGES
 
     @property
     def bank_sizes(self) -> list[int]:
@@ -176,5 +189,5 @@ class StreamGeometry:
             sums.append([pipe.settle(pipe.sum(orbit_terms(orbit_sums, self.orbits, s),
                                               self.sum_bits(s)))
                          for s in range(c.num_scales)])
-        stage = max([2] + [t.stage for lane in sums for t in lane])
+        stage = max([self.READ_STAGES] + [t.stage for lane in sums for t in lane])
         return sums, stage

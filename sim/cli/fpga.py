@@ -41,9 +41,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--synth-only", action="store_true",
                    help="stop after synthesis: area from yosys, no Fmax")
     p.add_argument("--rtlil", action="store_true",
-                   help="hand yosys Amaranth's RTLIL instead of Verilog (faster to read; "
-                   "the same netlist)")
-    p.add_argument("--seed", type=int, default=1, help="placer seed (default 1)")
+                   help="hand yosys Amaranth's RTLIL instead of Verilog (faster to read, "
+                   "but yosys then keeps every inferred memory read port's read-first "
+                   "behaviour and emulates it: see docs/fpga.md)")
+    p.add_argument("--memory", choices=("dp16kd", "inferred"), default="dp16kd",
+                   help="state memories as DP16KD instances with the output register on "
+                   "(default) or inferred by yosys (the bank register in fabric)")
+    p.add_argument("--seed", type=int, default=1,
+                   help="placer seed; with --seeds the first of N (default 1)")
+    p.add_argument("--seeds", type=int, metavar="N",
+                   help="place and route one synthesis with N placer seeds (--seed .. "
+                   "--seed+N-1), each in <out>/seed<K>/; report every seed and the best")
+    p.add_argument("--slope-lanes", type=int, metavar="P2",
+                   help="also synthesise at P2 lanes (yosys only) and report logic per lane "
+                   "as the slope between --lanes and P2, with the fixed part")
+    p.add_argument("--jobs", type=int, metavar="J",
+                   help="seeds placed at once (default min(N, cores))")
     p.add_argument("--timeout", type=float, metavar="S",
                    help="stop a tool that runs longer than S seconds (exit 3)")
     p.add_argument("-o", "--out", default="build/fpga",
@@ -56,7 +69,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.architectures import ARCHITECTURES
-    from rvsm.rtl.fpga.flow import run_fpga
+    from rvsm.rtl.fpga.flow import run_fpga, run_fpga_seeds
     from rvsm.sim.cli.rtl import arch_options
 
     arch = ARCHITECTURES[args.arch]
@@ -71,11 +84,24 @@ def _fpga(args: argparse.Namespace) -> int:
         if not args.quiet:
             print(f"rvsm fpga: {p.line()}", file=sys.stderr, flush=True)
 
-    report = run_fpga(point, args.out, arch=args.arch, lanes=options.get("lanes"),
-                      size=args.size,
-                      device=args.device, speed=args.speed, target_mhz=args.freq,
-                      synth_only=args.synth_only, seed=args.seed,
-                      netlist="rtlil" if args.rtlil else "verilog", on_progress=progress,
-                      timeout=args.timeout)
+    common = dict(arch=args.arch, lanes=options.get("lanes"), size=args.size,
+                  device=args.device, speed=args.speed, target_mhz=args.freq,
+                  netlist="rtlil" if args.rtlil else "verilog", memory=args.memory,
+                  slope_lanes=args.slope_lanes, on_progress=progress,
+                  timeout=args.timeout)
+    if args.seeds is not None:
+        if args.seeds < 1:
+            raise RvsmError(f"--seeds must be >= 1, got {args.seeds}")
+        if args.jobs is not None and args.jobs < 1:
+            raise RvsmError(f"--jobs must be >= 1, got {args.jobs}")
+        if args.synth_only:
+            raise RvsmError("--seeds places and routes: it does not go with --synth-only")
+        report = run_fpga_seeds(point, args.out, range(args.seed, args.seed + args.seeds),
+                                jobs=args.jobs, **common)
+    else:
+        if args.jobs is not None:
+            raise RvsmError("--jobs applies to --seeds only")
+        report = run_fpga(point, args.out, synth_only=args.synth_only, seed=args.seed,
+                          **common)
     print(report.to_json() if args.json else report.table())
     return 0

@@ -55,7 +55,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="clock of the constraints template <top>.sdc (default "
                    f"{DEFAULT_CLOCK_MHZ:g} MHz)")
     p.add_argument("--stats", action="store_true",
-                   help="synthesise with yosys (synth; stat) and print cells/flip-flops")
+                   help="synthesise with yosys (generic gates, memories kept as memories) and "
+                   "print cells, flip-flops and memory bits")
     add_force_argument(p)
     p.set_defaults(func=_verilog)
 
@@ -195,9 +196,13 @@ def _verilog(args: argparse.Namespace) -> int:
     if args.stats:
         st = yosys_stats(paths["verilog"], args.top)
         pixels = contract.height * contract.width
-        print(f"yosys synth: {st['cells']} cells, {st['flip_flops']} flip-flops "
-              f"({st['cells'] / pixels:.1f} cells, {st['flip_flops'] / pixels:.1f} FFs "
-              f"per pixel; {st['seconds']:.1f} s)")
+        print(f"yosys synth: {st['cells']} cells, {st['flip_flops']} flip-flops, "
+              f"{st['memories']} memories of {st['memory_bits']:,} bits in all (generic "
+              f"gates, memories kept as memories; {st['cells'] / pixels:.1f} cells, "
+              f"{st['flip_flops'] / pixels:.1f} FFs and {st['memory_bits'] / pixels:.1f} "
+              f"memory bits per pixel; {st['seconds']:.1f} s)")
+        for mem in st["memory_list"]:
+            print(f"  memory {mem['name']}: {mem['words']} x {mem['width']} bits")
     return 0
 
 

@@ -61,3 +61,4 @@ def test_yosys_stats(generated: tuple[Path, object], capsys: pytest.CaptureFixtu
     # per pixel at least the accumulator and threshold registers survive synthesis
     assert st["flip_flops"] >= 6 * (c.accumulator_bits + c.threshold_bits)
     assert st["cells"] > st["flip_flops"]
+    assert st["memories"] == 0 and st["memory_bits"] == 0  # its state is flip-flops

@@ -119,3 +119,59 @@ def test_a_design_too_big_for_the_device_is_refused_before_place_and_route(
     with pytest.raises(RvsmError, match="does not fit the ecp5-tiny.*--synth-only") as info:
         run_fpga(fsm_point, tmp_path, arch="parallel", size=TINY, device=tiny)
     assert not isinstance(info.value, ToolError)  # bad input (exit 2), nextpnr never ran
+
+
+FAKE_NEXTPNR = """seed=1
+while [ $# -gt 0 ]; do
+  case "$1" in --seed) seed=$2; shift ;; esac
+  shift
+done
+[ -f synth.json ] || exit 5
+fmax=$((100 + seed * 7 % 5))
+echo "placing with seed $seed" > nextpnr.log
+cat > report.json <<EOF
+{"fmax": {"clk": {"achieved": $fmax, "constraint": 150}},
+ "utilization": {"TRELLIS_COMB": {"used": 10, "available": 83640},
+                 "TRELLIS_FF": {"used": 5, "available": 83640},
+                 "DP16KD": {"used": 0, "available": 208}},
+ "critical_paths": [{"from": "posedge clk", "to": "posedge clk", "path": [
+   {"type": "clk-to-q", "delay": 0.5, "from": {"cell": "a"}, "to": {"cell": "a"}},
+   {"type": "routing", "net": "net_of_seed_$seed", "delay": 1.0, "from": {"cell": "a"},
+    "to": {"cell": "r_TRELLIS_FF_Q"}}]}]}
+EOF
+"""
+
+
+def test_seeds_place_one_synthesis_in_parallel_and_report_each(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fsm_point, fake_tool,
+        capsys: pytest.CaptureFixture) -> None:
+    """``rvsm fpga --seeds 3 --jobs 2``: one synthesis, three nextpnr runs (stand-ins:
+    nextpnr's Fmax depends on the seed) each in its own folder with its own report, the
+    summary and the best seed (seed 2 here, not the last)."""
+    import json
+
+    from rvsm.model.fixed.point_toml import save_design_point
+    from rvsm.sim.cli import main
+
+    monkeypatch.setenv("RVSM_NEXTPNR_ECP5", str(fake_tool(tmp_path / "pnr", FAKE_NEXTPNR)))
+    monkeypatch.setenv("RVSM_YOSYS", str(fake_tool(tmp_path / "yosys", (
+        "echo '{}' > synth.json\necho '{\"design\": {\"num_cells_by_type\": "
+        "{\"LUT4\": 10, \"TRELLIS_FF\": 5}}}' > stat.json\n"))))
+    save_design_point(tmp_path / "p.toml", fsm_point)
+    out = tmp_path / "out"
+    base = ["fpga", str(tmp_path / "p.toml"), "--arch", "parallel", "--size", "2x2"]
+    assert main([*base, "--seeds", "3", "--jobs", "2", "--quiet", "--freq", "150",
+                 "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "best: seed 2, 104.0 MHz (3 seeds" in text
+    for seed, fmax in ((1, 102), (2, 104), (3, 101)):
+        assert f"net_of_seed_{seed}" in text
+        report = json.loads((out / f"seed{seed}" / "fpga.json").read_text())
+        assert report["seed"] == seed and report["fmax_mhz"] == fmax
+        assert report["critical_path"]["start"] == f"net_of_seed_{seed}"
+        assert (out / f"seed{seed}" / "fpga.txt").read_text().startswith("design")
+    summary = json.loads((out / "seeds.json").read_text())
+    assert summary["best_seed"] == 2 and [s["seed"] for s in summary["seeds"]] == [1, 2, 3]
+    assert not (out / "report.json").exists()  # nextpnr ran in the seed folders only
+    assert main([*base, "--seeds", "2", "--synth-only", "-o", str(out)]) == 2
+    assert main([*base, "--jobs", "2", "-o", str(out)]) == 2

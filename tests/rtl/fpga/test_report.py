@@ -132,3 +132,36 @@ def test_devices_and_unknown_device() -> None:
 
     with pytest.raises(RvsmError, match="ecp5-85"):
         get_device("ice40")
+
+
+def test_the_critical_path_is_shown_when_timing_is_met_too() -> None:
+    from rvsm.rtl.fpga.report import CriticalPath
+
+    path = CriticalPath("a.q[0]", "b (FF)", 6.5, 2.0, 4.5, 3, ("a.q[0]",))
+    text = _report(fmax_mhz=153.8, target_mhz=150.0, critical_path=path, seed=2).table()
+    assert "153.8 MHz (meets the 150 MHz target, placer seed 2)" in text
+    assert "critical path a.q[0] -> b (FF): 6.50 ns" in text
+
+
+def test_lanes_needed_name_the_fmax_and_lanes_and_flag_an_extrapolation() -> None:
+    r = _report(fmax_mhz=150.0)  # measured at P = 4; 250x400 at 40 kHz needs P = 40
+    assert r.lanes_needed == 40 and r.lanes_extrapolated
+    text = r.table()
+    assert "at the 150.0 MHz measured at P = 4, 64x64: 40 lanes (clock 100.0 MHz)" in text
+    assert "extrapolated from P = 4" in text and "--lanes 40 to confirm" in text
+    assert json.loads(r.to_json())["sensor_lanes_extrapolated"] is True
+    same = _report(lanes=40, fmax_mhz=150.0)
+    assert not same.lanes_extrapolated and "extrapolated" not in same.table()
+
+
+def test_lane_slope_separates_the_fixed_part() -> None:
+    from rvsm.rtl.fpga.report import LaneSlope
+
+    s = LaneSlope(lanes=(4, 8), lut4=(7000, 13000), ff=(4400, 8000))
+    assert s.lut4_per_lane == 1500 and s.ff_per_lane == 900
+    assert s.lut4_fixed == 1000 and s.ff_fixed == 800
+    text = _report(slope=s).table()
+    assert "1,500 LUT4 and 900 FF (slope between P = 4 and 8" in text
+    assert "fixed part 1,000 LUT4 and 800 FF" in text
+    assert json.loads(_report(slope=s).to_json())["slope"]["lut4_fixed"] == 1000
+    assert "(--slope-lanes: the slope)" in _report().table()

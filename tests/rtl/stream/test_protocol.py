@@ -144,7 +144,18 @@ def test_coverage_counts_a_hand_made_script(small_contract) -> None:
     assert list(cov[0]) == list(PROTOCOL_BINS)
     assert cov[0]["clear_before_first_beat"] == 1
     assert cov[0]["clear_drained"] == 1
-    assert cov[0]["clear_at_top_last"] == 1
+
+    def band(q: int) -> str:  # the position q of a frame as a clear bin
+        y, g = divmod(q % geo.beats_per_frame, geo.groups)
+        row = "top" if y < geo.radius else "bottom" if y >= c.height - geo.radius \
+            else "middle"
+        return f"clear_at_{row}_{'first' if g == 0 else 'last'}"
+
+    # the drained clear follows a frame and lag flush beats; the cut one, 1 beat
+    bins = [band(geo.beats_per_frame + geo.lag), band(1)]
+    assert band(1) == "clear_at_top_last"
+    for b in set(bins):
+        assert cov[0][b] == bins.count(b)
     assert cov[0]["clear_at_middle_middle"] is None
     assert cov[0]["thr_write_same_edge"] == 0 and cov[0]["thr_write_streaming"] == 0
     load = c.num_scales * geo.beats_per_frame

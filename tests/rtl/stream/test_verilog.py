@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -95,3 +96,20 @@ def test_full_sensor_verilog(tmp_path: Path, lanes: int) -> None:
           f"with port map), {size / 1e6:.2f} MB")
     assert size < 10e6
     verilator_lint(paths["verilog"], STREAM_TOP)
+
+
+@pytest.mark.slow  # a yosys synthesis: about 15 s
+@pytest.mark.skipif(shutil.which("yosys") is None, reason="apt-get install yosys")
+def test_stats_report_state_memories_as_memory_bits(
+        generated: tuple[Path, DesignPoint]) -> None:
+    """``--stats`` keeps memories as memories: exactly the state bits of the geometry
+    (accumulators, thresholds, line buffer), one memory per bank and kind, plus the line
+    buffer; no flip-flop stands for a memory word."""
+    from rvsm.rtl.verilog import yosys_stats
+
+    out, point = generated
+    geo = StreamGeometry(point.contract(), 2)
+    st = yosys_stats(out / f"{STREAM_TOP}.v")
+    assert st["memory_bits"] == sum(geo.state_bits.values())
+    assert st["memories"] == 2 * point.contract().num_scales * len(geo.bank_sizes) + 1
+    assert st["flip_flops"] < geo.state_bits["accumulators"]

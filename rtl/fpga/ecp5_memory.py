@@ -1,0 +1,145 @@
+"""One state-memory bank as explicit ECP5 block RAMs with the output register on.
+
+yosys' ECP5 memory mapping (``share/lattice/brams_16kd.txt``) has no output-register
+option: it maps a synchronous read port to a DP16KD with ``REGMODE = "NOREG"`` and leaves
+a register after it in fabric flip-flops, so the block RAM's slow clock-to-out (5.83 ns
+at speed grade 6) starts the next path. :class:`Ecp5BlockRam` instead instantiates the
+DP16KD primitives itself with ``REGMODE_B = "OUTREG"``: the same two registered stages
+(the read latch, then the output register), both inside the block RAM, so the fabric
+sees a short clock-to-out. It is elaborated in place of the generic banks of
+:class:`~rvsm.rtl.stream.banked_memory.BankedMemory` when a design is converted with
+``platform=ECP5_PLATFORM`` (what ``rvsm fpga`` does by default); simulation, formal and
+``rvsm verilog`` keep the generic memories.
+
+Configuration (one primitive per 18 bits of the word, side by side): port A writes, port
+B reads, both 18 bits wide (1024 words: ``AD[13:4]`` is the word address, ``ADA[1:0]``
+the byte enables), ``WRITEMODE`` ``NORMAL`` (port A's own read data is unused), chip
+selects and resets tied off, ``GSR`` disabled, the initial contents in ``INITVAL_00`` ..
+``INITVAL_3F`` (16 words of 18 bits per 320-bit value, each in a 20-bit slot, the layout
+of yosys' own ``brams_map_16kd.v``). A read and a write of the same address at one edge
+(through the two ports) give undefined read data: the user gates the read enable then,
+as ``BankedMemory`` does. Only the 18-bit configuration is used: a bank of at most 1024
+words (``StreamGeometry.BANK_WORDS``); shallower banks waste the rest (the 36-bit
+pseudo-dual-port mode would halve the primitives at 512 words, but its data order is
+not pinned down by the open tools' sources, so it is not used).
+
+Cycle behaviour, equal to a generic synchronous read port with enable followed by a
+register with enable: at an edge where ``read_en`` is high the word at ``read_addr`` is
+latched; at an edge where ``out_en`` is high the latched word moves to ``data``.
+"""
+
+from __future__ import annotations
+
+from amaranth.hdl import Cat, ClockSignal, Const, Instance, Module, Signal, unsigned
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from rvsm.model.infra.errors import RvsmError
+
+__all__ = ["DP16KD_DEPTH", "DP16KD_WIDTH", "ECP5_PLATFORM", "Ecp5BlockRam", "dp16kd_count",
+           "initval"]
+
+#: The ``platform`` value that makes :class:`~rvsm.rtl.stream.banked_memory.BankedMemory`
+#: elaborate :class:`Ecp5BlockRam` banks (``verilog.convert(..., platform=ECP5_PLATFORM)``).
+ECP5_PLATFORM = "ecp5"
+#: Data bits and words of one DP16KD in the configuration used.
+DP16KD_WIDTH = 18
+DP16KD_DEPTH = 1024
+_SLOT = 20  # bits per word slot in an INITVAL value
+_PER_INITVAL = 16
+
+
+def dp16kd_count(width: int) -> int:
+    """DP16KD primitives side by side for a word of ``width`` bits (18 bits each)."""
+    return -(-width // DP16KD_WIDTH)
+
+
+def initval(words: list[int]) -> dict[str, Const]:
+    """The ``INITVAL_00`` .. ``INITVAL_3F`` parameters (320 bits each) of one DP16KD
+    holding ``words`` (18-bit values, word ``k`` at address ``k``; the rest zero)."""
+    if len(words) > DP16KD_DEPTH:
+        raise RvsmError(f"a DP16KD holds {DP16KD_DEPTH} words, got {len(words)}")
+    params = {}
+    for k in range(DP16KD_DEPTH // _PER_INITVAL):
+        value = 0
+        for i, word in enumerate(words[k * _PER_INITVAL:(k + 1) * _PER_INITVAL]):
+            value |= (word & ((1 << DP16KD_WIDTH) - 1)) << (i * _SLOT)
+        params[f"INITVAL_{k:02X}"] = Const(value, _SLOT * _PER_INITVAL)
+    return params
+
+
+class Ecp5BlockRam(wiring.Component):
+    """``depth`` (at most 1024) words of ``width`` bits in ``ceil(width / 18)`` DP16KD with
+    the output register on (see the module docstring).
+
+    Ports: ``write_en``, ``write_addr``, ``write_data`` (port A); ``read_en``,
+    ``read_addr`` (port B, the read latch's clock enable), ``out_en`` (the output
+    register's clock enable) and ``data`` (the output register). ``init_word``: every
+    word's value at configuration.
+    """
+
+    def __init__(self, width: int, depth: int, init_word: int = 0):
+        if not 1 <= depth <= DP16KD_DEPTH:
+            raise RvsmError(f"an ECP5 block-RAM bank holds 1..{DP16KD_DEPTH} words (banks "
+                            f"of at most {DP16KD_DEPTH} words), got {depth}")
+        if width < 1:
+            raise RvsmError(f"word width must be >= 1 bit, got {width}")
+        self.width, self.depth, self.init_word = width, depth, init_word
+        #: Primitives side by side (DP16KD).
+        self.primitives = dp16kd_count(width)
+        addr = unsigned(max(1, (depth - 1).bit_length()))
+        super().__init__({
+            "write_en": In(1), "write_addr": In(addr), "write_data": In(unsigned(width)),
+            "read_en": In(1), "read_addr": In(addr), "out_en": In(1),
+            "data": Out(unsigned(width)),
+        })
+
+    def elaborate(self, platform: object) -> Module:
+        """The DP16KD instances; slice ``k`` holds bits ``[18k, 18k+18)`` of every word."""
+        m = Module()
+        word_bits = DP16KD_DEPTH.bit_length() - 1  # 10 address bits at 18 bits wide
+        low = 14 - word_bits  # AD[3:0]: sub-word bits (AD[1:0] the byte enables)
+        outs = []
+        for k in range(self.primitives):
+            lo, hi = k * DP16KD_WIDTH, min(self.width, (k + 1) * DP16KD_WIDTH)
+            n = hi - lo
+            init = (self.init_word >> lo) & ((1 << n) - 1)
+            params = initval([init] * self.depth) if init else {}
+            do = Signal(unsigned(DP16KD_WIDTH), name=f"do{k}")
+            di = Signal(unsigned(DP16KD_WIDTH), name=f"di{k}")
+            m.d.comb += di.eq(self.write_data[lo:hi])
+            ports: dict = {
+                "i_CLKA": ClockSignal(), "i_CLKB": ClockSignal(),
+                "i_CEA": self.write_en, "i_WEA": self.write_en, "i_OCEA": Const(0),
+                "i_RSTA": Const(0), "i_CEB": self.read_en, "i_WEB": Const(0),
+                "i_OCEB": self.out_en, "i_RSTB": Const(0),
+            }
+            for p in ("A", "B"):
+                for c in range(3):
+                    ports[f"i_CS{p}{c}"] = Const(0)
+            for b in range(14):
+                if b < low:  # byte enables on port A (both bytes), sub-word bits zero
+                    ports[f"i_ADA{b}"] = Const(1 if b < 2 else 0)
+                    ports[f"i_ADB{b}"] = Const(0)
+                else:
+                    a = b - low
+                    ports[f"i_ADA{b}"] = (self.write_addr[a] if a < len(self.write_addr)
+                                          else Const(0))
+                    ports[f"i_ADB{b}"] = (self.read_addr[a] if a < len(self.read_addr)
+                                          else Const(0))
+            for b in range(DP16KD_WIDTH):
+                ports[f"i_DIA{b}"] = di[b]
+                ports[f"i_DIB{b}"] = Const(0)
+                ports[f"o_DOB{b}"] = do[b]
+            m.submodules[f"ram{k}"] = Instance(
+                "DP16KD",
+                p_DATA_WIDTH_A=DP16KD_WIDTH, p_DATA_WIDTH_B=DP16KD_WIDTH,
+                p_REGMODE_A="NOREG", p_REGMODE_B="OUTREG",
+                p_WRITEMODE_A="NORMAL", p_WRITEMODE_B="NORMAL",
+                p_CSDECODE_A="0b000", p_CSDECODE_B="0b000",
+                p_RESETMODE="SYNC", p_ASYNC_RESET_RELEASE="SYNC", p_GSR="DISABLED",
+                **{f"p_{name}": value for name, value in params.items()},
+                **ports)
+            outs.append(do[:n])
+        m.d.comb += self.data.eq(Cat(*outs))
+        return m
