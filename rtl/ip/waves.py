@@ -1,7 +1,7 @@
 """Timing diagrams of the AXI IP, recorded from ``amaranth.sim`` runs (docs/ip.md).
 
 Each scenario of :data:`SCENARIOS` drives a tiny IP (the ``fsm`` model's kernels on a
-4x8 array, 2 lanes: lag 5 beats, 4 beats per row, 16 per frame) through
+4x8 array, 2 lanes: lag 6 beats, 4 beats per row, 16 per frame) through
 :mod:`rvsm.rtl.ip.drive` and records chosen ports and internal signals once per clock
 cycle; :func:`scenario_waves` turns the recording into WaveJSON (one row per signal,
 ``=`` with a label for a bus, ``x`` where a bus carries nothing), the format WaveDrom
@@ -256,7 +256,7 @@ SCENARIOS: dict[str, tuple] = {
                  "find the FIFO full are dropped whole, STATUS.overflow and DROPPED count",
                  4, _overflow_rows, _overflow_scenario, 2, True),
     "flush_clear": ("End of a stream: the last beats, then CONTROL = flush | clear: lag "
-                    "(5) zero beats inserted, s_axis_tready low, then a one-cycle clear",
+                    "(6) zero beats inserted, s_axis_tready low, then a one-cycle clear",
                     8, _control_rows, _flush_scenario, 1, False),
     "threshold_write": ("A threshold write at a frame boundary: the source pauses after "
                         "threshold_pause_beat(1) = 17 beats, THR_ADDR and the data chunk "

@@ -1,7 +1,7 @@
 """Timing diagrams of the streaming array's native interface, recorded from ``amaranth.sim``.
 
 Each :data:`SCENARIOS` entry drives a small :class:`RvsmStreamArray` (``dog1``, 3x4,
-``P = 2``: ``lag`` 9, ``threshold_lag`` 5, 6 beats a frame, small enough to read) cycle
+``P = 2``, 6 beats a frame: small enough to read; each foot note gives its ``lag``) cycle
 by cycle and records its ports in a :class:`~rvsm.rtl.wavejson.CycleTable`, so every
 diagram in ``docs/integration.md`` is what the RTL did, not a drawing. Recording also
 checks the documented rules: output position ``p`` is presented in the second period
@@ -26,6 +26,7 @@ from rvsm.model.fixed.weights import quantise_model
 from rvsm.rtl.simulation import run_simulation
 from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.drive import threshold_writes
+from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.signatures import threshold_word_bits
 from rvsm.rtl.wavejson import CycleTable
 
@@ -67,7 +68,8 @@ def _flush(n: int) -> list[Cycle]:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A diagram: its title, cycles (from the geometry), window and foot note."""
+    """A diagram: its title, cycles (from the geometry), window and foot note (``{lag}``
+    and ``{pause}``, the beats before a frame-1 threshold write, filled in)."""
 
     title: str
     cycles: Callable[[int, int, int], list[Cycle]]  # (lag, threshold_lag, beats/frame)
@@ -99,7 +101,7 @@ SCENARIOS: dict[str, Scenario] = {
     "stream-input": Scenario(
         "input beats, a stall, and the lag", _input_and_lag,
         "output p is presented in the 2nd period after input beat p + lag is accepted "
-        "(lag = 9 here); a stall holds everything in flight"),
+        "(lag = {lag} here); a stall holds everything in flight"),
     "stream-flush-clear": Scenario(
         "end of a stream: lag flush beats, then clear", _flush_and_clear,
         "the frame's last positions come out only as lag flush beats (any codes) go in; "
@@ -111,7 +113,7 @@ SCENARIOS: dict[str, Scenario] = {
         "is b0 again", start=6),
     "stream-threshold-write": Scenario(
         "threshold writes at a frame boundary", _threshold_write,
-        "paused after H*G + threshold_lag = 11 beats, the writes apply from frame 1 on "
+        "paused after H*G + threshold_lag = {pause} beats, the writes apply from frame 1 on "
         "(StreamSchedule.threshold_pause_beat)", start=6),
 }
 
@@ -222,7 +224,10 @@ def scenario_wavejson(name: str) -> dict:
     if any(table.columns["thr.we"]):
         groups["thr"] = ("thr.we", "thr.addr")
     groups["out"] = ("spikes.valid", "spikes.payload", "spikes.last")
+    geo = StreamGeometry(diagram_contract(), DIAGRAM_LANES)
+    foot = scenario.foot.format(lag=geo.lag,
+                                pause=geo.schedule.threshold_pause_beat(1))
     diagram = table.wavejson(f"{name}: {scenario.title}", start=scenario.start,
-                             foot=scenario.foot, groups=groups)
+                             foot=foot, groups=groups)
     diagram["config"] = {"hscale": 2}
     return diagram
