@@ -18,6 +18,7 @@ def _size(text: str) -> tuple[int, int]:
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``fpga`` sub-command."""
     from rvsm.rtl.fpga.devices import DEVICES
+    from rvsm.rtl.ip.architecture import INTERFACES
     from rvsm.sim.cli.rtl import add_arch_arguments
 
     p = sub.add_parser(
@@ -47,6 +48,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--memory", choices=("dp16kd", "inferred"), default="dp16kd",
                    help="state memories as DP16KD instances with the output register on "
                    "(default) or inferred by yosys (the bank register in fabric)")
+    p.add_argument("--interface", choices=INTERFACES, default="native",
+                   help="native (default): the bare array; axis: the AXI4-Stream / "
+                   "AXI4-Lite IP around it, as rvsm verilog --interface axis builds it "
+                   "(docs/ip.md)")
+    p.add_argument("--fifo-depth", type=int, metavar="BEATS",
+                   help="the IP's output FIFO depth (--interface axis; default 16)")
     p.add_argument("--seed", type=int, default=1,
                    help="placer seed; with --seeds the first of N (default 1)")
     p.add_argument("--seeds", type=int, metavar="N",
@@ -69,26 +76,40 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.architectures import ARCHITECTURES
-    from rvsm.rtl.fpga.flow import run_fpga, run_fpga_seeds
+    from rvsm.rtl.fpga.flow import build_component, run_fpga, run_fpga_seeds
+    from rvsm.rtl.ip.architecture import interface_architecture
     from rvsm.sim.cli.rtl import arch_options
 
-    arch = ARCHITECTURES[args.arch]
+    base = ARCHITECTURES[args.arch]
     options = arch_options(args)
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be > 0 seconds, got {args.timeout}")
+    arch = interface_architecture(base, args.interface)
+    if args.fifo_depth is not None and args.interface != "axis":
+        raise RvsmError("--fifo-depth applies to --interface axis only")
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
     point = load_design_point(args.point)
-    arch.check((point.with_size(*args.size) if args.size else point).contract(), **options)
+    contract = (point.with_size(*args.size) if args.size else point).contract()
+    build = None
+    if arch is not base:  # the IP around the array: the flow places what rvsm verilog writes
+        ip_options = arch.resolve({**options, **({"fifo_depth": args.fifo_depth}
+                                                  if args.fifo_depth is not None else {})})
+        arch.check(contract, **ip_options)
+
+        def build(c, lanes):  # noqa: ANN001, ANN202 - rtl.fpga.flow.ComponentFactory
+            return build_component(c, arch, **{**ip_options, "lanes": lanes})
+    else:
+        base.check(contract, **options)
 
     def progress(p) -> None:  # noqa: ANN001 - rvsm.model.infra.tools.Progress
         if not args.quiet:
             print(f"rvsm fpga: {p.line()}", file=sys.stderr, flush=True)
 
-    common = dict(arch=args.arch, lanes=options.get("lanes"), size=args.size,
+    common = dict(arch=arch, lanes=options.get("lanes"), size=args.size,
                   device=args.device, speed=args.speed, target_mhz=args.freq,
                   netlist="rtlil" if args.rtlil else "verilog", memory=args.memory,
                   slope_lanes=args.slope_lanes, on_progress=progress,
-                  timeout=args.timeout)
+                  timeout=args.timeout, build=build)
     if args.seeds is not None:
         if args.seeds < 1:
             raise RvsmError(f"--seeds must be >= 1, got {args.seeds}")

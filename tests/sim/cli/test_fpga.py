@@ -52,3 +52,26 @@ def test_bad_input_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture, fsm_
     assert main(["fpga", str(tmp_path / "p.toml"), "--lanes", "0", "--arch", "parallel"]) == 2
     assert main(["fpga", str(tmp_path / "p.toml"), "--arch", "stream", "--size", "2x2",
                  "--lanes", "3", "--synth-only", "-o", str(tmp_path / "w")]) == 2
+
+
+def test_interface_axis_places_the_ip(tmp_path: Path, capsys: pytest.CaptureFixture,
+                                      monkeypatch: pytest.MonkeyPatch, fsm_point,
+                                      fake_tool) -> None:
+    """``--interface axis`` hands the flow the AXI IP around the array (the netlist has
+    its AXI ports; yosys here is a stand-in that fails after the Verilog is written)."""
+    save_design_point(tmp_path / "p.toml", fsm_point)
+    point = str(tmp_path / "p.toml")
+    monkeypatch.setenv("RVSM_YOSYS", str(fake_tool(tmp_path / "y", "exit 1\n")))
+    assert main(["fpga", point, "--size", "4x8", "--lanes", "2", "--interface", "axis",
+                 "--fifo-depth", "6", "--synth-only", "--quiet", "-o",
+                 str(tmp_path / "w")]) == 3
+    top = (tmp_path / "w" / "top.v").read_text()
+    assert "s_axil__awvalid" in top and "m_axis__tvalid" in top  # the AXI ports
+    assert "module \\rvsm_fpga_top.dut.fifo" in top  # and the output FIFO
+    capsys.readouterr()
+    assert main(["fpga", point, "--size", "4x8", "--lanes", "2", "--fifo-depth", "6",
+                 "--synth-only", "-o", str(tmp_path / "n")]) == 2
+    assert "--fifo-depth applies to --interface axis only" in capsys.readouterr().err
+    assert main(["fpga", point, "--size", "2x2", "--arch", "parallel", "--interface",
+                 "axis", "--synth-only", "-o", str(tmp_path / "p")]) == 2
+    assert "wraps the streaming array" in capsys.readouterr().err
