@@ -183,6 +183,7 @@ class _Twin:
                       "num_steps": source.num_steps, "lanes": geo.lanes,
                       "flush": [(n, self._encode_beats(b)) for n, b in self._parts(flush)]}
         self.expected: dict[int, np.ndarray] = {}
+        self.files: dict[int, list[str]] = {}  # input files of chunks not yet taken
         self.produced = self.taken = 0
         self.exhausted = False
         self.failed_at: int | None = None
@@ -213,6 +214,7 @@ class _Twin:
             parts.append((n, str(path)))
         self.seconds["encode"] += time.perf_counter() - tb
         self.expected[k] = chunk.spikes
+        self.files[k] = [path for _, path in parts]
         self.produced += 1
         if self.first_chunk_at is None:
             self.first_chunk_at = time.time() - self.t_start
@@ -225,6 +227,7 @@ class _Twin:
             k = int(msg[1])
             self.taken = k + 1
             spikes = self.expected.pop(k)
+            del self.files[k]
             if self.failed_at is None:
                 self.checker.expect(spikes)
                 self.border.update(spikes)
@@ -273,6 +276,9 @@ class _Twin:
 
     def result(self, ended: bool, steps_done: int) -> dict:
         """The checker's verdict and the twin's figures."""
+        for paths in self.files.values():  # made ahead of a run stopped early
+            for path in paths:
+                Path(path).unlink(missing_ok=True)
         c = self.contract
         finished = ended and self.failed_at is None
         r = {"result": self.checker.result(finished=finished),

@@ -118,14 +118,21 @@ async def stream_long_run(dut: object) -> None:
                 raise RuntimeError(f"the twin's process failed:\n{msg[1]}")
             else:
                 inbox.append(msg)
+                if kind == "result":
+                    return  # the twin's last message: it closes the socket next
 
     def wait_for(kind: str) -> tuple:
-        while not inbox:
-            pump(block=True)
-        msg = inbox.popleft()
-        if msg[0] not in (kind, "end"):
-            raise RuntimeError(f"expected {kind!r} from the twin's process, got {msg[0]!r}")
-        return msg
+        """The next message of ``kind`` (``"chunk"``: or ``"end"``); chunks made ahead
+        are dropped when waiting for the result of a run stopped early."""
+        while True:
+            while not inbox:
+                pump(block=True)
+            msg = inbox.popleft()
+            if msg[0] == kind or (kind == "chunk" and msg[0] == "end"):
+                return msg
+            if kind != "result":
+                raise RuntimeError(f"expected {kind!r} from the twin's process, got "
+                                   f"{msg[0]!r}")
 
     setup = wait_for("setup")[1]
     layout = HarnessLayout.from_ports(load_ports_json(testbench_arg("ports")), depth)
