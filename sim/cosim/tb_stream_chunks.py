@@ -161,10 +161,13 @@ async def stream_long_run(dut: object) -> None:
         to the twin's process."""
         for count, path, text in parts:
             ta = time.perf_counter()
+            # never over an existing file: ext4 writes a file renamed over another, or
+            # truncated, out to disk first (auto_da_alloc), 4-5 ms each, measured
+            in_file.unlink(missing_ok=True)
             if text is not None:
                 in_file.write_bytes(text)
             else:
-                os.replace(path, in_file)
+                os.rename(path, in_file)
             tb = time.perf_counter()
             cpu = time.thread_time()  # the simulator runs in this thread: its CPU time
             h["count"].value = count
@@ -179,7 +182,7 @@ async def stream_long_run(dut: object) -> None:
             out = None
             if n_out:
                 out = str(cwd / f"chunk_out.{counts['parts']}.hex")
-                os.replace(out_file, out)
+                os.rename(out_file, out)  # a new name: $writememh makes a new file
             conn.send(("check", out, n_out))
             counts["sent"] += 1
             pump(block=False)
