@@ -5,9 +5,9 @@ no cocotb (``scripts/bench_rtl.py --only icarus`` prints it beside the whole run
 Given a long-run harness build for Icarus (its folder: ``rvsm_chunk_harness.v``, the
 ``.icarus.v`` netlist, the port map) and the run's source (the JSON of
 ``StimulusChunks.spec``), this writes every chunk's input beats as the testbench does
-(chunks of 8 steps, then the ``lag`` flush), the threshold writes as ``{addr, data}``
-words, and a Verilog driver that resets the harness, writes the thresholds one per
-cycle, then streams each chunk (``start`` ... ``done``) exactly as the testbench does;
+(chunks of 8 steps, then the ``lag`` flush), the threshold writes, and a Verilog driver
+that resets the harness, has it write the thresholds (``thr_load``), then streams each
+chunk (``start`` ... ``done``) exactly as the testbench does, and the same file names;
 compiles it with ``iverilog`` and times ``vvp``. Output: one JSON line with ``cycles``,
 ``seconds`` (wall), ``user_seconds`` (vvp's CPU) and ``cycles_per_second``.
 
@@ -30,36 +30,37 @@ import numpy as np
 from rvsm.model.fixed.stimulus_chunks import open_stimulus_chunks
 from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.stream.drive import threshold_writes
-from rvsm.sim.cosim.chunk_harness import HARNESS_TOP, HarnessLayout, encode_input_beats
+from rvsm.sim.cosim.chunk_harness import (
+    HARNESS_TOP,
+    HarnessLayout,
+    encode_input_beats,
+    encode_threshold_writes,
+)
 from rvsm.sim.cosim.tb_common import stream_geometry
 
 CHUNK_STEPS = 8
 
 DRIVER = """`timescale 1ns/1ps
 module rvsm_plain_driver;
-  reg rst = 1, clear = 0, thr_we = 0, start = 0;
+  reg rst = 1, clear = 0, thr_we = 0, thr_load = 0, start = 0;
+  reg [31:0] thr_count = {nthr};
   reg [{ab}:0] thr_addr = 0;
   reg [{db}:0] thr_data = 0;
   reg [31:0] count = 0;
   wire clk, done, overflow;
   wire [31:0] out_count, stray;
-  reg [{wb}:0] thr_mem [0:{nthr}];
   reg [31:0] counts [0:{nchunks}];
   reg [8*1024-1:0] name;
   integer k;
   {top} h (.clk(clk), .rst(rst), .clear(clear), .thr_we(thr_we), .thr_addr(thr_addr),
-    .thr_data(thr_data), .start(start), .count(count), .done(done),
+    .thr_data(thr_data), .thr_load(thr_load), .thr_count(thr_count), .start(start),
+    .count(count), .done(done),
     .out_count(out_count), .stray(stray), .overflow(overflow));
   initial begin
-    $readmemh("thr.hex", thr_mem);
     $readmemh("counts.hex", counts);
     @(negedge clk); @(negedge clk); rst = 0;
-    thr_we = 1;
-    for (k = 0; k <= {nthr}; k = k + 1) begin
-      {{thr_addr, thr_data}} = thr_mem[k];
-      @(negedge clk);
-    end
-    thr_we = 0;
+    thr_load = 1; @(negedge clk); thr_load = 0;
+    @(posedge done); @(negedge clk);
     for (k = 0; k <= {nchunks}; k = k + 1) begin
       $sformat(name, "in_%0d.hex", k);
       h.in_file = name;
@@ -96,11 +97,10 @@ def write_replay(build_dir: Path, source_json: str, work: Path) -> int:
     part(np.zeros((sched.lag, geo.lanes), dtype=np.uint16))
     ab, db = layout.widths["thr_addr"], layout.widths["thr_data"]
     writes = threshold_writes(geo, source.thresholds)
-    digits = -(-(ab + db) // 4)
-    (work / "thr.hex").write_text("".join(f"{(a << db) | d:0{digits}x}\n" for a, d in writes))
+    (work / "thresholds.hex").write_bytes(encode_threshold_writes(writes, ab, db))
     (work / "counts.hex").write_text("".join(f"{n:08x}\n" for n in counts))
     (work / "driver.v").write_text(DRIVER.format(
-        ab=ab - 1, db=db - 1, wb=ab + db - 1, nthr=len(writes) - 1,
+        ab=ab - 1, db=db - 1, nthr=len(writes),
         nchunks=len(counts) - 1, top=HARNESS_TOP))
     return len(counts)
 

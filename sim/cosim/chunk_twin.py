@@ -14,9 +14,10 @@ listens on a Unix socket (:mod:`multiprocessing.connection`, an authentication k
 the environment); the testbench connects (:func:`connect`) and the two exchange small
 messages, in order:
 
-* twin -> testbench: ``("setup", {...})`` (threshold writes, steps, the flush beats as
-  ``$readmemh`` text), then ``("chunk", k, t0, steps, clear, [(beats, path), ...])`` per
-  chunk (its input files, written; at most ``AHEAD`` chunks not yet taken), ``("end",)``;
+* twin -> testbench: ``("setup", {...})`` (the number of threshold writes, whose file
+  ``thresholds.hex`` is written; steps; lanes; the flush beats as ``$readmemh`` text),
+  then ``("chunk", k, t0, steps, clear, [(beats, path), ...])`` per chunk (its input
+  files, written; at most ``AHEAD`` chunks not yet taken), ``("end",)``;
   ``("checked",)`` per output file checked, ``("failed", step)`` once a chunk mismatched
   (when stopping at the first failing chunk), ``("result", {...})`` at the end,
   ``("error", text)``;
@@ -60,6 +61,7 @@ from rvsm.sim.cosim.chunk_harness import (
     HarnessLayout,
     decode_output_beats,
     encode_input_beats,
+    encode_threshold_writes,
 )
 from rvsm.sim.cosim.tb_common import stream_geometry
 
@@ -179,7 +181,10 @@ class _Twin:
         self.chunks: Iterator = source.chunks(int(cfg["chunk_steps"]))
         self.num_steps = source.num_steps
         flush = np.zeros((self.sched.lag, geo.lanes), dtype=np.uint16)
-        self.setup = {"thresholds": threshold_writes(geo, source.thresholds),
+        writes = threshold_writes(geo, source.thresholds)
+        (self.dir / "thresholds.hex").write_bytes(encode_threshold_writes(
+            writes, self.layout.widths["thr_addr"], self.layout.widths["thr_data"]))
+        self.setup = {"thresholds": len(writes),
                       "num_steps": source.num_steps, "lanes": geo.lanes,
                       "flush": [(n, self._encode_beats(b)) for n, b in self._parts(flush)]}
         self.expected: dict[int, np.ndarray] = {}

@@ -22,7 +22,8 @@ one trigger, while the simulator runs every beat of the chunk. It then moves
 ``chunk_out.hex`` aside and hands it to the twin's process, which decodes and checks it
 (:class:`~rvsm.rtl.stream.schedule.StreamChecker`) while the simulator runs the next
 chunk. Before a clear it flushes the stream with ``lag`` zero beats and pulses
-``clear``. Thresholds are written first, one word per cycle from Python. Memory stays
+``clear``. The thresholds are written first, by the harness (``thr_load``: the twin's
+``thresholds.hex``, one word per cycle). Memory stays
 bounded: a few chunks of steps in the twin's process, a few files in flight.
 
 ``seconds`` in the result: ``wait_for_twin`` (the testbench waited for a chunk),
@@ -138,16 +139,17 @@ async def stream_long_run(dut: object) -> None:
     layout = HarnessLayout.from_ports(load_ports_json(testbench_arg("ports")), depth)
     clk = dut.clk  # type: ignore[attr-defined]
     h = {name: getattr(dut, name) for name in layout.ports}
-    await clock_and_reset(dut, ("clear", "thr_we", "thr_addr", "thr_data", "start",
-                                "count"), clock=clock == "outside")
+    await clock_and_reset(dut, ("clear", "thr_we", "thr_addr", "thr_data", "thr_load",
+                                "thr_count", "start", "count"), clock=clock == "outside")
     mark("reset")
     t0 = time.perf_counter()
-    h["thr_we"].value = 1
-    for addr, word in setup["thresholds"]:
-        h["thr_addr"].value = addr
-        h["thr_data"].value = word
+    if setup["thresholds"]:  # the harness writes them, one per cycle (thresholds.hex)
+        h["thr_count"].value = setup["thresholds"]
+        h["thr_load"].value = 1
         await FallingEdge(clk)
-    h["thr_we"].value = 0
+        h["thr_load"].value = 0
+        await RisingEdge(h["done"])
+        await FallingEdge(clk)
     mark("thresholds")
     timings = {"wait_for_twin": 0.0, "simulate": 0.0, "simulate_cpu": 0.0, "handover": 0.0,
                "thresholds": time.perf_counter() - t0, "wait_for_check": 0.0}
