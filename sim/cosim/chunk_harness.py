@@ -318,6 +318,8 @@ def decode_output_beats(text: bytes, bits: int) -> tuple[np.ndarray, np.ndarray]
 
     Comment lines (``//``) and blank lines are skipped."""
     digits = -(-bits // 4)
+    while text.startswith(b"//"):  # Icarus heads the file with "// 0x00000000"
+        text = text[text.find(b"\n") + 1:] if b"\n" in text else b""
     fast = np.frombuffer(text, dtype=np.uint8)
     if fast.size and fast.size % (digits + 1) == 0:  # only fixed-width lines: no split
         rows = fast.reshape(-1, digits + 1)

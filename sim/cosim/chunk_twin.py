@@ -23,7 +23,8 @@ messages, in order:
   ``("error", text)``;
 * testbench -> twin: ``("expect", k)`` (chunk ``k``'s beats go in next),
   ``("restart", t0)`` (a clear), ``("check", path, beats)`` (an output file, removed
-  once read), ``("chunk_end", steps_done)``, ``("finish", ended, steps_done)``.
+  once read), ``("chunk_end", steps_done)``, ``("finish", ended, steps_done)``; sent as
+  ``("batch", [...])``, one per output file (each message wakes the twin's process).
 
 The check is :class:`~rvsm.rtl.stream.schedule.StreamChecker`'s, in the same order as
 the beats were simulated, so a mismatch reports its step, scale, row, column and clock
@@ -325,12 +326,13 @@ def serve(cfg: dict, key: bytes) -> None:
             except EOFError:
                 return  # the testbench ended (or was stopped)
             twin.seconds["idle"] += time.perf_counter() - t
-            if msg[0] == "finish":
-                c.send(("result", twin.result(bool(msg[1]), int(msg[2]))))
-                return
-            reply = twin.handle(msg)
-            if reply is not None:
-                c.send(reply)
+            for m in msg[1] if msg[0] == "batch" else [msg]:
+                if m[0] == "finish":
+                    c.send(("result", twin.result(bool(m[1]), int(m[2]))))
+                    return
+                reply = twin.handle(m)
+                if reply is not None:
+                    c.send(reply)
     except BaseException:
         text = traceback.format_exc(limit=8)
         print(text, file=sys.stderr, flush=True)
