@@ -2,19 +2,15 @@
 chunk by chunk against the fixed twin, with cocotb in charge and the simulator running
 every cycle.
 
-Inputs (environment, or ``+rvsm_<name>=`` plusargs): ``RVSM_SOURCE`` -- the JSON
-description of the run (:func:`rvsm.model.fixed.stimulus_chunks.open_stimulus_chunks`: a
-stimulus file, or a scene through a design point); ``RVSM_PORTS`` -- the array's
+Inputs (environment, or ``+rvsm_<name>=`` plusargs): ``RVSM_PORTS`` -- the array's
 ``<top>.ports.json``; ``RVSM_RESULT`` -- where the JSON result goes; ``RVSM_TWIN`` and
-``RVSM_TWIN_KEY`` -- the socket of the twin's process (:mod:`.chunk_twin`, started by
-:func:`~.long_run.check_chunks` before the simulator; without them the testbench starts
-one itself); optional ``RVSM_CHUNK_STEPS`` (steps produced at a time, default 8),
-``RVSM_DEPTH`` (the harness's beats per chunk, default
-:data:`~.chunk_harness.DEFAULT_DEPTH`), ``RVSM_PROGRESS`` (a file rewritten with ``steps
-done/total`` after each chunk), ``RVSM_STOP_AFTER_CYCLE`` (stop once the simulation
-passes that cycle: a waveform window's re-run) and ``RVSM_HARNESS_CLOCK`` (``inside``:
-the harness makes ``clk`` itself, :func:`~.chunk_harness.clock_inside`; default
-``outside``, a cocotb ``Clock``).
+``RVSM_TWIN_KEY`` (environment only) -- the socket of the twin's process
+(:mod:`.chunk_twin`, which :func:`~.long_run.check_chunks` starts before the simulator
+on the run's source, chunk steps and harness depth); optional ``RVSM_PROGRESS`` (a file
+rewritten with ``steps done/total`` as chunks finish), ``RVSM_STOP_AFTER_CYCLE`` (stop
+once the simulation passes that cycle: a waveform window's re-run) and
+``RVSM_HARNESS_CLOCK`` (``inside``: the harness makes ``clk`` itself,
+:func:`~.chunk_harness.clock_inside`; default ``outside``, a cocotb ``Clock``).
 
 The twin's process makes each chunk's input beats as a ``$readmemh`` file; per chunk
 the testbench moves the file to ``chunk_in.hex``, pulses ``start`` and awaits ``done``:
@@ -48,15 +44,13 @@ import cocotb
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge, RisingEdge
 
-from rvsm.model.fixed.stimulus_chunks import open_stimulus_chunks
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.rtl.ports import load_ports_json
 from rvsm.sim.cosim.chunk_harness import CLOCK_NS as HARNESS_CLOCK_NS
-from rvsm.sim.cosim.chunk_harness import DEFAULT_DEPTH, HarnessLayout
-from rvsm.sim.cosim.chunk_twin import connect, start_twin
+from rvsm.sim.cosim.chunk_harness import HarnessLayout
+from rvsm.sim.cosim.chunk_twin import connect
 from rvsm.sim.cosim.tb_common import CLOCK_NS, clock_and_reset, testbench_arg
 
-DEFAULT_CHUNK_STEPS = 8
 #: Output files the twin's process may have left to check before the testbench waits.
 MAX_BEHIND = 4
 #: Seconds between rewrites of the progress file.
@@ -80,23 +74,16 @@ async def stream_long_run(dut: object) -> None:
         timeline[event] = round(time.perf_counter() - t_begin, 4)
 
     result_path = testbench_arg("result")
-    chunk_steps = int(_optional("chunk_steps", str(DEFAULT_CHUNK_STEPS)))
-    depth = int(_optional("depth", str(DEFAULT_DEPTH)))
     progress = _optional("progress", None)
     stop_after = _optional("stop_after_cycle", None)
     clock = _optional("harness_clock", "outside")
     if clock not in ("inside", "outside") or HARNESS_CLOCK_NS != CLOCK_NS:
         raise RuntimeError(f"RVSM_HARNESS_CLOCK must be inside or outside, got {clock!r} "
                            f"(harness period {HARNESS_CLOCK_NS} ns, testbench {CLOCK_NS})")
-    own = None
-    address = os.environ.get("RVSM_TWIN")
-    if address:
-        key = os.environ["RVSM_TWIN_KEY"]
-    else:  # run outside check_chunks: start the twin here
-        source = open_stimulus_chunks(testbench_arg("source"))
-        own = start_twin(json.dumps(source.spec), testbench_arg("ports"), Path.cwd(),
-                         chunk_steps, depth, stop_on_mismatch=stop_after is None)
-        address, key = own.address, own.key
+    address, key = os.environ.get("RVSM_TWIN"), os.environ.get("RVSM_TWIN_KEY")
+    if not address or not key:
+        raise RuntimeError("set RVSM_TWIN and RVSM_TWIN_KEY: the twin's process "
+                           "(rvsm.sim.cosim.chunk_twin.start_twin, which check_chunks runs)")
     conn = connect(address, key)
     mark("connected")
     log = dut._log  # type: ignore[attr-defined]
@@ -138,7 +125,7 @@ async def stream_long_run(dut: object) -> None:
                                    f"{msg[0]!r}")
 
     setup = wait_for("setup")[1]
-    layout = HarnessLayout.from_ports(load_ports_json(testbench_arg("ports")), depth)
+    layout = HarnessLayout.from_ports(load_ports_json(testbench_arg("ports")))
     clk = dut.clk  # type: ignore[attr-defined]
     h = {name: getattr(dut, name) for name in layout.ports}
     await clock_and_reset(dut, ("clear", "thr_we", "thr_addr", "thr_data", "thr_load",
@@ -251,8 +238,6 @@ async def stream_long_run(dut: object) -> None:
     timings["wait_for_check"] += time.perf_counter() - te
     stream_seconds = time.perf_counter() - t0
     conn.close()
-    if own is not None:
-        own.close()
     mark("end")
     timeline["twin_first_chunk"] = twin["first_chunk_at"]
     stray = int(h["stray"].value)
