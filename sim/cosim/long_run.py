@@ -35,7 +35,8 @@ from rvsm.rtl.architecture import Architecture
 from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.sim.cosim.build_cache import SimBuild, build, new_run_dir
-from rvsm.sim.cosim.chunk_harness import clock_inside
+from rvsm.sim.cosim.chunk_harness import DEFAULT_DEPTH, clock_inside
+from rvsm.sim.cosim.chunk_twin import start_twin
 from rvsm.sim.cosim.code_coverage import read_coverage, summary
 from rvsm.sim.cosim.simulation import run_cocotb
 
@@ -69,6 +70,20 @@ def _source_inputs(source: StimulusChunks, run_dir: Path, chunk_steps: int) -> d
     return {"RVSM_SOURCE": json.dumps(spec), "RVSM_CHUNK_STEPS": str(int(chunk_steps))}
 
 
+def _run(sb: SimBuild, inputs: dict, run_dir: Path, plusargs: list[str],
+         hdl_dumps: bool) -> dict:
+    """One testbench run, the twin's process (:mod:`.chunk_twin`) started first: its
+    first chunk is made while the simulator starts."""
+    twin = start_twin(inputs["RVSM_SOURCE"], sb.ports_json.resolve(), run_dir,
+                      int(inputs["RVSM_CHUNK_STEPS"]), DEFAULT_DEPTH,
+                      stop_on_mismatch="RVSM_STOP_AFTER_CYCLE" not in inputs)
+    try:
+        return run_cocotb(sb, {**inputs, **twin.env()}, run_dir, plusargs=plusargs,
+                          hdl_dumps=hdl_dumps)
+    finally:
+        twin.close()
+
+
 def _run_with_progress(sb: SimBuild, inputs: dict, run_dir: Path, total: int, desc: str,
                        progress: bool, plusargs: list[str], waves: bool) -> dict:
     """One testbench run; a thread follows ``progress.txt`` into a progress bar."""
@@ -92,7 +107,7 @@ def _run_with_progress(sb: SimBuild, inputs: dict, run_dir: Path, total: int, de
     if thread is not None:
         thread.start()
     try:
-        return run_cocotb(sb, inputs, run_dir, plusargs=plusargs, hdl_dumps=waves)
+        return _run(sb, inputs, run_dir, plusargs, waves)
     finally:
         stop.set()
         if thread is not None:
@@ -172,6 +187,6 @@ def _window(sb: SimBuild, inputs: dict, run_dir: Path, cycle: int,
     wave = again / WINDOW_WAVES
     plusargs = [f"+rvsm_dump_file={wave}", f"+rvsm_dump_from={lo}", f"+rvsm_dump_to={hi}"]
     inputs = {**inputs, "RVSM_STOP_AFTER_CYCLE": str(hi)}
-    run_cocotb(sb, inputs, again, plusargs=plusargs, hdl_dumps=True)
+    _run(sb, inputs, again, plusargs, hdl_dumps=True)
     return {"waves": str(wave) if wave.exists() else None,
             "wave_window_cycles": [lo, hi]}

@@ -2,63 +2,59 @@
 chunk by chunk against the fixed twin, with cocotb in charge and the simulator running
 every cycle.
 
-Inputs (environment, or ``+rvsm_<name>=`` plusargs): ``RVSM_SOURCE`` -- the JSON
-description of the run (:func:`rvsm.model.fixed.stimulus_chunks.open_stimulus_chunks`: a
-stimulus file, or a scene through a design point); ``RVSM_PORTS`` -- the array's
-``<top>.ports.json``; ``RVSM_RESULT`` -- where the JSON result goes; optional
-``RVSM_CHUNK_STEPS`` (steps produced at a time, default 8), ``RVSM_DEPTH`` (the
-harness's beats per chunk, default :data:`~.chunk_harness.DEFAULT_DEPTH`),
-``RVSM_PROGRESS`` (a file rewritten with ``steps done/total`` after each chunk),
-``RVSM_STOP_AFTER_CYCLE`` (stop once the simulation passes that cycle: a waveform
-window's re-run), ``RVSM_HARNESS_CLOCK`` (``inside``: the harness makes ``clk``
-itself, :func:`~.chunk_harness.clock_inside`; default ``outside``, a cocotb ``Clock``)
-and ``RVSM_PRODUCER`` (``process``, default: the twin runs in a forked process beside
-the simulator, :class:`ProcessChunkProducer`; ``thread``: in a thread of the simulator's
-process, :class:`ChunkProducer`).
+Inputs (environment, or ``+rvsm_<name>=`` plusargs): ``RVSM_PORTS`` -- the array's
+``<top>.ports.json``; ``RVSM_RESULT`` -- where the JSON result goes; ``RVSM_TWIN`` and
+``RVSM_TWIN_KEY`` (environment only) -- the socket of the twin's process
+(:mod:`.chunk_twin`, which :func:`~.long_run.check_chunks` starts before the simulator
+on the run's source, chunk steps and harness depth); optional ``RVSM_PROGRESS`` (a file
+rewritten with ``steps done/total`` as chunks finish), ``RVSM_STOP_AFTER_CYCLE`` (stop
+once the simulation passes that cycle: a waveform window's re-run) and
+``RVSM_HARNESS_CLOCK`` (``inside``: the harness makes ``clk`` itself,
+:func:`~.chunk_harness.clock_inside`; default ``outside``, a cocotb ``Clock``).
 
-Per chunk of steps the testbench gets codes and expected spikes (the twin, produced
-there and then), writes the input beats as a ``$readmemh`` file, pulses ``start`` and
-awaits ``done``: one trigger, while the simulator runs every beat of the chunk. It then
-reads the output file and checks it with :class:`~rvsm.rtl.stream.schedule.StreamChecker`.
-Before a clear it flushes the stream with ``lag`` zero beats and pulses ``clear``.
-Thresholds are written first, one word per cycle from Python. Memory stays bounded: one
-chunk of steps and the beats in flight.
+The twin's process makes each chunk's input beats as a ``$readmemh`` file; per chunk
+the testbench moves the file to ``chunk_in.hex``, pulses ``start`` and awaits ``done``:
+one trigger, while the simulator runs every beat of the chunk. It then moves
+``chunk_out.hex`` aside and hands it to the twin's process, which decodes and checks it
+(:class:`~rvsm.rtl.stream.schedule.StreamChecker`) while the simulator runs the next
+chunk. Before a clear it flushes the stream with ``lag`` zero beats and pulses
+``clear``. The thresholds are written first, by the harness (``thr_load``: the twin's
+``thresholds.hex``, one word per cycle). Memory stays
+bounded: a few chunks of steps in the twin's process, a few files in flight.
+
+``seconds`` in the result: ``wait_for_twin`` (the testbench waited for a chunk),
+``simulate`` (the simulator ran chunks: wall; ``simulate_cpu``: its thread's CPU),
+``handover`` (moving files and messages between chunks), ``thresholds``,
+``wait_for_check`` (waited for the twin's checks: falling behind, and the last one);
+the twin's own, on its core: ``twin``, ``encode``, ``decode``, ``check``, ``idle``.
+``timeline``: seconds since the test started at which it connected, reset, wrote the
+thresholds, got the first chunk, handed the first and the last chunks over, and ended
+(``twin_first_chunk``: since the twin's process started).
 """
 
 from __future__ import annotations
 
 import json
 import os
-import queue
-import threading
 import time
-from collections.abc import Callable, Iterator
+from collections import deque
 from pathlib import Path
 
 import cocotb
-import numpy as np
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge, RisingEdge
 
-from rvsm.model.fixed.stimulus_chunks import open_stimulus_chunks
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.rtl.ports import load_ports_json
-from rvsm.rtl.stream.coverage import BorderCoverage
-from rvsm.rtl.stream.drive import threshold_writes
-from rvsm.rtl.stream.schedule import OutputBeats, StreamChecker
-from rvsm.sim.cosim.chunk_harness import (
-    CLOCK_NS as HARNESS_CLOCK_NS,
-)
-from rvsm.sim.cosim.chunk_harness import (
-    DEFAULT_DEPTH,
-    STAMP_BITS,
-    HarnessLayout,
-    decode_output_beats,
-    encode_input_beats,
-)
-from rvsm.sim.cosim.tb_common import CLOCK_NS, clock_and_reset, stream_geometry, testbench_arg
+from rvsm.sim.cosim.chunk_harness import CLOCK_NS as HARNESS_CLOCK_NS
+from rvsm.sim.cosim.chunk_harness import HarnessLayout
+from rvsm.sim.cosim.chunk_twin import connect
+from rvsm.sim.cosim.tb_common import CLOCK_NS, clock_and_reset, testbench_arg
 
-DEFAULT_CHUNK_STEPS = 8
+#: Output files the twin's process may have left to check before the testbench waits.
+MAX_BEHIND = 4
+#: Seconds between rewrites of the progress file.
+PROGRESS_SECONDS = 0.5
 
 
 def _optional(name: str, default: str | None) -> str | None:
@@ -68,74 +64,101 @@ def _optional(name: str, default: str | None) -> str | None:
         return default
 
 
-def _bits_value(bits: np.ndarray, offset: int, width: int) -> np.ndarray:
-    """Columns ``[offset, offset + width)`` of little-endian bit rows as integers."""
-    cols = bits[:, offset:offset + width].astype(np.int64)
-    return cols @ (np.int64(1) << np.arange(width, dtype=np.int64))
-
-
 @cocotb.test()
 async def stream_long_run(dut: object) -> None:
-    """Stream the whole run chunk by chunk; check every output beat as it comes."""
-    source = open_stimulus_chunks(testbench_arg("source"))
-    ports = load_ports_json(testbench_arg("ports"))
+    """Stream the whole run chunk by chunk; the twin's process checks every output beat."""
+    t_begin = time.perf_counter()
+    timeline: dict[str, float] = {}
+
+    def mark(event: str) -> None:
+        timeline[event] = round(time.perf_counter() - t_begin, 4)
+
     result_path = testbench_arg("result")
-    chunk_steps = int(_optional("chunk_steps", str(DEFAULT_CHUNK_STEPS)))
-    depth = int(_optional("depth", str(DEFAULT_DEPTH)))
     progress = _optional("progress", None)
     stop_after = _optional("stop_after_cycle", None)
     clock = _optional("harness_clock", "outside")
     if clock not in ("inside", "outside") or HARNESS_CLOCK_NS != CLOCK_NS:
         raise RuntimeError(f"RVSM_HARNESS_CLOCK must be inside or outside, got {clock!r} "
                            f"(harness period {HARNESS_CLOCK_NS} ns, testbench {CLOCK_NS})")
-    c = source.contract
-    geo = stream_geometry(c, ports)
-    lanes = geo.lanes
-    sched = geo.schedule
-    layout = HarnessLayout.from_ports(ports, depth)
-    fields = layout.fields
-    scales = c.num_scales
-    cwd = Path.cwd()
-    in_file, out_file = cwd / "chunk_in.hex", cwd / "chunk_out.hex"
+    address, key = os.environ.get("RVSM_TWIN"), os.environ.get("RVSM_TWIN_KEY")
+    if not address or not key:
+        raise RuntimeError("set RVSM_TWIN and RVSM_TWIN_KEY: the twin's process "
+                           "(rvsm.sim.cosim.chunk_twin.start_twin, which check_chunks runs)")
+    conn = connect(address, key)
+    mark("connected")
+    log = dut._log  # type: ignore[attr-defined]
+    inbox: deque = deque()
+    state = {"acked": 0, "failed": None}
 
-    def encode(beats: np.ndarray) -> list[tuple[int, bytes]]:
-        """``beats (K, P)`` as ``$readmemh`` texts of at most ``depth`` beats each."""
-        return [(min(depth, beats.shape[0] - k0),
-                 encode_input_beats(beats[k0:k0 + depth], c.adc_bits, layout.in_bits))
-                for k0 in range(0, beats.shape[0], depth)]
+    def pump(block: bool) -> None:
+        """Read the twin's messages (waiting for one when ``block``)."""
+        while block or conn.poll():
+            try:
+                msg = conn.recv()
+            except EOFError:
+                raise RuntimeError("the twin's process ended before the run did (see "
+                                   "twin.log in the run folder)") from None
+            block = False
+            kind = msg[0]
+            if kind == "checked":
+                state["acked"] += 1
+            elif kind == "failed":
+                state["failed"] = msg[1]
+            elif kind == "error":
+                raise RuntimeError(f"the twin's process failed:\n{msg[1]}")
+            else:
+                inbox.append(msg)
+                if kind == "result":
+                    return  # the twin's last message: it closes the socket next
 
-    # The twin starts at once: its first chunk (imports, the JIT cache, the scene's first
-    # frames) is made while the simulator resets and takes the thresholds.
-    flush = encode(np.zeros((sched.lag, lanes), dtype=np.uint16))
-    producer = make_producer(os.environ.get("RVSM_PRODUCER", "process"),
-                             lambda: source.chunks(chunk_steps),
-                             lambda chunk: encode(sched.frame_beats(chunk.codes)))
+    def wait_for(kind: str) -> tuple:
+        """The next message of ``kind`` (``"chunk"``: or ``"end"``); chunks made ahead
+        are dropped when waiting for the result of a run stopped early."""
+        while True:
+            while not inbox:
+                pump(block=True)
+            msg = inbox.popleft()
+            if msg[0] == kind or (kind == "chunk" and msg[0] == "end"):
+                return msg
+            if kind != "result":
+                raise RuntimeError(f"expected {kind!r} from the twin's process, got "
+                                   f"{msg[0]!r}")
+
+    setup = wait_for("setup")[1]
+    layout = HarnessLayout.from_ports(load_ports_json(testbench_arg("ports")))
     clk = dut.clk  # type: ignore[attr-defined]
     h = {name: getattr(dut, name) for name in layout.ports}
-    await clock_and_reset(dut, ("clear", "thr_we", "thr_addr", "thr_data", "start",
-                                "count"), clock=clock == "outside")
+    await clock_and_reset(dut, ("clear", "thr_we", "thr_addr", "thr_data", "thr_load",
+                                "thr_count", "start", "count"), clock=clock == "outside")
+    mark("reset")
     t0 = time.perf_counter()
-    h["thr_we"].value = 1
-    for addr, word in threshold_writes(geo, source.thresholds):
-        h["thr_addr"].value = addr
-        h["thr_data"].value = word
+    if setup["thresholds"]:  # the harness writes them, one per cycle (thresholds.hex)
+        h["thr_count"].value = setup["thresholds"]
+        h["thr_load"].value = 1
         await FallingEdge(clk)
-    h["thr_we"].value = 0
+        h["thr_load"].value = 0
+        await RisingEdge(h["done"])
+        await FallingEdge(clk)
+    mark("thresholds")
+    timings = {"wait_for_twin": 0.0, "simulate": 0.0, "simulate_cpu": 0.0, "handover": 0.0,
+               "thresholds": time.perf_counter() - t0, "wait_for_check": 0.0}
+    cwd = Path.cwd()
+    in_file, out_file = cwd / "chunk_in.hex", cwd / "chunk_out.hex"
+    flush = [(n, None, text) for n, text in setup["flush"]]
+    counts = {"beats": 0, "parts": 0, "sent": 0}
 
-    checker = StreamChecker(sched)
-    border = BorderCoverage(c, lanes)
-    timings = {"wait_for_twin": 0.0, "encode": 0.0, "simulate": 0.0, "decode": 0.0, "check": 0.0,
-               "simulate_cpu": 0.0}
-    beats_sent = chunks = 0
-    steps_done = expected_spikes = 0
-    stopped_early = False
-
-    async def send(parts: list[tuple[int, bytes]]) -> None:
-        """Stream encoded beats through the harness, one part at a time; check outputs."""
-        nonlocal beats_sent, chunks
-        for count, text in parts:
+    async def send(parts: list[tuple]) -> None:
+        """Stream input files through the harness, one part at a time; hand the outputs
+        to the twin's process."""
+        for count, path, text in parts:
             ta = time.perf_counter()
-            in_file.write_bytes(text)
+            # never over an existing file: ext4 writes a file renamed over another, or
+            # truncated, out to disk first (auto_da_alloc), 4-5 ms each, measured
+            in_file.unlink(missing_ok=True)
+            if text is not None:
+                in_file.write_bytes(text)
+            else:
+                os.rename(path, in_file)
             tb = time.perf_counter()
             cpu = time.thread_time()  # the simulator runs in this thread: its CPU time
             h["count"].value = count
@@ -147,79 +170,84 @@ async def stream_long_run(dut: object) -> None:
             tc = time.perf_counter()
             timings["simulate_cpu"] += time.thread_time() - cpu
             n_out = int(h["out_count"].value)
+            out = None
             if n_out:
-                bits, unknown = decode_output_beats(out_file.read_bytes(),
-                                                    layout.out_bits + STAMP_BITS)
-            else:
-                bits = np.zeros((0, layout.out_bits + STAMP_BITS), np.uint8)
-                unknown = np.zeros(0, bool)
-            if bits.shape[0] != n_out:
-                raise RuntimeError(f"harness wrote {bits.shape[0]} output beats, counted "
-                                   f"{n_out}")
+                out = str(cwd / f"chunk_out.{counts['parts']}.hex")
+                os.rename(out_file, out)  # a new name: $writememh makes a new file
+            outbox.append(("check", out, n_out))
+            conn.send(("batch", outbox[:]))  # one message (one wakeup) per chunk file
+            outbox.clear()
+            counts["sent"] += 1
+            pump(block=False)
             td = time.perf_counter()
-            cycles = _bits_value(bits, layout.out_bits, STAMP_BITS)
-            npos = scales * lanes
-            po, _ = fields["pos"]
-            ne, _ = fields["neg"]
-            spikes = (bits[:, po:po + npos].astype(np.int8)
-                      - bits[:, ne:ne + npos].astype(np.int8)).reshape(-1, scales, lanes)
-            got = OutputBeats(_bits_value(bits, *fields["row"]),
-                              _bits_value(bits, *fields["group"]),
-                              _bits_value(bits, *fields["last"]).astype(bool), spikes)
-            first = checker.beats
-            checker.receive(got, cycles)
-            if unknown.any():
-                k = int(np.flatnonzero(unknown)[0])
-                checker.mismatches += int(unknown.sum())
-                checker.listed.append({"beat": first + k, "cycle": int(cycles[k]),
-                                       "error": f"X/Z in {int(unknown.sum())} output "
-                                       "beat(s)"})
+            while counts["sent"] - state["acked"] > MAX_BEHIND:
+                pump(block=True)
             te = time.perf_counter()
-            timings["encode"] += tb - ta
+            timings["handover"] += (tb - ta) + (td - tc)
             timings["simulate"] += tc - tb
-            timings["decode"] += td - tc
-            timings["check"] += te - td
-            beats_sent += count
-            chunks += 1
+            timings["wait_for_check"] += te - td
+            counts["beats"] += count
+            counts["parts"] += 1
 
+    steps_done = 0
+    stopped_early = ended = False
+    outbox: list[tuple] = []  # messages to the twin, sent with the next output file
+    last_progress = 0.0
     while True:
         ta = time.perf_counter()
-        item = producer.next()
+        item = wait_for("chunk")
         timings["wait_for_twin"] += time.perf_counter() - ta
-        if item is None:
+        if "first_chunk" not in timeline:
+            mark("first_chunk")
+        if item[0] == "end":
             await send(flush)  # the last lag positions
+            ended = True
             break
-        chunk, parts = item
-        if chunk.clear:
+        _, k, t0_step, num_steps, clear, files = item
+        if clear:
             await send(flush)
             h["clear"].value = 1
             await FallingEdge(clk)
             h["clear"].value = 0
-            checker.restart(chunk.t0)
-        checker.expect(chunk.spikes)
-        border.update(chunk.spikes)
-        expected_spikes += int(np.count_nonzero(chunk.spikes))
-        await send(parts)
-        steps_done = chunk.t0 + chunk.num_steps
-        if progress:
-            write_text_atomic(progress, f"{steps_done}/{source.num_steps}\n")
-        if checker.mismatches and stop_after is None:
+            outbox.append(("restart", t0_step))
+        outbox.append(("expect", k))
+        if k == 0:
+            mark("first_handed")
+        await send([(n, path, None) for n, path in files])
+        steps_done = t0_step + num_steps
+        outbox.append(("chunk_end", steps_done))
+        if progress and time.perf_counter() - last_progress > PROGRESS_SECONDS:
+            # (the bar reads it every 0.5 s; each atomic rewrite costs about 4 ms on ext4)
+            write_text_atomic(progress, f"{steps_done}/{setup['num_steps']}\n")
+            last_progress = time.perf_counter()
+        log.info("chunk %d (steps %d..%d) done at %.3f s, simulation cycle %d", k, t0_step,
+                 steps_done - 1, time.perf_counter() - t_begin,
+                 int(get_sim_time("ns")) // CLOCK_NS)
+        pump(block=False)
+        if state["failed"] is not None:
             break  # the first failing chunk: its step is known, stop here
         if stop_after is not None and int(get_sim_time("ns")) // CLOCK_NS > int(stop_after):
             stopped_early = True
             break
-    producer.close()
-    timings["twin"] = producer.seconds
+    mark("last_done")
+    te = time.perf_counter()
+    if progress:
+        write_text_atomic(progress, f"{steps_done}/{setup['num_steps']}\n")
+    conn.send(("batch", [*outbox, ("finish", ended and not stopped_early, steps_done)]))
+    twin = wait_for("result")[1]
+    timings["wait_for_check"] += time.perf_counter() - te
     stream_seconds = time.perf_counter() - t0
+    conn.close()
+    mark("end")
+    timeline["twin_first_chunk"] = twin["first_chunk_at"]
     stray = int(h["stray"].value)
     overflow = int(h["overflow"].value)
-    ended = not stopped_early and item is None
-    result = checker.result(finished=ended)
-    if not ended:
-        result["stopped_at_step"] = steps_done
+    result = twin["result"]
+    if "stopped_at_step" in twin:
+        result["stopped_at_step"] = twin["stopped_at_step"]
     if stray or overflow:
         result["mismatches"] += stray + overflow
-        result["mismatch_list"].insert(0, {"beat": checker.beats, "error": (
+        result["mismatch_list"].insert(0, {"beat": twin["beats_received"], "error": (
             f"{stray} output beat(s) presented while no input was streamed"
             if stray else "more output beats than input beats in one chunk")})
         result["first_mismatch"] = result["mismatch_list"][0]
@@ -229,160 +257,25 @@ async def stream_long_run(dut: object) -> None:
     result.update({
         "first_mismatch_time_ns": (None if first is None or "cycle" not in first
                                    else _cycle_time_ns(first["cycle"])),
-        "steps": steps_done,
-        "accumulators": scales * c.height * c.width,
-        "expected_spikes": expected_spikes,
-        "lane_coverage": border.bins(),
-        "lanes": lanes,
+        "steps": twin.get("stopped_at_step", steps_done),
+        "accumulators": twin["accumulators"],
+        "expected_spikes": twin["expected_spikes"],
+        "lane_coverage": twin["lane_coverage"],
+        "lanes": setup["lanes"],
         "harness": "chunk",
-        "chunks": chunks,
-        "beats_streamed": beats_sent,
+        "chunks": counts["parts"],
+        "beats_streamed": counts["beats"],
         "cycles": cycles_total,
         "cycles_per_second": cycles_total / stream_seconds if stream_seconds else None,
         "stream_seconds": stream_seconds,
-        "seconds": timings,
+        "seconds": {**timings, **twin["seconds"]},
+        "timeline": timeline,
         "sim_time_ns": sim_ns,
         "pid_rss_kb": _rss_kb(),
     })
     Path(result_path).write_text(json.dumps(result))
     assert result["mismatches"] == 0, \
         f"{result['mismatches']} mismatches; first {result['first_mismatch']}"
-
-
-class ChunkProducer:
-    """The next chunks and their encoded input beats, made by a thread; at most
-    ``ahead`` chunks wait, so memory stays bounded. The thread works while the testbench
-    waits for it or runs Python, not while the simulator runs: cocotb 2.1 keeps the
-    interpreter lock then (its ``simulator`` module calls ``PyGILState_Ensure/Release``
-    around each callback, never ``PyEval_SaveThread``), so with a harness that clocks
-    itself the twin's time adds to the simulator's (docs/long-runs.md).
-
-    :meth:`next` gives ``(chunk, parts)`` or None at the end (re-raising the thread's
-    error); ``seconds`` is the thread's working time."""
-
-    def __init__(self, chunks: Iterator, encode: Callable, ahead: int = 2):
-        self.queue: queue.Queue = queue.Queue(maxsize=ahead)
-        self.stop = threading.Event()
-        self.seconds = 0.0
-        self.thread = threading.Thread(target=self._run, args=(chunks, encode),
-                                       daemon=True)
-        self.thread.start()
-
-    def _put(self, item: object) -> bool:
-        while not self.stop.is_set():
-            try:
-                self.queue.put(item, timeout=0.2)
-                return True
-            except queue.Full:
-                continue
-        return False
-
-    def _run(self, chunks: Iterator, encode: Callable) -> None:
-        try:
-            while True:
-                t = time.perf_counter()
-                chunk = next(chunks, None)
-                item = None if chunk is None else (chunk, encode(chunk))
-                self.seconds += time.perf_counter() - t
-                if not self._put(item) or item is None:
-                    return
-        except BaseException as exc:  # handed to the testbench, raised there
-            self._put(exc)
-
-    def next(self) -> tuple | None:
-        """The next ``(chunk, parts)``, or None after the last."""
-        item = self.queue.get()
-        if isinstance(item, BaseException):
-            raise item
-        return item
-
-    def close(self) -> None:
-        """Stop the thread (it may be waiting to hand over a chunk)."""
-        self.stop.set()
-        self.thread.join(timeout=10)
-
-
-def _produce(make_chunks: Callable[[], Iterator], encode: Callable, out: object) -> None:
-    """The twin's process (:class:`ProcessChunkProducer`): every chunk and its encoded
-    beats into ``out``, then ``("end", seconds)``; an error as ``("error", text)``."""
-    import sys
-    import traceback
-
-    # cocotb imports through pytest's assertion-rewriting hook, which rewrites every
-    # module the twin imports on first use (scipy, scikit-image: 3.7 of the first
-    # chunk's 4.6 s at 64x64, measured); the twin asserts nothing for pytest
-    sys.meta_path[:] = [f for f in sys.meta_path
-                        if type(f).__name__ != "AssertionRewritingHook"]
-    seconds = 0.0
-    try:
-        chunks = make_chunks()
-        while True:
-            t = time.perf_counter()
-            chunk = next(chunks, None)
-            if chunk is None:
-                out.put(("end", seconds + time.perf_counter() - t))  # type: ignore[attr-defined]
-                return
-            item = ("chunk", chunk, encode(chunk))
-            seconds += time.perf_counter() - t
-            out.put(item)  # type: ignore[attr-defined]
-    except BaseException:  # handed to the testbench, raised there
-        out.put(("error", traceback.format_exc(limit=8)))  # type: ignore[attr-defined]
-
-
-class ProcessChunkProducer:
-    """:class:`ChunkProducer`'s interface with the twin in a forked child process: the
-    simulator holds the interpreter lock while it runs (cocotb 2.1), so a thread of its
-    process cannot overlap it, a process can (the machine's second core). At most
-    ``ahead`` chunks wait in the queue; the child is killed by :meth:`close` (and with
-    the simulator's process group). ``seconds`` is the child's working time."""
-
-    def __init__(self, make_chunks: Callable[[], Iterator], encode: Callable,
-                 ahead: int = 2):
-        import multiprocessing
-
-        ctx = multiprocessing.get_context("fork")
-        self.queue = ctx.Queue(maxsize=ahead)
-        self.proc = ctx.Process(target=_produce, args=(make_chunks, encode, self.queue),
-                                daemon=True, name="rvsm-twin")
-        self.proc.start()
-        self.seconds = 0.0
-
-    def next(self) -> tuple | None:
-        """The next ``(chunk, parts)``, or None after the last."""
-        while True:
-            try:
-                item = self.queue.get(timeout=1.0)
-                break
-            except queue.Empty:
-                if not self.proc.is_alive():
-                    raise RuntimeError(f"the twin's process ended (exit code "
-                                       f"{self.proc.exitcode}) without its chunks") from None
-        if item[0] == "error":
-            raise RuntimeError(f"the twin's process failed:\n{item[1]}")
-        if item[0] == "end":
-            self.seconds = float(item[1])
-            return None
-        return item[1], item[2]
-
-    def close(self) -> None:
-        """Stop the child (it may be waiting to hand over a chunk)."""
-        if self.proc.is_alive():
-            self.proc.terminate()
-        self.proc.join(timeout=10)
-        self.queue.close()
-
-
-def make_producer(kind: str, make_chunks: Callable[[], Iterator], encode: Callable
-                  ) -> ChunkProducer | ProcessChunkProducer:
-    """``"process"`` (:class:`ProcessChunkProducer`, where ``fork`` exists) or
-    ``"thread"`` (:class:`ChunkProducer`)."""
-    import multiprocessing
-
-    if kind == "process" and "fork" in multiprocessing.get_all_start_methods():
-        return ProcessChunkProducer(make_chunks, encode)
-    if kind not in ("process", "thread"):
-        raise RuntimeError(f"RVSM_PRODUCER must be 'process' or 'thread', got {kind!r}")
-    return ChunkProducer(make_chunks(), encode)
 
 
 def _cycle_time_ns(cycle: int) -> int:

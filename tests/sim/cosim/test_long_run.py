@@ -21,7 +21,11 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.loaders import load_scene
 from rvsm.rtl.stream.schedule import pack_lanes
 from rvsm.sim.cli import main
-from rvsm.sim.cosim.chunk_harness import decode_output_beats, encode_input_beats
+from rvsm.sim.cosim.chunk_harness import (
+    decode_output_beats,
+    encode_input_beats,
+    encode_threshold_writes,
+)
 from rvsm.sim.cosim.long_run import check_chunks
 from rvsm.sim.cosim.verify import AUTO_CHUNK_BEATS, choose_harness, run_rtl
 
@@ -41,7 +45,8 @@ def _random_stimulus(c: ArrayContract, steps: int, seed: int,
 
 def test_hex_chunks_round_trip() -> None:
     """Input beats are written as the integers :func:`pack_lanes` makes, most significant
-    digit first; output text decodes to the same bits, X/Z lines flagged."""
+    digit first; output text decodes to the same bits (with Icarus's heading comment
+    too), X/Z lines flagged; threshold writes as ``{addr, data}`` words."""
     rng = np.random.default_rng(3)
     beats = rng.integers(0, 128, (50, 5))
     text = encode_input_beats(beats, 7, 35)
@@ -54,6 +59,10 @@ def test_hex_chunks_round_trip() -> None:
     assert np.array_equal(bits, want)
     _, unknown = decode_output_beats(b"0x1\n123\n", 12)
     assert unknown.tolist() == [True, False]
+    headed, _ = decode_output_beats(b"// 0x00000000\n" + text, 35)  # as Icarus writes
+    assert np.array_equal(headed, want)
+    thr = encode_threshold_writes([(5, 9), (0x12, 0x3FF)], 6, 10)
+    assert thr == b"1409\n4bff\n"  # {addr, data}: 6 + 10 bits, 4 hex digits
 
 
 @pytest.mark.parametrize("sim", SIMS)
@@ -73,6 +82,11 @@ def test_long_run_agrees_with_the_per_cycle_testbench(sim: str, small_contract,
     assert long["expected_spikes"] == np.count_nonzero(stim.spikes) > 0
     assert long["harness"] == "chunk" and long["steps"] == 12
     assert long["cycles_per_second"] > 0 and long["waves"] is None
+    # the twin's process made and checked every chunk file, and removed it
+    assert set(long["timeline"]) >= {"connected", "reset", "thresholds", "first_chunk",
+                                     "last_done", "end", "twin_first_chunk"}
+    assert {"decode", "check", "twin", "simulate", "handover"} <= set(long["seconds"])
+    assert not list(Path(long["run_dir"]).glob("chunk_*.*.hex"))
 
 
 @pytest.mark.parametrize("sim", SIMS)
@@ -94,6 +108,8 @@ def test_long_run_finds_a_wrong_spike_and_keeps_a_window(sim: str, small_contrac
     assert (first["step"], first["scale"], first["row"], first["column"]) == (17, 1, 2, 5)
     assert r["first_mismatch_time_ns"] == first["cycle"] * 10
     assert r["stopped_at_step"] == 20  # the failing chunk (steps 16..19) was the last
+    # chunks the twin made ahead of the stop are dropped with their files
+    assert not list(Path(r["run_dir"]).glob("chunk_*.*.hex"))
     lo, hi = r["wave_window_cycles"]
     assert lo < first["cycle"] < hi
     wave = Path(r["waves"])

@@ -1,0 +1,30 @@
+"""The twin's process of the long-run harness (:mod:`rvsm.sim.cosim.chunk_twin`) on its
+own, without a simulator: its errors reach the testbench's connection. (Whole runs
+through it, on both simulators: ``test_long_run.py``.)"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from rvsm.sim.cosim.chunk_twin import connect, start_twin
+
+
+def test_the_twin_hands_its_error_to_the_testbench(tmp_path: Path) -> None:
+    """A source the twin cannot open: the testbench's first message is the error (with
+    the cause), the process ends, and a testbench that connects to nothing is told."""
+    ports = tmp_path / "arr.ports.json"
+    ports.write_text("{}")
+    twin = start_twin(json.dumps({"kind": "nothing"}), ports, tmp_path, 8, 64)
+    try:
+        conn = connect(twin.address, twin.key, timeout=60)
+        kind, text = conn.recv()
+        assert kind == "error" and "not a stimulus description" in text
+        conn.close()
+        assert twin.proc.wait(timeout=30) == 0
+    finally:
+        twin.close()
+    with pytest.raises(RuntimeError, match="did not listen"):
+        connect(str(tmp_path / "none"), "00", timeout=0.05)
