@@ -14,8 +14,8 @@ policy nothing is dropped.
 
 The rules it states (module docstring of :mod:`rvsm.rtl.ip.wrapper`): input beat ``k``
 accepted at the edge ending cycle ``c`` releases position ``k - lag`` (if ``k >= lag``),
-which reaches the FIFO in cycle ``c + 2``; ``tready = drop or level + r1 + v <
-fifo_depth``; the FIFO is Amaranth's ``SyncFIFOBuffered`` (``depth - 1`` words of
+which reaches the FIFO in cycle ``c + 2``; ``tready = drop or credit`` with the
+registered ``credit`` of the cycle before, ``level + r1 + v + 1 < fifo_depth``; the FIFO is Amaranth's ``SyncFIFOBuffered`` (``depth - 1`` words of
 memory and an output register; ``w_rdy`` = memory not full; ``m_axis_tvalid`` = the
 output register is full).
 """
@@ -69,11 +69,13 @@ def run_stream_model(beats: int, lag: int, fifo_depth: int, drop: bool,
     accepted, delivered, sent, dropped = [], [], [], []
     released = max(0, beats - lag)
     c = 0
+    credit = True  # the registered credit: room for every beat in flight, with margin
     while k < beats or r1 is not None or v is not None or inner or out_reg is not None:
         if c >= max_cycles:
             raise RuntimeError(f"the stream did not finish within {max_cycles} cycles")
         level = len(inner) + (out_reg is not None)
-        tready = drop or level + (r1 is not None) + (v is not None) < fifo_depth
+        tready = drop or credit
+        credit = level + (r1 is not None) + (v is not None) + 1 < fifo_depth
         fire = k < beats and at(valid, c) and tready
         r_en = at(ready, c)
         w_rdy = len(inner) != fifo_depth - 1

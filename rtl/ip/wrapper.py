@@ -3,7 +3,7 @@
 One clock domain ``sync`` (synchronous reset ``rst``)::
 
     s_axis (video: P codes/beat, tuser = start of frame, tlast = end of line)
-      -> input gate: tready = ~busy & (drop policy | credit)     [framing check]
+      -> input gate: tready = ~busy & (drop policy | credit_r)   [framing check]
       -> RvsmStreamArray (codes, clear, thr)  <- flush beats, clear, threshold writes
       -> spikes beat (+ tuser, tlast) -> SyncFIFOBuffered(fifo_depth) -> m_axis
     s_axil -> AxiLiteRegisters(ip_register_map) <-> control, status, counters, THR_*
@@ -11,10 +11,12 @@ One clock domain ``sync`` (synchronous reset ``rst``)::
 **Policies** (``CONTROL.drop``). *Stall* (0, the reset value; replay from memory): the
 array has no output back-pressure and an output beat appears two cycles after the
 input beat that releases it, so the input is gated by credits, never by the FIFO's
-fullness: ``tready`` is high only while ``level + r1 + v < fifo_depth`` (``level`` the
-FIFO's beats, ``r1`` a beat accepted in the previous cycle, ``v`` the array's output
-this cycle). Every beat in flight then finds room: no beat is lost, whatever the sink
-does. *Drop* (1; a live sensor, which cannot stall): ``tready`` stays high (except
+fullness: ``tready`` is high only in a cycle after one with ``level + r1 + v + 1 <
+fifo_depth`` (``level`` the FIFO's beats, ``r1`` a beat accepted in the previous cycle,
+``v`` the array's output that cycle; the credit is registered, so no path runs from the
+FIFO's level or ``m_axis_tready`` to ``s_axis_tready`` or the array's clock enable, and
+the ``+ 1`` covers the beat accepted meanwhile). Every beat in flight then finds room:
+no beat is lost, whatever the sink does. *Drop* (1; a live sensor, which cannot stall): ``tready`` stays high (except
 while busy); an output beat that reaches the FIFO while it is full (``w_rdy`` low: the
 FIFO holds ``fifo_depth`` beats) is dropped whole, ``STATUS.overflow`` is set and
 ``DROPPED`` counts it. The cycle model :mod:`rvsm.rtl.ip.model` gives the exact drops
@@ -75,8 +77,9 @@ class RvsmAxisIp(wiring.Component):
     #: can be in flight between the input gate and the FIFO.
     MIN_FIFO_DEPTH = 4
     #: Smallest output FIFO that takes a beat every cycle while the sink is always ready
-    #: (two beats in the FIFO, one in the array's output, one accepted the cycle before).
-    FULL_RATE_DEPTH = 5
+    #: (two beats in the FIFO, one in the array's output, one accepted the cycle before,
+    #: one accepted while the registered credit is formed).
+    FULL_RATE_DEPTH = 6
     #: Default output FIFO depth (beats).
     FIFO_DEPTH = 16
     #: Cycles from the edge accepting a releasing input beat to the cycle its output is
@@ -158,7 +161,11 @@ class RvsmAxisIp(wiring.Component):
         drop_policy = regs.value["CONTROL.drop"]
         busy = init | flush_req | clear_req
         r1 = Signal(name="accepted_r1")  # a beat entered the array in the previous cycle
-        credit = drop_policy | (fifo.level + r1 + arr.spikes.valid < self.fifo_depth)
+        # room next cycle for every beat then in flight: registered (timing), with one
+        # more beat of margin for the beat this cycle may accept
+        credit_r = Signal(init=1, name="credit_r")
+        m.d.sync += credit_r.eq(fifo.level + r1 + arr.spikes.valid + 1 < self.fifo_depth)
+        credit = drop_policy | credit_r
         s_in = self.s_axis
         m.d.comb += s_in.tready.eq(~busy & credit)
         fire = s_in.tvalid & s_in.tready
