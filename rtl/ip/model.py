@@ -15,7 +15,8 @@ policy nothing is dropped.
 The rules it states (module docstring of :mod:`rvsm.rtl.ip.wrapper`): input beat ``k``
 accepted at the edge ending cycle ``c`` releases position ``k - lag`` (if ``k >= lag``),
 which reaches the FIFO in cycle ``c + 2``; ``tready = drop or credit`` with the
-registered ``credit`` of the cycle before, ``level + r1 + v + 1 < fifo_depth``; the FIFO is Amaranth's ``SyncFIFOBuffered`` (``depth - 1`` words of
+registered ``credit`` of the cycle before, ``level + r1 + v + 1 < fifo_depth``; the FIFO
+is Amaranth's ``SyncFIFOBuffered`` (``depth - 1`` words of
 memory and an output register; ``w_rdy`` = memory not full; ``m_axis_tvalid`` = the
 output register is full).
 """

@@ -16,7 +16,8 @@ fifo_depth`` (``level`` the FIFO's beats, ``r1`` a beat accepted in the previous
 ``v`` the array's output that cycle; the credit is registered, so no path runs from the
 FIFO's level or ``m_axis_tready`` to ``s_axis_tready`` or the array's clock enable, and
 the ``+ 1`` covers the beat accepted meanwhile). Every beat in flight then finds room:
-no beat is lost, whatever the sink does. *Drop* (1; a live sensor, which cannot stall): ``tready`` stays high (except
+no beat is lost, whatever the sink does. *Drop* (1; a live sensor, which cannot
+stall): ``tready`` stays high (except
 while busy); an output beat that reaches the FIFO while it is full (``w_rdy`` low: the
 FIFO holds ``fifo_depth`` beats) is dropped whole, ``STATUS.overflow`` is set and
 ``DROPPED`` counts it. The cycle model :mod:`rvsm.rtl.ip.model` gives the exact drops
