@@ -191,18 +191,23 @@ class RvsmAxisIp(wiring.Component):
         with m.If(clear_now):
             m.d.sync += clear_req.eq(0)
 
-        # input position: framing check of tuser (start of frame) and tlast (end of line)
+        # input position: framing check of tuser (start of frame) and tlast (end of line),
+        # one cycle after the beat (its handshake registered: no path from the input gate
+        # into the position counters); the counters hold the position of the beat in r1
         in_g = Signal(range(geo.groups), name="in_group")
         in_y = Signal(range(c.height), name="in_row")
+        fire_r = Signal(name="fire_r")
+        tuser_r, tlast_r = Signal(name="tuser_r"), Signal(name="tlast_r")
+        m.d.sync += [fire_r.eq(fire), tuser_r.eq(s_in.tuser), tlast_r.eq(s_in.tlast)]
         g_end = in_g == geo.groups - 1
         with m.If(clear_now):
             m.d.sync += [in_g.eq(0), in_y.eq(0)]
-        with m.Elif(arr.codes.valid):
+        with m.Elif(r1):
             m.d.sync += [in_g.eq(Mux(g_end, 0, in_g + 1)),
                          in_y.eq(Mux(g_end, Mux(in_y == c.height - 1, 0, in_y + 1), in_y))]
         sof = (in_g == 0) & (in_y == 0)
         m.d.comb += regs.set["STATUS.framing"].eq(
-            fire & ((s_in.tuser != sof) | (s_in.tlast != g_end)))
+            fire_r & ((tuser_r != sof) | (tlast_r != g_end)))
 
         self._thresholds(m, regs, init)
 
@@ -232,7 +237,9 @@ class RvsmAxisIp(wiring.Component):
                 m.d.sync += count.eq(0)
             with m.Elif(event):
                 m.d.sync += count.eq(count + 1)
-        m.d.comb += [regs.value["STATUS.init"].eq(init),
+        # status as registers (one cycle behind): the register read multiplexer starts
+        # at flip-flops
+        m.d.sync += [regs.value["STATUS.init"].eq(init),
                      regs.value["STATUS.flushing"].eq(flush_req),
                      regs.value["STATUS.busy"].eq(busy),
                      regs.value["STATUS.fifo_level"].eq(fifo.level)]
