@@ -119,7 +119,10 @@ def test_seeded_bug_gives_a_counterexample(formal_point, tmp_path, mutation, che
 
 
 @pytest.mark.parametrize("mutation, check, broken", [
-    ("stream.clear_forgets_scale0", "state", "state.fresh_after_clear"),
+    # about 6 minutes of bounded model checking (the bound is one lag past the checks'):
+    # under make regress; rvsm mutate kills it too (docs/mutation.md)
+    pytest.param("stream.clear_forgets_scale0", "state", "state.fresh_after_clear",
+                 marks=pytest.mark.slow),
     ("stream.no_threshold_forwarding", "thresholds", "threshold.read_stage"),
 ])
 def test_seeded_memory_bug_gives_a_counterexample(formal_point, tmp_path, mutation,
