@@ -5,6 +5,7 @@ line), 3 (a missing solver, one line)."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -12,6 +13,7 @@ import pytest
 from rvsm.model.infra.errors import ToolError
 from rvsm.rtl.parallel.architecture import PARALLEL
 from rvsm.rtl.parallel.formal import ParallelProperties
+from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.sim.cli import main
 from rvsm.sim.formal import sby
 
@@ -102,7 +104,8 @@ def test_solver_over_its_time_limit_is_exit_3(formal, capsys: pytest.CaptureFixt
     assert "not checked" in captured.out and "cover" not in captured.out.split("note:")[0]
 
 
-def test_stream_checks_run_side_by_side(formal_point_toml: Path, tmp_path: Path,
+def test_stream_checks_run_side_by_side(formal_point_toml: Path, formal_point,
+                                        tmp_path: Path,
                                         capsys: pytest.CaptureFixture) -> None:
     out = tmp_path / "stream"
     assert main(["formal", str(formal_point_toml), "--arch", "stream", "--size", "3x4",
@@ -112,8 +115,10 @@ def test_stream_checks_run_side_by_side(formal_point_toml: Path, tmp_path: Path,
     assert (report["model"], report["size"], report["options"]) == ("fsm", [3, 4],
                                                                    {"lanes": 2})
     # in the registry's order whatever the order asked, each to two frames plus the lag
+    geo = StreamGeometry(replace(formal_point, model="fsm").with_size(3, 4).contract(), 2)
+    depth = 2 * geo.beats_per_frame + geo.lag + 2
     assert [(c["check"], c["mode"], c["status"], c["depth"]) for c in report["checks"]] == [
-        ("tail", "bmc", "pass", 19), ("equivalence", "bmc", "pass", 19)]
+        ("tail", "bmc", "pass", depth), ("equivalence", "bmc", "pass", depth)]
     assert (out / "tail" / "formal.log").is_file()
 
 
