@@ -31,7 +31,7 @@ import pytest
 
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint, default_design_point
-from rvsm.model.fixed.weights import quantise_model
+from rvsm.model.fixed.weights import model_contract as weights_model_contract
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -41,10 +41,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int = 10,
                    shift: int = 1, reset: str = "subtract", adc_bits: int = 4) -> ArrayContract:
-    """A small contract from ``model``'s quantised kernels (round-half-up weights)."""
-    ks = quantise_model(model, frac_bits, "round-half-up")
-    weights = tuple(tuple(tuple(int(v) for v in row) for row in k) for k in ks)
-    return ArrayContract(h, w, adc_bits, weights, shift, acc_bits, model != "fsm", reset)
+    """A small contract from ``model``'s quantised kernels (round-half-up weights):
+    :func:`rvsm.model.fixed.weights.model_contract`."""
+    return weights_model_contract(model, h, w, frac_bits, acc_bits, shift, reset, adc_bits)
 
 
 @pytest.fixture

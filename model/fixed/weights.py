@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from rvsm.model.fixed.adc import quantise
+from rvsm.model.fixed.core import ArrayContract
 from rvsm.model.fixed.widths import signed_range
 from rvsm.model.kernels.receptive_fields import model_spec
 
@@ -25,6 +26,17 @@ def quantise_kernel(kernel: np.ndarray, frac_bits: int, rounding: str) -> np.nda
 def quantise_model(model: str, frac_bits: int, rounding: str) -> list[np.ndarray]:
     """Integer kernels of every scale of ``model``: ``S`` arrays ``(2L+1, 2L+1) int64``."""
     return [quantise_kernel(k, frac_bits, rounding) for k in model_spec(model).kernels()]
+
+
+def model_contract(model: str, height: int, width: int, frac_bits: int = 6,
+                   accumulator_bits: int = 10, shift: int = 1, reset: str = "subtract",
+                   adc_bits: int = 4) -> ArrayContract:
+    """A small contract straight from ``model``'s kernels quantised round-half-up to
+    ``frac_bits`` (no design point): for tests, timing diagrams and examples."""
+    kernels = quantise_model(model, frac_bits, "round-half-up")
+    weights = tuple(tuple(tuple(int(v) for v in row) for row in k) for k in kernels)
+    return ArrayContract(height, width, adc_bits, weights, shift, accumulator_bits,
+                         model != "fsm", reset)
 
 
 def weight_error_report(model: str, bits: int, frac_bits: int, rounding: str) -> list[dict]:

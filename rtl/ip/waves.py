@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.fixed.weights import quantise_model
+from rvsm.model.fixed.weights import model_contract
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.rtl.ip.drive import (
     Cycler,
@@ -43,9 +43,7 @@ LANES = 2
 
 def diagram_contract() -> ArrayContract:
     """The diagrams' design: ``fsm`` kernels, 4x8 pixels, 4-bit ADC, 12-bit accumulators."""
-    ks = quantise_model("fsm", 6, "round-half-up")
-    weights = tuple(tuple(tuple(int(v) for v in row) for row in k) for k in ks)
-    return ArrayContract(4, 8, 4, weights, 1, 12, False, "subtract")
+    return model_contract("fsm", 4, 8, accumulator_bits=12)
 
 
 @dataclass(frozen=True)

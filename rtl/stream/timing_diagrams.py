@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rvsm.model.fixed.core import ArrayContract
-from rvsm.model.fixed.weights import quantise_model
+from rvsm.model.fixed.weights import model_contract
 from rvsm.rtl.simulation import run_simulation
 from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.drive import threshold_writes
@@ -38,9 +38,7 @@ DIAGRAM_LANES = 2
 
 def diagram_contract() -> ArrayContract:
     """The diagrams' contract: ``dog1`` 3x4, 4-bit codes, 10-bit accumulators."""
-    kernels = quantise_model("dog1", 6, "round-half-up")
-    weights = tuple(tuple(tuple(int(v) for v in row) for row in k) for k in kernels)
-    return ArrayContract(3, 4, 4, weights, 1, 10, True, "subtract")
+    return model_contract("dog1", 3, 4)
 
 
 @dataclass(frozen=True)

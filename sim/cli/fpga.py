@@ -18,8 +18,7 @@ def _size(text: str) -> tuple[int, int]:
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``fpga`` sub-command."""
     from rvsm.rtl.fpga.devices import DEVICES
-    from rvsm.rtl.ip.architecture import INTERFACES
-    from rvsm.sim.cli.rtl import add_arch_arguments
+    from rvsm.sim.cli.rtl import add_arch_arguments, add_interface_arguments
 
     p = sub.add_parser(
         "fpga", help="synthesise, place and route the array on an ECP5; Fmax and area",
@@ -48,12 +47,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--memory", choices=("dp16kd", "inferred"), default="dp16kd",
                    help="state memories as DP16KD instances with the output register on "
                    "(default) or inferred by yosys (the bank register in fabric)")
-    p.add_argument("--interface", choices=INTERFACES, default="native",
-                   help="native (default): the bare array; axis: the AXI4-Stream / "
-                   "AXI4-Lite IP around it, as rvsm verilog --interface axis builds it "
-                   "(docs/ip.md)")
-    p.add_argument("--fifo-depth", type=int, metavar="BEATS",
-                   help="the IP's output FIFO depth (--interface axis; default 16)")
+    add_interface_arguments(p, "native (default): the bare array; axis: the AXI4-Stream / "
+                            "AXI4-Lite IP around it, as rvsm verilog --interface axis "
+                            "builds it (docs/ip.md)")
     p.add_argument("--seed", type=int, default=1,
                    help="placer seed; with --seeds the first of N (default 1)")
     p.add_argument("--seeds", type=int, metavar="N",

@@ -40,13 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                        f"{a.default_top} for {a.name}" for a in ARCHITECTURES.values())
                    + ")")
     add_arch_arguments(p)
-    p.add_argument("--interface", choices=INTERFACES, default="native",
-                   help="native (default): the bare array's ports; axis: the streaming "
-                   "array as IP, AXI4-Stream video in and spikes out, AXI4-Lite "
-                   "registers, plus <top>.regs.md/.json/.h (docs/ip.md)")
-    p.add_argument("--fifo-depth", type=int, metavar="BEATS",
-                   help="--interface axis: output FIFO depth in beats (default "
-                   f"{STREAM_AXIS.options[-1].default})")
+    add_interface_arguments(p, "native (default): the bare array's ports; axis: the "
+                            "streaming array as IP, AXI4-Stream video in and spikes out, "
+                            "AXI4-Lite registers, plus <top>.regs.md/.json/.h (docs/ip.md)")
     p.add_argument("--lint", action="store_true",
                    help="lint the written files as a user would: verilator --lint-only "
                    "-Wall with the shipped <top>.vlt only, and iverilog -g2005 and -g2012 "
@@ -113,13 +109,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "in and keep the run's coverage.dat (docs/regressions.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_arch_arguments(p)
-    p.add_argument("--interface", choices=INTERFACES, default="native",
-                   help="axis: verify the AXI IP (rvsm verilog --interface axis) with "
-                   "cocotbext-axi under random idle cycles and back-pressure (docs/ip.md); "
-                   "with SCENE, --stimulus or --random")
-    p.add_argument("--fifo-depth", type=int, metavar="BEATS",
-                   help="--interface axis: output FIFO depth (default "
-                   f"{STREAM_AXIS.options[-1].default})")
+    add_interface_arguments(p, "axis: verify the AXI IP (rvsm verilog --interface axis) "
+                            "with cocotbext-axi under random idle cycles and back-pressure "
+                            "(docs/ip.md); with SCENE, --stimulus or --random")
     p.add_argument("--policy", choices=("stall", "drop"), default="stall",
                    help="--interface axis: output policy; drop streams without clears and "
                    "checks the drops against the IP's cycle model (default stall)")
@@ -204,6 +196,15 @@ def _verilog(args: argparse.Namespace) -> int:
         for mem in st["memory_list"]:
             print(f"  memory {mem['name']}: {mem['words']} x {mem['width']} bits")
     return 0
+
+
+def add_interface_arguments(p: argparse.ArgumentParser, interface_help: str) -> None:
+    """``--interface native|axis`` (with ``interface_help``) and ``--fifo-depth``, the
+    AXI IP's output FIFO (:data:`~rvsm.rtl.ip.architecture.STREAM_AXIS`)."""
+    p.add_argument("--interface", choices=INTERFACES, default="native", help=interface_help)
+    p.add_argument("--fifo-depth", type=int, metavar="BEATS",
+                   help="--interface axis: output FIFO depth in beats (default "
+                   f"{STREAM_AXIS.options[-1].default})")
 
 
 def _timing_text(ports_json: Path, gen: GeneratedVerilog) -> str:
