@@ -235,7 +235,7 @@ def run_fpga(
     point: DesignPoint,
     work_dir: str | os.PathLike,
     *,
-    arch: str = DEFAULT_ARCHITECTURE,
+    arch: str | Architecture = DEFAULT_ARCHITECTURE,
     lanes: int | None = None,
     size: tuple[int, int] | None = None,
     device: str | Device = "ecp5-85",
@@ -311,7 +311,7 @@ def run_fpga_seeds(
     seeds: Sequence[int],
     *,
     jobs: int | None = None,
-    arch: str = DEFAULT_ARCHITECTURE,
+    arch: str | Architecture = DEFAULT_ARCHITECTURE,
     lanes: int | None = None,
     size: tuple[int, int] | None = None,
     device: str | Device = "ecp5-85",
@@ -369,7 +369,7 @@ class _Job:
     """What :func:`run_fpga` and :func:`run_fpga_seeds` share: checks, synthesis, report."""
 
     point: DesignPoint
-    arch: str
+    arch: str | Architecture
     lanes: int | None
     size: tuple[int, int] | None
     device_name: str | Device
