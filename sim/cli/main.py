@@ -111,22 +111,46 @@ def _run(args: argparse.Namespace) -> int:
     """``args.func(args)`` with every failure mapped to its exit status."""
     try:
         return int(args.func(args) or 0)
-    except ToolError as exc:
-        return _fail(args, exc, str(exc), 3)
-    except RvsmError as exc:
-        return _fail(args, exc, str(exc), 2)
     except KeyboardInterrupt as exc:
         return _interrupted(exc)
     except BrokenPipeError:
         return 0
-    except MemoryError as exc:
+    except Exception as exc:
+        interrupt = _interrupt_behind(exc)
+        if interrupt is not None:  # e.g. Ctrl-C inside a lazy import: RuntimeError from it
+            return _interrupted(interrupt)
+        return _failed(args, exc)
+
+
+def _interrupt_behind(exc: BaseException) -> KeyboardInterrupt | None:
+    """The ``KeyboardInterrupt`` that caused ``exc`` (``__cause__``/``__context__``), if any.
+
+    Python wraps an exception raised while a class body is set up (``__set_name__``) in a
+    ``RuntimeError``; a signal arriving then must still exit 130, not as an internal error.
+    """
+    seen: set[int] = set()
+    current: BaseException | None = exc
+    while current is not None and id(current) not in seen:
+        if isinstance(current, KeyboardInterrupt):
+            return current
+        seen.add(id(current))
+        current = current.__cause__ or current.__context__
+    return None
+
+
+def _failed(args: argparse.Namespace, exc: Exception) -> int:
+    """One line for ``exc`` and its exit status (2 bad input, 3 tool/environment/bug)."""
+    if isinstance(exc, ToolError):
+        return _fail(args, exc, str(exc), 3)
+    if isinstance(exc, RvsmError):
+        return _fail(args, exc, str(exc), 2)
+    if isinstance(exc, MemoryError):
         return _fail(args, exc, "out of memory", 3)
-    except OSError as exc:  # disk full, read-only or unwritable location, I/O error
+    if isinstance(exc, OSError):  # disk full, read-only or unwritable location, I/O error
         where = f": {exc.filename}" if exc.filename else ""
         return _fail(args, exc, f"{exc.strerror or exc}{where}", 3)
-    except Exception as exc:  # a bug: still one line (the traceback with --debug)
-        return _fail(args, exc, f"internal error {type(exc).__name__}: {exc} (rerun with "
-                     "--debug for the traceback and report it)", 3)
+    return _fail(args, exc, f"internal error {type(exc).__name__}: {exc} (rerun with "
+                 "--debug for the traceback and report it)", 3)
 
 
 def _fail(args: argparse.Namespace, exc: BaseException, message: str, status: int) -> int:

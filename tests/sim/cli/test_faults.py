@@ -210,6 +210,21 @@ def test_an_unforeseen_os_error_is_one_line(tmp_path, capsys, monkeypatch):
     assert code == 3 and "Input/output error" in _one_line(err)
 
 
+def test_an_interrupt_wrapped_by_python_is_still_130(tmp_path, capsys, monkeypatch):
+    """Ctrl-C while a lazy import sets up a class reaches us as a RuntimeError (CI saw
+    PIL's ``GifImageFile``): exit 130 with the interrupt line, not an internal error."""
+    def interrupted_import(*a, **k):
+        try:
+            raise KeyboardInterrupt("SIGINT")
+        except KeyboardInterrupt as exc:
+            raise RuntimeError("Error calling __set_name__ on 'cached_property'") from exc
+
+    monkeypatch.setattr("rvsm.sim.cli.sampling.open_spikes", interrupted_import)
+    code, _, err = _run(capsys, "evaluate", tmp_path / "x.npz")
+    assert code == 130 and err.strip().splitlines() == [
+        "rvsm: interrupted by SIGINT; finished results are kept, partial files removed"]
+
+
 def test_sweep_database_on_a_full_disk_exits_3(tmpfs, tmp_path, capsys):
     mount = tmpfs(size="40k")
     sweep = tmp_path / "s.toml"
