@@ -18,6 +18,22 @@ def _startup_interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt(signal.Signals(signum).name)
 
 
+def interrupt_behind(exc: BaseException) -> KeyboardInterrupt | None:
+    """The ``KeyboardInterrupt`` that is ``exc`` or caused it (``__cause__``/``__context__``).
+
+    Python wraps an exception raised while a class is set up (``__set_name__``, e.g. during
+    a lazy import) in a ``RuntimeError``; a signal arriving then must still exit 130.
+    """
+    seen: set[int] = set()
+    current: BaseException | None = exc
+    while current is not None and id(current) not in seen:
+        if isinstance(current, KeyboardInterrupt):
+            return current
+        seen.add(id(current))
+        current = current.__cause__ or current.__context__
+    return None
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``rvsm`` console script; returns the process exit status."""
     previous = {sig: signal.getsignal(sig) for sig in (signal.SIGTERM, signal.SIGHUP)}
@@ -27,7 +43,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         try:
             from rvsm.sim.cli.main import main as run
-        except KeyboardInterrupt as exc:
+        except (KeyboardInterrupt, Exception) as error:
+            exc = interrupt_behind(error)
+            if exc is None:
+                raise
             why = f" by {exc.args[0]}" if exc.args else ""
             print(f"rvsm: interrupted{why} while starting", file=sys.stderr)
             return 130

@@ -29,6 +29,7 @@ from rvsm.sim.cli import (
     studies,
     sweep,
 )
+from rvsm.sim.console import interrupt_behind
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
 #: co-simulation, formal checks, FPGA timing and area, paper studies, the demo, design sweeps.
@@ -116,26 +117,10 @@ def _run(args: argparse.Namespace) -> int:
     except BrokenPipeError:
         return 0
     except Exception as exc:
-        interrupt = _interrupt_behind(exc)
+        interrupt = interrupt_behind(exc)
         if interrupt is not None:  # e.g. Ctrl-C inside a lazy import: RuntimeError from it
             return _interrupted(interrupt)
         return _failed(args, exc)
-
-
-def _interrupt_behind(exc: BaseException) -> KeyboardInterrupt | None:
-    """The ``KeyboardInterrupt`` that caused ``exc`` (``__cause__``/``__context__``), if any.
-
-    Python wraps an exception raised while a class body is set up (``__set_name__``) in a
-    ``RuntimeError``; a signal arriving then must still exit 130, not as an internal error.
-    """
-    seen: set[int] = set()
-    current: BaseException | None = exc
-    while current is not None and id(current) not in seen:
-        if isinstance(current, KeyboardInterrupt):
-            return current
-        seen.add(id(current))
-        current = current.__cause__ or current.__context__
-    return None
 
 
 def _failed(args: argparse.Namespace, exc: Exception) -> int:
