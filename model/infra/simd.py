@@ -1,0 +1,79 @@
+"""The vector width numba compiles for: 512-bit AVX-512 vectors where the host has them.
+
+LLVM targets 256-bit vectors on Intel CPUs with AVX-512 unless told otherwise (the
+``prefer-256-bit`` tuning of every Intel AVX-512 CPU since Skylake-SP, against the clock
+drop of 512-bit code on those), so numba's loops run 4 float64 lanes where the host has
+8. :func:`prefer_512_bit_vectors` sets ``NUMBA_CPU_FEATURES`` to the host's own feature
+string plus ``-prefer-256-bit``; it must run before numba is imported (numba reads the
+variable once) and is called from ``rvsm.model``'s ``__init__``. It changes nothing
+
+- on a host without AVX-512 (``avx512f`` missing from ``/proc/cpuinfo``; a host without
+  ``/proc/cpuinfo`` is left alone too),
+- when ``NUMBA_CPU_FEATURES`` or ``NUMBA_CPU_NAME`` is set (the user's choice wins),
+- when numba is already imported,
+- when ``RVSM_SIMD=256`` (the opt-out: numba's own choice).
+
+Results do not depend on it: no kernel runs under ``fastmath``, so a vector loop does the
+same float operations in the same order at any width (the event engines' oracle tests
+compare bit for bit). Numba's on-disk cache is keyed on the CPU name and feature string,
+so code compiled for one width is never loaded for the other. Speed: ``docs/events.md``
+(section "Speed") and ``docs/performance.md``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+__all__ = ["OPT_OUT", "prefer_512_bit_vectors", "wide_vector_features"]
+
+#: ``RVSM_SIMD=256`` keeps numba's default vector width.
+OPT_OUT = "RVSM_SIMD"
+_CPUINFO = Path("/proc/cpuinfo")
+
+
+def _host_has_avx512(cpuinfo: Path = _CPUINFO) -> bool:
+    try:
+        text = cpuinfo.read_text(errors="replace")
+    except OSError:
+        return False
+    for line in text.splitlines():
+        if line.startswith("flags"):
+            return "avx512f" in line.split(":", 1)[-1].split()
+    return False
+
+
+def _llvm_host_features() -> str | None:
+    """LLVM's feature string of this host (None when LLVM cannot read it)."""
+    import llvmlite.binding as llvm
+
+    try:
+        return llvm.get_host_cpu_features().flatten()
+    except RuntimeError:
+        return None
+
+
+def wide_vector_features(host_features: str) -> str | None:
+    """The feature string for 512-bit vectors from LLVM's host feature string
+    (``"+avx,+avx2,..."``), or None when the host lacks ``+avx512f``."""
+    feats = [f for f in host_features.split(",") if f]
+    if "+avx512f" not in feats:
+        return None
+    feats = [f for f in feats if f.lstrip("+-") != "prefer-256-bit"]
+    return ",".join(feats + ["-prefer-256-bit"])
+
+
+def prefer_512_bit_vectors(environ: dict | None = None, cpuinfo: Path = _CPUINFO) -> bool:
+    """Set ``NUMBA_CPU_FEATURES`` in ``environ`` (default ``os.environ``) for 512-bit
+    vectors when the conditions of the module doc hold; True when it did."""
+    env = os.environ if environ is None else environ
+    if (env.get(OPT_OUT) == "256" or "NUMBA_CPU_FEATURES" in env or "NUMBA_CPU_NAME" in env
+            or "numba" in sys.modules or not _host_has_avx512(cpuinfo)):
+        return False
+    host = _llvm_host_features()
+    features = None if host is None else wide_vector_features(host)
+    if features is None:
+        return False
+    env["NUMBA_CPU_FEATURES"] = features
+    return True
