@@ -23,9 +23,12 @@ exactly for the fixed twin). The weighted sum stays in a register, so the loop o
 ``x`` vectorises.
 
 ``ladder_sum_S(pairs, pr, w, width, out)``: ``out[s, x]`` for every scale ``s`` of a
-ladder of half-widths ``1..S`` (weights ``w (S, N)``), two scales a loop: each orbit is
-formed once per loop and added to both scales' sums, each sum in its own order, so every
-``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and additions.
+ladder of half-widths ``1..S`` (weights ``w (S, N)``), every scale in one loop: each
+orbit is formed once and added to the sums of the scales that use it, each sum in its own
+order, so every ``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and
+additions. The loop over four scales reads 45 rows and writes 4: it vectorises only with
+the vectoriser's runtime alias-check limit raised
+(:func:`rvsm.model.infra.simd.allow_alias_checks`, set by :mod:`.row_sums`).
 """
 
 from numba import njit
@@ -81,14 +84,17 @@ def generate() -> str:
 
 
 def ladder_sum(scales: int) -> list[str]:
-    """The lines of ``ladder_sum_S`` for the ladder of half-widths ``1..S``: one loop per
-    pair of scales, forming each orbit the pair uses once and adding it to both sums (a
-    loop over more scales stores to more rows than LLVM's runtime alias checks allow: it
-    stays scalar, 2x slower; forming the orbits into a buffer first is 10 % slower)."""
+    """The lines of ``ladder_sum_S`` for the ladder of half-widths ``1..S``: one loop over
+    every scale, forming each orbit once and adding it to the sums of the scales that use
+    it. For four scales (45 rows read, 4 written) LLVM needs up to 180 runtime alias
+    checks, above its default limit of 128 (then the loop stays scalar, 2x slower):
+    ``row_sums`` raises the limit. Two loops of two scales (within the default limit) were
+    a third slower per pixel than one loop; forming the orbits into a buffer first, 10 %
+    slower than two loops."""
     orbits = [(a, b) for a in range(scales + 1) for b in range(a + 1)]
     lines = ['@njit(inline="always", cache=True)',
              f"def ladder_sum_{scales}(pairs, pr, w, width, out):"]
-    for group in [range(s0, min(s0 + 2, scales)) for s0 in range(0, scales, 2)]:
+    for group in [range(scales)]:  # one loop
         used = [(s + 2) * (s + 3) // 2 for s in group]  # orbits of half-width s + 1
         exprs, rows = [], set()
         for a, b in orbits[:max(used)]:

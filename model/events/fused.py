@@ -8,9 +8,10 @@ the tile from the counter-based streams of :mod:`rvsm.model.noise.streams`) and 
 (:func:`.log_intensity.log_intensity_value`) in one vectorised loop, then the row's pairs
 into a ring of ``2L + 1`` rows (each stored twice, so the window around any output row is
 consecutive). Once a row's window is complete it forms every scale's receptive sum of it
-(:func:`~rvsm.model.sampling.row_sums.ladder_sum` for the ``1..S`` ladders, else
-:func:`~rvsm.model.sampling.row_sums.scale_sum` per scale; the orbit order) and applies
-the event rule to the row's accumulators and references.
+(:func:`~rvsm.model.sampling.row_sums.ladder_sum` for the ``1..S`` ladders: one
+vectorised loop over all scales; else :func:`~rvsm.model.sampling.row_sums.scale_sum` per
+scale; the orbit order) and applies the event rule to the row's accumulators and
+references.
 
 Every float operation is the one :mod:`.numpy_engine` does, in the same order, the log
 is the same inlined function, no loop runs under ``fastmath``, and every pixel's

@@ -1,4 +1,5 @@
-"""The vector width numba compiles for: 512-bit AVX-512 vectors where the host has them.
+"""How numba vectorises: 512-bit AVX-512 vectors where the host has them, and loops that
+read many rows vectorised behind runtime alias checks.
 
 LLVM targets 256-bit vectors on Intel CPUs with AVX-512 unless told otherwise (the
 ``prefer-256-bit`` tuning of every Intel AVX-512 CPU since Skylake-SP, against the clock
@@ -13,7 +14,13 @@ variable once) and is called from ``rvsm.model``'s ``__init__``. It changes noth
 - when numba is already imported,
 - when ``RVSM_SIMD=256`` (the opt-out: numba's own choice).
 
-Results do not depend on it: no kernel runs under ``fastmath``, so a vector loop does the
+:func:`allow_alias_checks` raises LLVM's limit on the runtime alias checks a loop may
+carry to be vectorised (``-vectorize-memory-check-threshold``, default 128 pointer
+comparisons), a process-wide LLVM option; :mod:`rvsm.model.sampling.row_sums` sets it
+when imported, before any of its kernels compile (the one loop of the four-scale ladder
+sums reads 45 rows and writes 4).
+
+Results depend on neither: no kernel runs under ``fastmath``, so a vector loop does the
 same float operations in the same order at any width (the event engines' oracle tests
 compare bit for bit). Numba's on-disk cache is keyed on the CPU name and feature string,
 so code compiled for one width is never loaded for the other. Speed: ``docs/events.md``
@@ -26,11 +33,15 @@ import os
 import sys
 from pathlib import Path
 
-__all__ = ["OPT_OUT", "prefer_512_bit_vectors", "wide_vector_features"]
+__all__ = ["ALIAS_CHECKS", "OPT_OUT", "allow_alias_checks", "prefer_512_bit_vectors",
+           "wide_vector_features"]
 
 #: ``RVSM_SIMD=256`` keeps numba's default vector width.
 OPT_OUT = "RVSM_SIMD"
 _CPUINFO = Path("/proc/cpuinfo")
+#: The runtime alias checks LLVM may add to vectorise one loop (4 rows written x 45 read
+#: by the four-scale ladder sums, and headroom).
+ALIAS_CHECKS = 256
 
 
 def _host_has_avx512(cpuinfo: Path = _CPUINFO) -> bool:
@@ -77,3 +88,11 @@ def prefer_512_bit_vectors(environ: dict | None = None, cpuinfo: Path = _CPUINFO
         return False
     env["NUMBA_CPU_FEATURES"] = features
     return True
+
+
+def allow_alias_checks(limit: int = ALIAS_CHECKS) -> None:
+    """Let LLVM's loop vectoriser add up to ``limit`` runtime pointer comparisons to a loop
+    (process-wide; affects code compiled from now on)."""
+    import llvmlite.binding as llvm
+
+    llvm.set_option("", f"-vectorize-memory-check-threshold={int(limit)}")

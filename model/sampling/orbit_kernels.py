@@ -9,9 +9,12 @@ exactly for the fixed twin). The weighted sum stays in a register, so the loop o
 ``x`` vectorises.
 
 ``ladder_sum_S(pairs, pr, w, width, out)``: ``out[s, x]`` for every scale ``s`` of a
-ladder of half-widths ``1..S`` (weights ``w (S, N)``), two scales a loop: each orbit is
-formed once per loop and added to both scales' sums, each sum in its own order, so every
-``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and additions.
+ladder of half-widths ``1..S`` (weights ``w (S, N)``), every scale in one loop: each
+orbit is formed once and added to the sums of the scales that use it, each sum in its own
+order, so every ``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and
+additions. The loop over four scales reads 45 rows and writes 4: it vectorises only with
+the vectoriser's runtime alias-check limit raised
+(:func:`rvsm.model.infra.simd.allow_alias_checks`, set by :mod:`.row_sums`).
 """
 
 from numba import njit
@@ -257,52 +260,6 @@ def ladder_sum_2(pairs, pr, w, width, out):
 
 @njit(inline="always", cache=True)
 def ladder_sum_3(pairs, pr, w, width, out):
-    r0_m2 = pairs[0, pr - 2]
-    r0_m1 = pairs[0, pr - 1]
-    r0_p0 = pairs[0, pr + 0]
-    r0_p1 = pairs[0, pr + 1]
-    r0_p2 = pairs[0, pr + 2]
-    r1_m2 = pairs[1, pr - 2]
-    r1_m1 = pairs[1, pr - 1]
-    r1_p0 = pairs[1, pr + 0]
-    r1_p1 = pairs[1, pr + 1]
-    r1_p2 = pairs[1, pr + 2]
-    r2_m2 = pairs[2, pr - 2]
-    r2_m1 = pairs[2, pr - 1]
-    r2_p0 = pairs[2, pr + 0]
-    r2_p1 = pairs[2, pr + 1]
-    r2_p2 = pairs[2, pr + 2]
-    out0 = out[0]
-    w0_0 = w[0, 0]
-    w0_1 = w[0, 1]
-    w0_2 = w[0, 2]
-    out1 = out[1]
-    w1_0 = w[1, 0]
-    w1_1 = w[1, 1]
-    w1_2 = w[1, 2]
-    w1_3 = w[1, 3]
-    w1_4 = w[1, 4]
-    w1_5 = w[1, 5]
-    for x in range(width):
-        t0 = w0_0 - w0_0
-        t1 = w1_0 - w1_0
-        o = r0_p0[x]
-        t0 = t0 + w0_0 * o
-        t1 = t1 + w1_0 * o
-        o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
-        t0 = t0 + w0_1 * o
-        t1 = t1 + w1_1 * o
-        o = (r1_m1[x] + r1_p1[x])
-        t0 = t0 + w0_2 * o
-        t1 = t1 + w1_2 * o
-        o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
-        t1 = t1 + w1_3 * o
-        o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
-        t1 = t1 + w1_4 * o
-        o = (r2_m2[x] + r2_p2[x])
-        t1 = t1 + w1_5 * o
-        out0[x] = t0
-        out1[x] = t1
     r0_m3 = pairs[0, pr - 3]
     r0_m2 = pairs[0, pr - 2]
     r0_m1 = pairs[0, pr - 1]
@@ -331,6 +288,17 @@ def ladder_sum_3(pairs, pr, w, width, out):
     r3_p1 = pairs[3, pr + 1]
     r3_p2 = pairs[3, pr + 2]
     r3_p3 = pairs[3, pr + 3]
+    out0 = out[0]
+    w0_0 = w[0, 0]
+    w0_1 = w[0, 1]
+    w0_2 = w[0, 2]
+    out1 = out[1]
+    w1_0 = w[1, 0]
+    w1_1 = w[1, 1]
+    w1_2 = w[1, 2]
+    w1_3 = w[1, 3]
+    w1_4 = w[1, 4]
+    w1_5 = w[1, 5]
     out2 = out[2]
     w2_0 = w[2, 0]
     w2_1 = w[2, 1]
@@ -343,18 +311,29 @@ def ladder_sum_3(pairs, pr, w, width, out):
     w2_8 = w[2, 8]
     w2_9 = w[2, 9]
     for x in range(width):
+        t0 = w0_0 - w0_0
+        t1 = w1_0 - w1_0
         t2 = w2_0 - w2_0
         o = r0_p0[x]
+        t0 = t0 + w0_0 * o
+        t1 = t1 + w1_0 * o
         t2 = t2 + w2_0 * o
         o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
+        t0 = t0 + w0_1 * o
+        t1 = t1 + w1_1 * o
         t2 = t2 + w2_1 * o
         o = (r1_m1[x] + r1_p1[x])
+        t0 = t0 + w0_2 * o
+        t1 = t1 + w1_2 * o
         t2 = t2 + w2_2 * o
         o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
+        t1 = t1 + w1_3 * o
         t2 = t2 + w2_3 * o
         o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
+        t1 = t1 + w1_4 * o
         t2 = t2 + w2_4 * o
         o = (r2_m2[x] + r2_p2[x])
+        t1 = t1 + w1_5 * o
         t2 = t2 + w2_5 * o
         o = ((r0_m3[x] + r0_p3[x]) + r3_p0[x])
         t2 = t2 + w2_6 * o
@@ -364,57 +343,13 @@ def ladder_sum_3(pairs, pr, w, width, out):
         t2 = t2 + w2_8 * o
         o = (r3_m3[x] + r3_p3[x])
         t2 = t2 + w2_9 * o
+        out0[x] = t0
+        out1[x] = t1
         out2[x] = t2
 
 
 @njit(inline="always", cache=True)
 def ladder_sum_4(pairs, pr, w, width, out):
-    r0_m2 = pairs[0, pr - 2]
-    r0_m1 = pairs[0, pr - 1]
-    r0_p0 = pairs[0, pr + 0]
-    r0_p1 = pairs[0, pr + 1]
-    r0_p2 = pairs[0, pr + 2]
-    r1_m2 = pairs[1, pr - 2]
-    r1_m1 = pairs[1, pr - 1]
-    r1_p0 = pairs[1, pr + 0]
-    r1_p1 = pairs[1, pr + 1]
-    r1_p2 = pairs[1, pr + 2]
-    r2_m2 = pairs[2, pr - 2]
-    r2_m1 = pairs[2, pr - 1]
-    r2_p0 = pairs[2, pr + 0]
-    r2_p1 = pairs[2, pr + 1]
-    r2_p2 = pairs[2, pr + 2]
-    out0 = out[0]
-    w0_0 = w[0, 0]
-    w0_1 = w[0, 1]
-    w0_2 = w[0, 2]
-    out1 = out[1]
-    w1_0 = w[1, 0]
-    w1_1 = w[1, 1]
-    w1_2 = w[1, 2]
-    w1_3 = w[1, 3]
-    w1_4 = w[1, 4]
-    w1_5 = w[1, 5]
-    for x in range(width):
-        t0 = w0_0 - w0_0
-        t1 = w1_0 - w1_0
-        o = r0_p0[x]
-        t0 = t0 + w0_0 * o
-        t1 = t1 + w1_0 * o
-        o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
-        t0 = t0 + w0_1 * o
-        t1 = t1 + w1_1 * o
-        o = (r1_m1[x] + r1_p1[x])
-        t0 = t0 + w0_2 * o
-        t1 = t1 + w1_2 * o
-        o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
-        t1 = t1 + w1_3 * o
-        o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
-        t1 = t1 + w1_4 * o
-        o = (r2_m2[x] + r2_p2[x])
-        t1 = t1 + w1_5 * o
-        out0[x] = t0
-        out1[x] = t1
     r0_m4 = pairs[0, pr - 4]
     r0_m3 = pairs[0, pr - 3]
     r0_m2 = pairs[0, pr - 2]
@@ -460,6 +395,17 @@ def ladder_sum_4(pairs, pr, w, width, out):
     r4_p2 = pairs[4, pr + 2]
     r4_p3 = pairs[4, pr + 3]
     r4_p4 = pairs[4, pr + 4]
+    out0 = out[0]
+    w0_0 = w[0, 0]
+    w0_1 = w[0, 1]
+    w0_2 = w[0, 2]
+    out1 = out[1]
+    w1_0 = w[1, 0]
+    w1_1 = w[1, 1]
+    w1_2 = w[1, 2]
+    w1_3 = w[1, 3]
+    w1_4 = w[1, 4]
+    w1_5 = w[1, 5]
     out2 = out[2]
     w2_0 = w[2, 0]
     w2_1 = w[2, 1]
@@ -488,24 +434,35 @@ def ladder_sum_4(pairs, pr, w, width, out):
     w3_13 = w[3, 13]
     w3_14 = w[3, 14]
     for x in range(width):
+        t0 = w0_0 - w0_0
+        t1 = w1_0 - w1_0
         t2 = w2_0 - w2_0
         t3 = w3_0 - w3_0
         o = r0_p0[x]
+        t0 = t0 + w0_0 * o
+        t1 = t1 + w1_0 * o
         t2 = t2 + w2_0 * o
         t3 = t3 + w3_0 * o
         o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
+        t0 = t0 + w0_1 * o
+        t1 = t1 + w1_1 * o
         t2 = t2 + w2_1 * o
         t3 = t3 + w3_1 * o
         o = (r1_m1[x] + r1_p1[x])
+        t0 = t0 + w0_2 * o
+        t1 = t1 + w1_2 * o
         t2 = t2 + w2_2 * o
         t3 = t3 + w3_2 * o
         o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
+        t1 = t1 + w1_3 * o
         t2 = t2 + w2_3 * o
         t3 = t3 + w3_3 * o
         o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
+        t1 = t1 + w1_4 * o
         t2 = t2 + w2_4 * o
         t3 = t3 + w3_4 * o
         o = (r2_m2[x] + r2_p2[x])
+        t1 = t1 + w1_5 * o
         t2 = t2 + w2_5 * o
         t3 = t3 + w3_5 * o
         o = ((r0_m3[x] + r0_p3[x]) + r3_p0[x])
@@ -530,5 +487,7 @@ def ladder_sum_4(pairs, pr, w, width, out):
         t3 = t3 + w3_13 * o
         o = (r4_m4[x] + r4_p4[x])
         t3 = t3 + w3_14 * o
+        out0[x] = t0
+        out1[x] = t1
         out2[x] = t2
         out3[x] = t3
