@@ -22,12 +22,13 @@ starts at ``w[0] - w[0]``, i.e. 0 of the weights' type, so the same code sums in
 exactly for the fixed twin). The weighted sum stays in a register, so the loop over
 ``x`` vectorises.
 
-``ladder_sum_S(pairs, pr, w, width, out)``: ``out[s, x]`` for every scale ``s`` of a
-ladder of half-widths ``1..S`` (weights ``w (S, N)``), every scale in one loop: each
-orbit is formed once and added to the sums of the scales that use it, each sum in its own
-order, so every ``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and
-additions. The loop over four scales reads 45 rows and writes 4: it vectorises only with
-the vectoriser's runtime alias-check limit raised
+``ladder_sum_S(pairs, pr, ring, w, width, out)``: ``out[s, x]`` for every scale ``s`` of
+a ladder of half-widths ``1..S`` (weights ``w (S, N)``), rows taken modulo ``ring`` (a
+ring of rows stored once; ``ring`` = the rows of ``pairs`` for plain rows; ``pr >= S``),
+every scale in one loop: each orbit is formed once and added to the sums of the scales
+that use it, each sum in its own order, so every ``out[s]`` equals ``scale_sum_{s + 1}``
+bit for bit with fewer loads and additions. The loop over four scales reads 45 rows and
+writes 4: it vectorises only with the vectoriser's runtime alias-check limit raised
 (:func:`rvsm.model.infra.simd.allow_alias_checks`, set by :mod:`.row_sums`).
 """
 
@@ -93,7 +94,7 @@ def ladder_sum(scales: int) -> list[str]:
     slower than two loops."""
     orbits = [(a, b) for a in range(scales + 1) for b in range(a + 1)]
     lines = ['@njit(inline="always", cache=True)',
-             f"def ladder_sum_{scales}(pairs, pr, w, width, out):"]
+             f"def ladder_sum_{scales}(pairs, pr, ring, w, width, out):"]
     for group in [range(scales)]:  # one loop
         used = [(s + 2) * (s + 3) // 2 for s in group]  # orbits of half-width s + 1
         exprs, rows = [], set()
@@ -102,7 +103,8 @@ def ladder_sum(scales: int) -> list[str]:
             exprs.append(expr)
             rows |= r
         for pb, d in sorted(rows):
-            lines.append(f"    {_row(pb, d)} = pairs[{pb}, pr {'-' if d < 0 else '+'} {abs(d)}]")
+            lines.append(f"    {_row(pb, d)} = pairs[{pb}, (pr {'-' if d < 0 else '+'} {abs(d)})"
+                         " % ring]")
         for s, n_s in zip(group, used, strict=True):
             lines.append(f"    out{s} = out[{s}]")
             lines += [f"    w{s}_{n} = w[{s}, {n}]" for n in range(n_s)]

@@ -6,7 +6,8 @@ tile and step it streams the tile's rows plus a halo of ``L`` rows, one at a tim
 brightness (interpolated between the chunk's frames, plus the dark current drawn inside
 the tile from the counter-based streams of :mod:`rvsm.model.noise.streams`) and its log
 (:func:`.log_intensity.log_intensity_value`) in one vectorised loop, then the row's pairs
-into a ring of ``2L + 1`` rows (each stored twice, so the window around any output row is
+into a ring of ``2L + 1`` rows (the ladder sums take their rows modulo the ring; for the
+per-scale sums each row is stored twice, so the window around any output row is
 consecutive). Once a row's window is complete it forms every scale's receptive sum of it
 (:func:`~rvsm.model.sampling.row_sums.ladder_sum` for the ``1..S`` ladders: one
 vectorised loop over all scales; else :func:`~rvsm.model.sampling.row_sums.scale_sum` per
@@ -83,25 +84,33 @@ def _log_row(frames, f, a, y, noisy, key, t, mean, sd, zx, zr, dark, width, dst)
 
 
 @njit(inline="always", cache=True)
-def _ring_pairs(pad, lmax, width, ring, k, pairs):
+def _ring_pairs(pad, lmax, width, ring, k, twice, pairs):
     """Row pairs of the padded row ``pad (W + 2L,)`` (:func:`.row_sums.row_pairs`) into
-    ring slots ``k`` and ``k + ring`` of ``pairs (L + 1, 2 ring, W)``."""
+    ring slot ``k`` of ``pairs (L + 1, 2 ring, W)``, and slot ``k + ring`` if ``twice``."""
     mid = pad[lmax:lmax + width]
     d0 = pairs[0, k]
     d1 = pairs[0, k + ring]
-    for x in range(width):
-        v = mid[x]
-        d0[x] = v
-        d1[x] = v
+    if twice:
+        for x in range(width):
+            v = mid[x]
+            d0[x] = v
+            d1[x] = v
+    else:
+        for x in range(width):
+            d0[x] = mid[x]
     for b in range(1, lmax + 1):
         left = pad[lmax - b:lmax - b + width]
         right = pad[lmax + b:lmax + b + width]
         d0 = pairs[b, k]
         d1 = pairs[b, k + ring]
-        for x in range(width):
-            v = left[x] + right[x]
-            d0[x] = v
-            d1[x] = v
+        if twice:
+            for x in range(width):
+                v = left[x] + right[x]
+                d0[x] = v
+                d1[x] = v
+        else:
+            for x in range(width):
+                d0[x] = left[x] + right[x]
 
 
 @njit(parallel=True, cache=True, error_model="numpy")
@@ -115,9 +124,11 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
         y0 = ti * tile_rows
         rows = min(height, y0 + tile_rows) - y0
         pad = np.zeros(width + 2 * lmax)  # one row of L, zero margins
-        # Each padded row's pairs go to ring slots k and k + ring, so the 2L + 1 rows
-        # around any output row are consecutive slots (what the row sums index).
+        # Each padded row's pairs go to ring slot k; for the per-scale sums also to slot
+        # k + ring, so the 2L + 1 rows around any output row are consecutive slots (what
+        # scale_sum indexes; ladder_sum takes its rows modulo the ring).
         pairs = np.zeros((lmax + 1, 2 * ring, width))
+        twice = not ladder
         dark = np.empty(width)
         resp = np.empty((num_scales, width))
         for b in range(num_steps):
@@ -131,13 +142,13 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
                 else:
                     _log_row(frames, fidx[b], aw[b], y, noisy, key, t0 + b, mean, sd, zx,
                              zr, dark, width, pad[lmax:lmax + width])
-                    _ring_pairs(pad, lmax, width, ring, k, pairs)
+                    _ring_pairs(pad, lmax, width, ring, k, twice, pairs)
                 if r < 2 * lmax:
                     continue
                 yo = y - lmax  # the output row whose window ends at row y
                 pr = (r - 2 * lmax) % ring + lmax
                 if ladder:
-                    ladder_sum(pairs, pr, weights, width, resp)
+                    ladder_sum(pairs, pr, ring, weights, width, resp)
                 else:
                     for s in range(num_scales):
                         scale_sum(pairs, pr, weights[s], halves[s], width, resp[s])
