@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Write ``model/sampling/orbit_kernels.py``: the per-half-width orbit sums and the ladder
-sums (every scale of a ``1..S`` ladder in one pass), unrolled for numba.
+sums (every scale of a ``1..S`` ladder in one pass), unrolled for numba; and
+``model/events/ladder_kernels.py``: the ladder sums with the event rule of every scale in
+the same loop (the RVSM-DVS fused engine's step).
 
 Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
 ``model/kernels/orbits.py``; ``tests/model/sampling/test_fused.py`` checks the file is up to date.
@@ -8,6 +10,7 @@ Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -118,10 +121,67 @@ def ladder_sum(scales: int) -> list[str]:
     return lines
 
 
+EVENTS_HEADER = '''"""Ladder sums and event rule, one loop (scripts/gen_orbit_kernels.py wrote it).
+
+``ladder_events_S(pairs, pr, ring, w, width, thr, ref, ev, y)``: every scale's receptive
+sum of padded row ``pr`` exactly as
+:func:`rvsm.model.sampling.orbit_kernels.ladder_sum_S` forms it (rows modulo ``ring``,
+the same operations in the same order), then, in the same loop, the event rule
+(:func:`.event_rule.event_step`) on row ``y`` of every scale: thresholds and references
+``thr, ref (S, H, W)``, events ``ev (S, H, W) int8``. The responses stay in registers (no
+row of responses is stored and read back); the loop reads 45 + 8 rows and writes 8 for
+four scales, so it vectorises only with the vectoriser's runtime alias-check limit raised
+(:func:`rvsm.model.infra.simd.allow_alias_checks`, raised here). They are compiled as
+functions of their own, not inlined: four inlined loops made the fused kernel 10 %
+slower.
+"""
+
+from numba import njit
+
+from rvsm.model.events.event_rule import event_step
+from rvsm.model.infra.simd import allow_alias_checks
+
+# The four-scale loop reads 53 rows and writes 8: up to 424 runtime alias checks.
+allow_alias_checks(1024)
+'''
+
+
+def ladder_events(scales: int) -> list[str]:
+    """The lines of ``ladder_events_S``: ``ladder_sum_S`` whose stores of the responses
+    are the event rule of each scale."""
+    lines = ladder_sum(scales)
+    lines[0] = "@njit(cache=True)"  # not inlined: four inlined loops slow the kernel 10 %
+    lines[1] = f"def ladder_events_{scales}(pairs, pr, ring, w, width, thr, ref, ev, y):"
+    out = []
+    for line in lines:
+        row = re.fullmatch(r"    out(\d) = out\[(\d)\]", line)
+        store = re.fullmatch(r"        out(\d)\[x\] = t(\d)", line)
+        if row:
+            s = row[1]
+            out += [f"    th{s} = thr[{s}, y]", f"    rf{s} = ref[{s}, y]",
+                    f"    ev{s} = ev[{s}, y]"]
+        elif store:
+            s = store[1]
+            out.append(f"        event_step(t{s}, th{s}, rf{s}, ev{s}, x)")
+        else:
+            out.append(line)
+    return out
+
+
+def generate_events() -> str:
+    """The source text of ``model/events/ladder_kernels.py``."""
+    out = [EVENTS_HEADER.rstrip("\n")]
+    for scales in range(1, MAX_HALF + 1):
+        out += ["", ""] + ladder_events(scales)
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
 def main() -> None:
-    target = Path(__file__).resolve().parent.parent / "model" / "sampling" / "orbit_kernels.py"
-    target.write_text(generate())
-    print(f"wrote {target}", file=sys.stderr)
+    root = Path(__file__).resolve().parent.parent
+    for target, text in ((root / "model" / "sampling" / "orbit_kernels.py", generate()),
+                         (root / "model" / "events" / "ladder_kernels.py", generate_events())):
+        target.write_text(text)
+        print(f"wrote {target}", file=sys.stderr)
 
 
 if __name__ == "__main__":

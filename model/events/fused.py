@@ -9,10 +9,12 @@ the tile from the counter-based streams of :mod:`rvsm.model.noise.streams`) and 
 into a ring of ``2L + 1`` rows (the ladder sums take their rows modulo the ring; for the
 per-scale sums each row is stored twice, so the window around any output row is
 consecutive). Once a row's window is complete it forms every scale's receptive sum of it
-(:func:`~rvsm.model.sampling.row_sums.ladder_sum` for the ``1..S`` ladders: one
-vectorised loop over all scales; else :func:`~rvsm.model.sampling.row_sums.scale_sum` per
-scale; the orbit order) and applies the event rule to the row's accumulators and
-references.
+and applies the event rule (:mod:`.event_rule`) to the row's accumulators and references:
+for the ``1..S`` ladders in one vectorised loop over all scales
+(:mod:`.ladder_kernels`, the sums of :func:`~rvsm.model.sampling.row_sums.ladder_sum`,
+the responses never stored), else :func:`~rvsm.model.sampling.row_sums.scale_sum` per
+scale into a row of responses, then the rule per scale (the orbit order either way; the
+first step's capture of the references goes the second way too).
 
 Every float operation is the one :mod:`.numpy_engine` does, in the same order, the log
 is the same inlined function, no loop runs under ``fastmath``, and every pixel's
@@ -27,6 +29,13 @@ import numpy as np
 from numba import njit, prange
 
 from rvsm.model.events.config import EventConfig
+from rvsm.model.events.event_rule import event_step
+from rvsm.model.events.ladder_kernels import (
+    ladder_events_1,
+    ladder_events_2,
+    ladder_events_3,
+    ladder_events_4,
+)
 from rvsm.model.events.log_intensity import log_intensity_value
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, normal_row
@@ -51,13 +60,21 @@ def _events_row(resp, th, rf, out, width, capture):
             out[x] = 0
         return
     for x in range(width):
-        r = rf[x]
-        d = resp[x] - r
-        c = th[x]
-        on = d >= c
-        off = (d <= -c) & (not on)
-        out[x] = np.int8(on) - np.int8(off)
-        rf[x] = r + c if on else (r - c if off else r)
+        event_step(resp[x], th, rf, out, x)
+
+
+@njit(inline="always", cache=True)
+def ladder_events(pairs, pr, ring, w, width, thr, ref, ev, y):
+    """:mod:`.ladder_kernels`' ``ladder_events_S`` for the ``S = w.shape[0]`` scales."""
+    num_scales = w.shape[0]
+    if num_scales == 1:
+        ladder_events_1(pairs, pr, ring, w, width, thr, ref, ev, y)
+    elif num_scales == 2:
+        ladder_events_2(pairs, pr, ring, w, width, thr, ref, ev, y)
+    elif num_scales == 3:
+        ladder_events_3(pairs, pr, ring, w, width, thr, ref, ev, y)
+    else:
+        ladder_events_4(pairs, pr, ring, w, width, thr, ref, ev, y)
 
 
 @njit(inline="always", cache=True)
@@ -147,6 +164,9 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
                     continue
                 yo = y - lmax  # the output row whose window ends at row y
                 pr = (r - 2 * lmax) % ring + lmax
+                if ladder and not capture:  # sums and event rule in one loop
+                    ladder_events(pairs, pr, ring, weights, width, thr, ref, out[b], yo)
+                    continue
                 if ladder:
                     ladder_sum(pairs, pr, ring, weights, width, resp)
                 else:

@@ -16,9 +16,10 @@ variable once) and is called from ``rvsm.model``'s ``__init__``. It changes noth
 
 :func:`allow_alias_checks` raises LLVM's limit on the runtime alias checks a loop may
 carry to be vectorised (``-vectorize-memory-check-threshold``, default 128 pointer
-comparisons), a process-wide LLVM option; :mod:`rvsm.model.sampling.row_sums` sets it
-when imported, before any of its kernels compile (the one loop of the four-scale ladder
-sums reads 45 rows and writes 4).
+comparisons), a process-wide LLVM option; :mod:`rvsm.model.sampling.row_sums` (256: the
+one loop of the four-scale ladder sums reads 45 rows and writes 4) and
+:mod:`rvsm.model.events.ladder_kernels` (1024: sums and event rule, 53 rows read and 8
+written) raise it when imported, before any of their kernels compile.
 
 Results depend on neither: no kernel runs under ``fastmath``, so a vector loop does the
 same float operations in the same order at any width (the event engines' oracle tests
@@ -42,6 +43,7 @@ _CPUINFO = Path("/proc/cpuinfo")
 #: The runtime alias checks LLVM may add to vectorise one loop (4 rows written x 45 read
 #: by the four-scale ladder sums, and headroom).
 ALIAS_CHECKS = 256
+_alias_checks = 128  # LLVM's default
 
 
 def _host_has_avx512(cpuinfo: Path = _CPUINFO) -> bool:
@@ -90,9 +92,14 @@ def prefer_512_bit_vectors(environ: dict | None = None, cpuinfo: Path = _CPUINFO
     return True
 
 
-def allow_alias_checks(limit: int = ALIAS_CHECKS) -> None:
+def allow_alias_checks(limit: int = ALIAS_CHECKS) -> int:
     """Let LLVM's loop vectoriser add up to ``limit`` runtime pointer comparisons to a loop
-    (process-wide; affects code compiled from now on)."""
-    import llvmlite.binding as llvm
+    (process-wide; affects code compiled from now on). The limit only rises: a module
+    asking for less than an earlier one leaves it. Returns the limit in force."""
+    global _alias_checks
+    if limit > _alias_checks:
+        import llvmlite.binding as llvm
 
-    llvm.set_option("", f"-vectorize-memory-check-threshold={int(limit)}")
+        llvm.set_option("", f"-vectorize-memory-check-threshold={int(limit)}")
+        _alias_checks = int(limit)
+    return _alias_checks
