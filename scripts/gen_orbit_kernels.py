@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Write ``model/sampling/orbit_kernels.py``: the per-half-width orbit sums and the ladder
-sums (every scale of a ``1..S`` ladder in one pass), unrolled for numba.
+sums (every scale of a ``1..S`` ladder in one pass), unrolled for numba; and
+``model/events/ladder_kernels.py``: the ladder sums with the event rule of every scale in
+the same loop (the RVSM-DVS fused engine's step).
 
 Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
 ``model/kernels/orbits.py``; ``tests/model/sampling/test_fused.py`` checks the file is up to date.
@@ -8,6 +10,7 @@ Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -22,10 +25,14 @@ starts at ``w[0] - w[0]``, i.e. 0 of the weights' type, so the same code sums in
 exactly for the fixed twin). The weighted sum stays in a register, so the loop over
 ``x`` vectorises.
 
-``ladder_sum_S(pairs, pr, w, width, out)``: ``out[s, x]`` for every scale ``s`` of a
-ladder of half-widths ``1..S`` (weights ``w (S, N)``), two scales a loop: each orbit is
-formed once per loop and added to both scales' sums, each sum in its own order, so every
-``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and additions.
+``ladder_sum_S(pairs, pr, ring, w, width, out)``: ``out[s, x]`` for every scale ``s`` of
+a ladder of half-widths ``1..S`` (weights ``w (S, N)``), rows taken modulo ``ring`` (a
+ring of rows stored once; ``ring`` = the rows of ``pairs`` for plain rows; ``pr >= S``),
+every scale in one loop: each orbit is formed once and added to the sums of the scales
+that use it, each sum in its own order, so every ``out[s]`` equals ``scale_sum_{s + 1}``
+bit for bit with fewer loads and additions. The loop over four scales reads 45 rows and
+writes 4: it vectorises only with the vectoriser's runtime alias-check limit raised
+(:func:`rvsm.model.infra.simd.allow_alias_checks`, set by :mod:`.row_sums`).
 """
 
 from numba import njit
@@ -81,14 +88,17 @@ def generate() -> str:
 
 
 def ladder_sum(scales: int) -> list[str]:
-    """The lines of ``ladder_sum_S`` for the ladder of half-widths ``1..S``: one loop per
-    pair of scales, forming each orbit the pair uses once and adding it to both sums (a
-    loop over more scales stores to more rows than LLVM's runtime alias checks allow: it
-    stays scalar, 2x slower; forming the orbits into a buffer first is 10 % slower)."""
+    """The lines of ``ladder_sum_S`` for the ladder of half-widths ``1..S``: one loop over
+    every scale, forming each orbit once and adding it to the sums of the scales that use
+    it. For four scales (45 rows read, 4 written) LLVM needs up to 180 runtime alias
+    checks, above its default limit of 128 (then the loop stays scalar, 2x slower):
+    ``row_sums`` raises the limit. Two loops of two scales (within the default limit) were
+    a third slower per pixel than one loop; forming the orbits into a buffer first, 10 %
+    slower than two loops."""
     orbits = [(a, b) for a in range(scales + 1) for b in range(a + 1)]
     lines = ['@njit(inline="always", cache=True)',
-             f"def ladder_sum_{scales}(pairs, pr, w, width, out):"]
-    for group in [range(s0, min(s0 + 2, scales)) for s0 in range(0, scales, 2)]:
+             f"def ladder_sum_{scales}(pairs, pr, ring, w, width, out):"]
+    for group in [range(scales)]:  # one loop
         used = [(s + 2) * (s + 3) // 2 for s in group]  # orbits of half-width s + 1
         exprs, rows = [], set()
         for a, b in orbits[:max(used)]:
@@ -96,7 +106,8 @@ def ladder_sum(scales: int) -> list[str]:
             exprs.append(expr)
             rows |= r
         for pb, d in sorted(rows):
-            lines.append(f"    {_row(pb, d)} = pairs[{pb}, pr {'-' if d < 0 else '+'} {abs(d)}]")
+            lines.append(f"    {_row(pb, d)} = pairs[{pb}, (pr {'-' if d < 0 else '+'} {abs(d)})"
+                         " % ring]")
         for s, n_s in zip(group, used, strict=True):
             lines.append(f"    out{s} = out[{s}]")
             lines += [f"    w{s}_{n} = w[{s}, {n}]" for n in range(n_s)]
@@ -110,10 +121,67 @@ def ladder_sum(scales: int) -> list[str]:
     return lines
 
 
+EVENTS_HEADER = '''"""Ladder sums and event rule, one loop (scripts/gen_orbit_kernels.py wrote it).
+
+``ladder_events_S(pairs, pr, ring, w, width, thr, ref, ev, y)``: every scale's receptive
+sum of padded row ``pr`` exactly as
+:func:`rvsm.model.sampling.orbit_kernels.ladder_sum_S` forms it (rows modulo ``ring``,
+the same operations in the same order), then, in the same loop, the event rule
+(:func:`.event_rule.event_step`) on row ``y`` of every scale: thresholds and references
+``thr, ref (S, H, W)``, events ``ev (S, H, W) int8``. The responses stay in registers (no
+row of responses is stored and read back); the loop reads 45 + 8 rows and writes 8 for
+four scales, so it vectorises only with the vectoriser's runtime alias-check limit raised
+(:func:`rvsm.model.infra.simd.allow_alias_checks`, raised here). They are compiled as
+functions of their own, not inlined: four inlined loops made the fused kernel 10 %
+slower.
+"""
+
+from numba import njit
+
+from rvsm.model.events.event_rule import event_step
+from rvsm.model.infra.simd import allow_alias_checks
+
+# The four-scale loop reads 53 rows and writes 8: up to 424 runtime alias checks.
+allow_alias_checks(1024)
+'''
+
+
+def ladder_events(scales: int) -> list[str]:
+    """The lines of ``ladder_events_S``: ``ladder_sum_S`` whose stores of the responses
+    are the event rule of each scale."""
+    lines = ladder_sum(scales)
+    lines[0] = "@njit(cache=True)"  # not inlined: four inlined loops slow the kernel 10 %
+    lines[1] = f"def ladder_events_{scales}(pairs, pr, ring, w, width, thr, ref, ev, y):"
+    out = []
+    for line in lines:
+        row = re.fullmatch(r"    out(\d) = out\[(\d)\]", line)
+        store = re.fullmatch(r"        out(\d)\[x\] = t(\d)", line)
+        if row:
+            s = row[1]
+            out += [f"    th{s} = thr[{s}, y]", f"    rf{s} = ref[{s}, y]",
+                    f"    ev{s} = ev[{s}, y]"]
+        elif store:
+            s = store[1]
+            out.append(f"        event_step(t{s}, th{s}, rf{s}, ev{s}, x)")
+        else:
+            out.append(line)
+    return out
+
+
+def generate_events() -> str:
+    """The source text of ``model/events/ladder_kernels.py``."""
+    out = [EVENTS_HEADER.rstrip("\n")]
+    for scales in range(1, MAX_HALF + 1):
+        out += ["", ""] + ladder_events(scales)
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
 def main() -> None:
-    target = Path(__file__).resolve().parent.parent / "model" / "sampling" / "orbit_kernels.py"
-    target.write_text(generate())
-    print(f"wrote {target}", file=sys.stderr)
+    root = Path(__file__).resolve().parent.parent
+    for target, text in ((root / "model" / "sampling" / "orbit_kernels.py", generate()),
+                         (root / "model" / "events" / "ladder_kernels.py", generate_events())):
+        target.write_text(text)
+        print(f"wrote {target}", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -6,11 +6,15 @@ tile and step it streams the tile's rows plus a halo of ``L`` rows, one at a tim
 brightness (interpolated between the chunk's frames, plus the dark current drawn inside
 the tile from the counter-based streams of :mod:`rvsm.model.noise.streams`) and its log
 (:func:`.log_intensity.log_intensity_value`) in one vectorised loop, then the row's pairs
-into a ring of ``2L + 1`` rows (each stored twice, so the window around any output row is
+into a ring of ``2L + 1`` rows (the ladder sums take their rows modulo the ring; for the
+per-scale sums each row is stored twice, so the window around any output row is
 consecutive). Once a row's window is complete it forms every scale's receptive sum of it
-(:func:`~rvsm.model.sampling.row_sums.ladder_sum` for the ``1..S`` ladders, else
-:func:`~rvsm.model.sampling.row_sums.scale_sum` per scale; the orbit order) and applies
-the event rule to the row's accumulators and references.
+and applies the event rule (:mod:`.event_rule`) to the row's accumulators and references:
+for the ``1..S`` ladders in one vectorised loop over all scales
+(:mod:`.ladder_kernels`, the sums of :func:`~rvsm.model.sampling.row_sums.ladder_sum`,
+the responses never stored), else :func:`~rvsm.model.sampling.row_sums.scale_sum` per
+scale into a row of responses, then the rule per scale (the orbit order either way; the
+first step's capture of the references goes the second way too).
 
 Every float operation is the one :mod:`.numpy_engine` does, in the same order, the log
 is the same inlined function, no loop runs under ``fastmath``, and every pixel's
@@ -25,6 +29,13 @@ import numpy as np
 from numba import njit, prange
 
 from rvsm.model.events.config import EventConfig
+from rvsm.model.events.event_rule import event_step
+from rvsm.model.events.ladder_kernels import (
+    ladder_events_1,
+    ladder_events_2,
+    ladder_events_3,
+    ladder_events_4,
+)
 from rvsm.model.events.log_intensity import log_intensity_value
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, normal_row
@@ -49,13 +60,21 @@ def _events_row(resp, th, rf, out, width, capture):
             out[x] = 0
         return
     for x in range(width):
-        r = rf[x]
-        d = resp[x] - r
-        c = th[x]
-        on = d >= c
-        off = (d <= -c) & (not on)
-        out[x] = np.int8(on) - np.int8(off)
-        rf[x] = r + c if on else (r - c if off else r)
+        event_step(resp[x], th, rf, out, x)
+
+
+@njit(inline="always", cache=True)
+def ladder_events(pairs, pr, ring, w, width, thr, ref, ev, y):
+    """:mod:`.ladder_kernels`' ``ladder_events_S`` for the ``S = w.shape[0]`` scales."""
+    num_scales = w.shape[0]
+    if num_scales == 1:
+        ladder_events_1(pairs, pr, ring, w, width, thr, ref, ev, y)
+    elif num_scales == 2:
+        ladder_events_2(pairs, pr, ring, w, width, thr, ref, ev, y)
+    elif num_scales == 3:
+        ladder_events_3(pairs, pr, ring, w, width, thr, ref, ev, y)
+    else:
+        ladder_events_4(pairs, pr, ring, w, width, thr, ref, ev, y)
 
 
 @njit(inline="always", cache=True)
@@ -82,25 +101,33 @@ def _log_row(frames, f, a, y, noisy, key, t, mean, sd, zx, zr, dark, width, dst)
 
 
 @njit(inline="always", cache=True)
-def _ring_pairs(pad, lmax, width, ring, k, pairs):
+def _ring_pairs(pad, lmax, width, ring, k, twice, pairs):
     """Row pairs of the padded row ``pad (W + 2L,)`` (:func:`.row_sums.row_pairs`) into
-    ring slots ``k`` and ``k + ring`` of ``pairs (L + 1, 2 ring, W)``."""
+    ring slot ``k`` of ``pairs (L + 1, 2 ring, W)``, and slot ``k + ring`` if ``twice``."""
     mid = pad[lmax:lmax + width]
     d0 = pairs[0, k]
     d1 = pairs[0, k + ring]
-    for x in range(width):
-        v = mid[x]
-        d0[x] = v
-        d1[x] = v
+    if twice:
+        for x in range(width):
+            v = mid[x]
+            d0[x] = v
+            d1[x] = v
+    else:
+        for x in range(width):
+            d0[x] = mid[x]
     for b in range(1, lmax + 1):
         left = pad[lmax - b:lmax - b + width]
         right = pad[lmax + b:lmax + b + width]
         d0 = pairs[b, k]
         d1 = pairs[b, k + ring]
-        for x in range(width):
-            v = left[x] + right[x]
-            d0[x] = v
-            d1[x] = v
+        if twice:
+            for x in range(width):
+                v = left[x] + right[x]
+                d0[x] = v
+                d1[x] = v
+        else:
+            for x in range(width):
+                d0[x] = left[x] + right[x]
 
 
 @njit(parallel=True, cache=True, error_model="numpy")
@@ -114,9 +141,11 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
         y0 = ti * tile_rows
         rows = min(height, y0 + tile_rows) - y0
         pad = np.zeros(width + 2 * lmax)  # one row of L, zero margins
-        # Each padded row's pairs go to ring slots k and k + ring, so the 2L + 1 rows
-        # around any output row are consecutive slots (what the row sums index).
+        # Each padded row's pairs go to ring slot k; for the per-scale sums also to slot
+        # k + ring, so the 2L + 1 rows around any output row are consecutive slots (what
+        # scale_sum indexes; ladder_sum takes its rows modulo the ring).
         pairs = np.zeros((lmax + 1, 2 * ring, width))
+        twice = not ladder
         dark = np.empty(width)
         resp = np.empty((num_scales, width))
         for b in range(num_steps):
@@ -130,13 +159,16 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
                 else:
                     _log_row(frames, fidx[b], aw[b], y, noisy, key, t0 + b, mean, sd, zx,
                              zr, dark, width, pad[lmax:lmax + width])
-                    _ring_pairs(pad, lmax, width, ring, k, pairs)
+                    _ring_pairs(pad, lmax, width, ring, k, twice, pairs)
                 if r < 2 * lmax:
                     continue
                 yo = y - lmax  # the output row whose window ends at row y
                 pr = (r - 2 * lmax) % ring + lmax
+                if ladder and not capture:  # sums and event rule in one loop
+                    ladder_events(pairs, pr, ring, weights, width, thr, ref, out[b], yo)
+                    continue
                 if ladder:
-                    ladder_sum(pairs, pr, weights, width, resp)
+                    ladder_sum(pairs, pr, ring, weights, width, resp)
                 else:
                     for s in range(num_scales):
                         scale_sum(pairs, pr, weights[s], halves[s], width, resp[s])

@@ -8,10 +8,14 @@ starts at ``w[0] - w[0]``, i.e. 0 of the weights' type, so the same code sums in
 exactly for the fixed twin). The weighted sum stays in a register, so the loop over
 ``x`` vectorises.
 
-``ladder_sum_S(pairs, pr, w, width, out)``: ``out[s, x]`` for every scale ``s`` of a
-ladder of half-widths ``1..S`` (weights ``w (S, N)``), two scales a loop: each orbit is
-formed once per loop and added to both scales' sums, each sum in its own order, so every
-``out[s]`` equals ``scale_sum_{s + 1}`` bit for bit with fewer loads and additions.
+``ladder_sum_S(pairs, pr, ring, w, width, out)``: ``out[s, x]`` for every scale ``s`` of
+a ladder of half-widths ``1..S`` (weights ``w (S, N)``), rows taken modulo ``ring`` (a
+ring of rows stored once; ``ring`` = the rows of ``pairs`` for plain rows; ``pr >= S``),
+every scale in one loop: each orbit is formed once and added to the sums of the scales
+that use it, each sum in its own order, so every ``out[s]`` equals ``scale_sum_{s + 1}``
+bit for bit with fewer loads and additions. The loop over four scales reads 45 rows and
+writes 4: it vectorises only with the vectoriser's runtime alias-check limit raised
+(:func:`rvsm.model.infra.simd.allow_alias_checks`, set by :mod:`.row_sums`).
 """
 
 from numba import njit
@@ -183,13 +187,13 @@ def scale_sum_4(pairs, pr, w, width, out):
 
 
 @njit(inline="always", cache=True)
-def ladder_sum_1(pairs, pr, w, width, out):
-    r0_m1 = pairs[0, pr - 1]
-    r0_p0 = pairs[0, pr + 0]
-    r0_p1 = pairs[0, pr + 1]
-    r1_m1 = pairs[1, pr - 1]
-    r1_p0 = pairs[1, pr + 0]
-    r1_p1 = pairs[1, pr + 1]
+def ladder_sum_1(pairs, pr, ring, w, width, out):
+    r0_m1 = pairs[0, (pr - 1) % ring]
+    r0_p0 = pairs[0, (pr + 0) % ring]
+    r0_p1 = pairs[0, (pr + 1) % ring]
+    r1_m1 = pairs[1, (pr - 1) % ring]
+    r1_p0 = pairs[1, (pr + 0) % ring]
+    r1_p1 = pairs[1, (pr + 1) % ring]
     out0 = out[0]
     w0_0 = w[0, 0]
     w0_1 = w[0, 1]
@@ -206,22 +210,22 @@ def ladder_sum_1(pairs, pr, w, width, out):
 
 
 @njit(inline="always", cache=True)
-def ladder_sum_2(pairs, pr, w, width, out):
-    r0_m2 = pairs[0, pr - 2]
-    r0_m1 = pairs[0, pr - 1]
-    r0_p0 = pairs[0, pr + 0]
-    r0_p1 = pairs[0, pr + 1]
-    r0_p2 = pairs[0, pr + 2]
-    r1_m2 = pairs[1, pr - 2]
-    r1_m1 = pairs[1, pr - 1]
-    r1_p0 = pairs[1, pr + 0]
-    r1_p1 = pairs[1, pr + 1]
-    r1_p2 = pairs[1, pr + 2]
-    r2_m2 = pairs[2, pr - 2]
-    r2_m1 = pairs[2, pr - 1]
-    r2_p0 = pairs[2, pr + 0]
-    r2_p1 = pairs[2, pr + 1]
-    r2_p2 = pairs[2, pr + 2]
+def ladder_sum_2(pairs, pr, ring, w, width, out):
+    r0_m2 = pairs[0, (pr - 2) % ring]
+    r0_m1 = pairs[0, (pr - 1) % ring]
+    r0_p0 = pairs[0, (pr + 0) % ring]
+    r0_p1 = pairs[0, (pr + 1) % ring]
+    r0_p2 = pairs[0, (pr + 2) % ring]
+    r1_m2 = pairs[1, (pr - 2) % ring]
+    r1_m1 = pairs[1, (pr - 1) % ring]
+    r1_p0 = pairs[1, (pr + 0) % ring]
+    r1_p1 = pairs[1, (pr + 1) % ring]
+    r1_p2 = pairs[1, (pr + 2) % ring]
+    r2_m2 = pairs[2, (pr - 2) % ring]
+    r2_m1 = pairs[2, (pr - 1) % ring]
+    r2_p0 = pairs[2, (pr + 0) % ring]
+    r2_p1 = pairs[2, (pr + 1) % ring]
+    r2_p2 = pairs[2, (pr + 2) % ring]
     out0 = out[0]
     w0_0 = w[0, 0]
     w0_1 = w[0, 1]
@@ -256,22 +260,35 @@ def ladder_sum_2(pairs, pr, w, width, out):
 
 
 @njit(inline="always", cache=True)
-def ladder_sum_3(pairs, pr, w, width, out):
-    r0_m2 = pairs[0, pr - 2]
-    r0_m1 = pairs[0, pr - 1]
-    r0_p0 = pairs[0, pr + 0]
-    r0_p1 = pairs[0, pr + 1]
-    r0_p2 = pairs[0, pr + 2]
-    r1_m2 = pairs[1, pr - 2]
-    r1_m1 = pairs[1, pr - 1]
-    r1_p0 = pairs[1, pr + 0]
-    r1_p1 = pairs[1, pr + 1]
-    r1_p2 = pairs[1, pr + 2]
-    r2_m2 = pairs[2, pr - 2]
-    r2_m1 = pairs[2, pr - 1]
-    r2_p0 = pairs[2, pr + 0]
-    r2_p1 = pairs[2, pr + 1]
-    r2_p2 = pairs[2, pr + 2]
+def ladder_sum_3(pairs, pr, ring, w, width, out):
+    r0_m3 = pairs[0, (pr - 3) % ring]
+    r0_m2 = pairs[0, (pr - 2) % ring]
+    r0_m1 = pairs[0, (pr - 1) % ring]
+    r0_p0 = pairs[0, (pr + 0) % ring]
+    r0_p1 = pairs[0, (pr + 1) % ring]
+    r0_p2 = pairs[0, (pr + 2) % ring]
+    r0_p3 = pairs[0, (pr + 3) % ring]
+    r1_m3 = pairs[1, (pr - 3) % ring]
+    r1_m2 = pairs[1, (pr - 2) % ring]
+    r1_m1 = pairs[1, (pr - 1) % ring]
+    r1_p0 = pairs[1, (pr + 0) % ring]
+    r1_p1 = pairs[1, (pr + 1) % ring]
+    r1_p2 = pairs[1, (pr + 2) % ring]
+    r1_p3 = pairs[1, (pr + 3) % ring]
+    r2_m3 = pairs[2, (pr - 3) % ring]
+    r2_m2 = pairs[2, (pr - 2) % ring]
+    r2_m1 = pairs[2, (pr - 1) % ring]
+    r2_p0 = pairs[2, (pr + 0) % ring]
+    r2_p1 = pairs[2, (pr + 1) % ring]
+    r2_p2 = pairs[2, (pr + 2) % ring]
+    r2_p3 = pairs[2, (pr + 3) % ring]
+    r3_m3 = pairs[3, (pr - 3) % ring]
+    r3_m2 = pairs[3, (pr - 2) % ring]
+    r3_m1 = pairs[3, (pr - 1) % ring]
+    r3_p0 = pairs[3, (pr + 0) % ring]
+    r3_p1 = pairs[3, (pr + 1) % ring]
+    r3_p2 = pairs[3, (pr + 2) % ring]
+    r3_p3 = pairs[3, (pr + 3) % ring]
     out0 = out[0]
     w0_0 = w[0, 0]
     w0_1 = w[0, 1]
@@ -283,54 +300,6 @@ def ladder_sum_3(pairs, pr, w, width, out):
     w1_3 = w[1, 3]
     w1_4 = w[1, 4]
     w1_5 = w[1, 5]
-    for x in range(width):
-        t0 = w0_0 - w0_0
-        t1 = w1_0 - w1_0
-        o = r0_p0[x]
-        t0 = t0 + w0_0 * o
-        t1 = t1 + w1_0 * o
-        o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
-        t0 = t0 + w0_1 * o
-        t1 = t1 + w1_1 * o
-        o = (r1_m1[x] + r1_p1[x])
-        t0 = t0 + w0_2 * o
-        t1 = t1 + w1_2 * o
-        o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
-        t1 = t1 + w1_3 * o
-        o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
-        t1 = t1 + w1_4 * o
-        o = (r2_m2[x] + r2_p2[x])
-        t1 = t1 + w1_5 * o
-        out0[x] = t0
-        out1[x] = t1
-    r0_m3 = pairs[0, pr - 3]
-    r0_m2 = pairs[0, pr - 2]
-    r0_m1 = pairs[0, pr - 1]
-    r0_p0 = pairs[0, pr + 0]
-    r0_p1 = pairs[0, pr + 1]
-    r0_p2 = pairs[0, pr + 2]
-    r0_p3 = pairs[0, pr + 3]
-    r1_m3 = pairs[1, pr - 3]
-    r1_m2 = pairs[1, pr - 2]
-    r1_m1 = pairs[1, pr - 1]
-    r1_p0 = pairs[1, pr + 0]
-    r1_p1 = pairs[1, pr + 1]
-    r1_p2 = pairs[1, pr + 2]
-    r1_p3 = pairs[1, pr + 3]
-    r2_m3 = pairs[2, pr - 3]
-    r2_m2 = pairs[2, pr - 2]
-    r2_m1 = pairs[2, pr - 1]
-    r2_p0 = pairs[2, pr + 0]
-    r2_p1 = pairs[2, pr + 1]
-    r2_p2 = pairs[2, pr + 2]
-    r2_p3 = pairs[2, pr + 3]
-    r3_m3 = pairs[3, pr - 3]
-    r3_m2 = pairs[3, pr - 2]
-    r3_m1 = pairs[3, pr - 1]
-    r3_p0 = pairs[3, pr + 0]
-    r3_p1 = pairs[3, pr + 1]
-    r3_p2 = pairs[3, pr + 2]
-    r3_p3 = pairs[3, pr + 3]
     out2 = out[2]
     w2_0 = w[2, 0]
     w2_1 = w[2, 1]
@@ -343,18 +312,29 @@ def ladder_sum_3(pairs, pr, w, width, out):
     w2_8 = w[2, 8]
     w2_9 = w[2, 9]
     for x in range(width):
+        t0 = w0_0 - w0_0
+        t1 = w1_0 - w1_0
         t2 = w2_0 - w2_0
         o = r0_p0[x]
+        t0 = t0 + w0_0 * o
+        t1 = t1 + w1_0 * o
         t2 = t2 + w2_0 * o
         o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
+        t0 = t0 + w0_1 * o
+        t1 = t1 + w1_1 * o
         t2 = t2 + w2_1 * o
         o = (r1_m1[x] + r1_p1[x])
+        t0 = t0 + w0_2 * o
+        t1 = t1 + w1_2 * o
         t2 = t2 + w2_2 * o
         o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
+        t1 = t1 + w1_3 * o
         t2 = t2 + w2_3 * o
         o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
+        t1 = t1 + w1_4 * o
         t2 = t2 + w2_4 * o
         o = (r2_m2[x] + r2_p2[x])
+        t1 = t1 + w1_5 * o
         t2 = t2 + w2_5 * o
         o = ((r0_m3[x] + r0_p3[x]) + r3_p0[x])
         t2 = t2 + w2_6 * o
@@ -364,26 +344,58 @@ def ladder_sum_3(pairs, pr, w, width, out):
         t2 = t2 + w2_8 * o
         o = (r3_m3[x] + r3_p3[x])
         t2 = t2 + w2_9 * o
+        out0[x] = t0
+        out1[x] = t1
         out2[x] = t2
 
 
 @njit(inline="always", cache=True)
-def ladder_sum_4(pairs, pr, w, width, out):
-    r0_m2 = pairs[0, pr - 2]
-    r0_m1 = pairs[0, pr - 1]
-    r0_p0 = pairs[0, pr + 0]
-    r0_p1 = pairs[0, pr + 1]
-    r0_p2 = pairs[0, pr + 2]
-    r1_m2 = pairs[1, pr - 2]
-    r1_m1 = pairs[1, pr - 1]
-    r1_p0 = pairs[1, pr + 0]
-    r1_p1 = pairs[1, pr + 1]
-    r1_p2 = pairs[1, pr + 2]
-    r2_m2 = pairs[2, pr - 2]
-    r2_m1 = pairs[2, pr - 1]
-    r2_p0 = pairs[2, pr + 0]
-    r2_p1 = pairs[2, pr + 1]
-    r2_p2 = pairs[2, pr + 2]
+def ladder_sum_4(pairs, pr, ring, w, width, out):
+    r0_m4 = pairs[0, (pr - 4) % ring]
+    r0_m3 = pairs[0, (pr - 3) % ring]
+    r0_m2 = pairs[0, (pr - 2) % ring]
+    r0_m1 = pairs[0, (pr - 1) % ring]
+    r0_p0 = pairs[0, (pr + 0) % ring]
+    r0_p1 = pairs[0, (pr + 1) % ring]
+    r0_p2 = pairs[0, (pr + 2) % ring]
+    r0_p3 = pairs[0, (pr + 3) % ring]
+    r0_p4 = pairs[0, (pr + 4) % ring]
+    r1_m4 = pairs[1, (pr - 4) % ring]
+    r1_m3 = pairs[1, (pr - 3) % ring]
+    r1_m2 = pairs[1, (pr - 2) % ring]
+    r1_m1 = pairs[1, (pr - 1) % ring]
+    r1_p0 = pairs[1, (pr + 0) % ring]
+    r1_p1 = pairs[1, (pr + 1) % ring]
+    r1_p2 = pairs[1, (pr + 2) % ring]
+    r1_p3 = pairs[1, (pr + 3) % ring]
+    r1_p4 = pairs[1, (pr + 4) % ring]
+    r2_m4 = pairs[2, (pr - 4) % ring]
+    r2_m3 = pairs[2, (pr - 3) % ring]
+    r2_m2 = pairs[2, (pr - 2) % ring]
+    r2_m1 = pairs[2, (pr - 1) % ring]
+    r2_p0 = pairs[2, (pr + 0) % ring]
+    r2_p1 = pairs[2, (pr + 1) % ring]
+    r2_p2 = pairs[2, (pr + 2) % ring]
+    r2_p3 = pairs[2, (pr + 3) % ring]
+    r2_p4 = pairs[2, (pr + 4) % ring]
+    r3_m4 = pairs[3, (pr - 4) % ring]
+    r3_m3 = pairs[3, (pr - 3) % ring]
+    r3_m2 = pairs[3, (pr - 2) % ring]
+    r3_m1 = pairs[3, (pr - 1) % ring]
+    r3_p0 = pairs[3, (pr + 0) % ring]
+    r3_p1 = pairs[3, (pr + 1) % ring]
+    r3_p2 = pairs[3, (pr + 2) % ring]
+    r3_p3 = pairs[3, (pr + 3) % ring]
+    r3_p4 = pairs[3, (pr + 4) % ring]
+    r4_m4 = pairs[4, (pr - 4) % ring]
+    r4_m3 = pairs[4, (pr - 3) % ring]
+    r4_m2 = pairs[4, (pr - 2) % ring]
+    r4_m1 = pairs[4, (pr - 1) % ring]
+    r4_p0 = pairs[4, (pr + 0) % ring]
+    r4_p1 = pairs[4, (pr + 1) % ring]
+    r4_p2 = pairs[4, (pr + 2) % ring]
+    r4_p3 = pairs[4, (pr + 3) % ring]
+    r4_p4 = pairs[4, (pr + 4) % ring]
     out0 = out[0]
     w0_0 = w[0, 0]
     w0_1 = w[0, 1]
@@ -395,71 +407,6 @@ def ladder_sum_4(pairs, pr, w, width, out):
     w1_3 = w[1, 3]
     w1_4 = w[1, 4]
     w1_5 = w[1, 5]
-    for x in range(width):
-        t0 = w0_0 - w0_0
-        t1 = w1_0 - w1_0
-        o = r0_p0[x]
-        t0 = t0 + w0_0 * o
-        t1 = t1 + w1_0 * o
-        o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
-        t0 = t0 + w0_1 * o
-        t1 = t1 + w1_1 * o
-        o = (r1_m1[x] + r1_p1[x])
-        t0 = t0 + w0_2 * o
-        t1 = t1 + w1_2 * o
-        o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
-        t1 = t1 + w1_3 * o
-        o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
-        t1 = t1 + w1_4 * o
-        o = (r2_m2[x] + r2_p2[x])
-        t1 = t1 + w1_5 * o
-        out0[x] = t0
-        out1[x] = t1
-    r0_m4 = pairs[0, pr - 4]
-    r0_m3 = pairs[0, pr - 3]
-    r0_m2 = pairs[0, pr - 2]
-    r0_m1 = pairs[0, pr - 1]
-    r0_p0 = pairs[0, pr + 0]
-    r0_p1 = pairs[0, pr + 1]
-    r0_p2 = pairs[0, pr + 2]
-    r0_p3 = pairs[0, pr + 3]
-    r0_p4 = pairs[0, pr + 4]
-    r1_m4 = pairs[1, pr - 4]
-    r1_m3 = pairs[1, pr - 3]
-    r1_m2 = pairs[1, pr - 2]
-    r1_m1 = pairs[1, pr - 1]
-    r1_p0 = pairs[1, pr + 0]
-    r1_p1 = pairs[1, pr + 1]
-    r1_p2 = pairs[1, pr + 2]
-    r1_p3 = pairs[1, pr + 3]
-    r1_p4 = pairs[1, pr + 4]
-    r2_m4 = pairs[2, pr - 4]
-    r2_m3 = pairs[2, pr - 3]
-    r2_m2 = pairs[2, pr - 2]
-    r2_m1 = pairs[2, pr - 1]
-    r2_p0 = pairs[2, pr + 0]
-    r2_p1 = pairs[2, pr + 1]
-    r2_p2 = pairs[2, pr + 2]
-    r2_p3 = pairs[2, pr + 3]
-    r2_p4 = pairs[2, pr + 4]
-    r3_m4 = pairs[3, pr - 4]
-    r3_m3 = pairs[3, pr - 3]
-    r3_m2 = pairs[3, pr - 2]
-    r3_m1 = pairs[3, pr - 1]
-    r3_p0 = pairs[3, pr + 0]
-    r3_p1 = pairs[3, pr + 1]
-    r3_p2 = pairs[3, pr + 2]
-    r3_p3 = pairs[3, pr + 3]
-    r3_p4 = pairs[3, pr + 4]
-    r4_m4 = pairs[4, pr - 4]
-    r4_m3 = pairs[4, pr - 3]
-    r4_m2 = pairs[4, pr - 2]
-    r4_m1 = pairs[4, pr - 1]
-    r4_p0 = pairs[4, pr + 0]
-    r4_p1 = pairs[4, pr + 1]
-    r4_p2 = pairs[4, pr + 2]
-    r4_p3 = pairs[4, pr + 3]
-    r4_p4 = pairs[4, pr + 4]
     out2 = out[2]
     w2_0 = w[2, 0]
     w2_1 = w[2, 1]
@@ -488,24 +435,35 @@ def ladder_sum_4(pairs, pr, w, width, out):
     w3_13 = w[3, 13]
     w3_14 = w[3, 14]
     for x in range(width):
+        t0 = w0_0 - w0_0
+        t1 = w1_0 - w1_0
         t2 = w2_0 - w2_0
         t3 = w3_0 - w3_0
         o = r0_p0[x]
+        t0 = t0 + w0_0 * o
+        t1 = t1 + w1_0 * o
         t2 = t2 + w2_0 * o
         t3 = t3 + w3_0 * o
         o = ((r0_m1[x] + r0_p1[x]) + r1_p0[x])
+        t0 = t0 + w0_1 * o
+        t1 = t1 + w1_1 * o
         t2 = t2 + w2_1 * o
         t3 = t3 + w3_1 * o
         o = (r1_m1[x] + r1_p1[x])
+        t0 = t0 + w0_2 * o
+        t1 = t1 + w1_2 * o
         t2 = t2 + w2_2 * o
         t3 = t3 + w3_2 * o
         o = ((r0_m2[x] + r0_p2[x]) + r2_p0[x])
+        t1 = t1 + w1_3 * o
         t2 = t2 + w2_3 * o
         t3 = t3 + w3_3 * o
         o = ((r1_m2[x] + r1_p2[x]) + (r2_m1[x] + r2_p1[x]))
+        t1 = t1 + w1_4 * o
         t2 = t2 + w2_4 * o
         t3 = t3 + w3_4 * o
         o = (r2_m2[x] + r2_p2[x])
+        t1 = t1 + w1_5 * o
         t2 = t2 + w2_5 * o
         t3 = t3 + w3_5 * o
         o = ((r0_m3[x] + r0_p3[x]) + r3_p0[x])
@@ -530,5 +488,7 @@ def ladder_sum_4(pairs, pr, w, width, out):
         t3 = t3 + w3_13 * o
         o = (r4_m4[x] + r4_p4[x])
         t3 = t3 + w3_14 * o
+        out0[x] = t0
+        out1[x] = t1
         out2[x] = t2
         out3[x] = t3

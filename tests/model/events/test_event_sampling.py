@@ -60,7 +60,7 @@ def test_rvsm_dvs_references_and_integrability() -> None:
     assert np.count_nonzero(train.events) > 0
 
 
-@pytest.mark.parametrize("model", ["fsm", "dog4", "gauss3"])
+@pytest.mark.parametrize("model", ["fsm", "dog1", "dog2", "gauss3", "dog4"])
 @pytest.mark.parametrize("noisy", [False, True])
 def test_fused_equals_numpy(model: str, noisy: bool) -> None:
     scene = load_scene("flyball", size=(20, 28), num_frames=4)

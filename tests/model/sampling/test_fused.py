@@ -102,6 +102,8 @@ def test_generated_orbit_kernels_are_up_to_date():
         sys.path.pop(0)
     text = (ROOT / "model" / "sampling" / "orbit_kernels.py").read_text()
     assert text == gen_orbit_kernels.generate()
+    text = (ROOT / "model" / "events" / "ladder_kernels.py").read_text()
+    assert text == gen_orbit_kernels.generate_events()
 
 
 def test_bad_engine_and_chunking_are_refused():

@@ -18,9 +18,14 @@ from rvsm.model.sampling.row_sums import is_ladder, ladder_sum, scale_sum
 @njit(cache=True)
 def _both(pairs, w, halves, rows, width, lad, per):
     for r in range(rows):
-        ladder_sum(pairs, halves[-1] + r, w, width, lad[r])
+        ladder_sum(pairs, halves[-1] + r, pairs.shape[1], w, width, lad[r])
         for s in range(w.shape[0]):
             scale_sum(pairs, halves[-1] + r, w[s], halves[s], width, per[r, s])
+
+
+@njit(cache=True)
+def _ring(pairs, pr, w, width, out):
+    ladder_sum(pairs, pr, pairs.shape[1], w, width, out)
 
 
 @pytest.mark.slow
@@ -37,6 +42,13 @@ def test_ladder_sum_equals_scale_sums(model: str) -> None:
             per = np.empty_like(lad)
             _both(pairs, np.ascontiguousarray(w), halves, rows, width, lad, per)
             assert np.array_equal(lad, per)
+            # A ring of the 2L + 1 rows of output row 0, rotated by k: the same sums.
+            window = np.ascontiguousarray(pairs[:, :2 * lmax + 1])
+            for k in range(2 * lmax + 1):
+                ring = np.ascontiguousarray(np.roll(window, k, axis=1))
+                got = np.empty((len(halves), width))
+                _ring(ring, lmax + k, np.ascontiguousarray(w), width, got)
+                assert np.array_equal(got, per[0])
 
 
 def test_is_ladder() -> None:
