@@ -11,27 +11,13 @@ from __future__ import annotations
 import signal
 import sys
 
+from rvsm.model.infra.errors import interrupt_behind
+
 __all__ = ["main"]
 
 
 def _startup_interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt(signal.Signals(signum).name)
-
-
-def interrupt_behind(exc: BaseException) -> KeyboardInterrupt | None:
-    """The ``KeyboardInterrupt`` that is ``exc`` or caused it (``__cause__``/``__context__``).
-
-    Python wraps an exception raised while a class is set up (``__set_name__``, e.g. during
-    a lazy import) in a ``RuntimeError``; a signal arriving then must still exit 130.
-    """
-    seen: set[int] = set()
-    current: BaseException | None = exc
-    while current is not None and id(current) not in seen:
-        if isinstance(current, KeyboardInterrupt):
-            return current
-        seen.add(id(current))
-        current = current.__cause__ or current.__context__
-    return None
 
 
 def main(argv: list[str] | None = None) -> int:

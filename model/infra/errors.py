@@ -55,3 +55,19 @@ def os_error(exc: OSError, target: str | os.PathLike, what: str = "write") -> Rv
     if code in (errno.ENOENT, errno.ENOTDIR, errno.EISDIR, errno.ENAMETOOLONG):
         return RvsmError(f"cannot {what} {target}: {reason}; check the path")
     return ToolError(f"cannot {what} {target}: {reason}")
+
+
+def interrupt_behind(exc: BaseException) -> KeyboardInterrupt | None:
+    """The ``KeyboardInterrupt`` that is ``exc`` or caused it (``__cause__``/``__context__``).
+
+    Python wraps an exception raised while a class is set up (``__set_name__``, e.g. during
+    a lazy import) in a ``RuntimeError``; a signal arriving then must still exit 130.
+    """
+    seen: set[int] = set()
+    current: BaseException | None = exc
+    while current is not None and id(current) not in seen:
+        if isinstance(current, KeyboardInterrupt):
+            return current
+        seen.add(id(current))
+        current = current.__cause__ or current.__context__
+    return None

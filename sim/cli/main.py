@@ -14,7 +14,7 @@ import signal
 import sys
 from types import ModuleType
 
-from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.model.infra.errors import RvsmError, ToolError, interrupt_behind
 from rvsm.sim.cli import (
     demo,
     events,
@@ -29,7 +29,6 @@ from rvsm.sim.cli import (
     studies,
     sweep,
 )
-from rvsm.sim.console import interrupt_behind
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
 #: co-simulation, formal checks, FPGA timing and area, paper studies, the demo, design sweeps.
