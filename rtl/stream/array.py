@@ -119,16 +119,21 @@ class _Centre:
 
 @dataclass(frozen=True)
 class _Tail:
-    """What the state memories and the tail need from the position pipeline."""
+    """What the state memories and the tail need from the position pipeline (``*_ahead``:
+    the value at the next edge if this cycle advances, ``"adv"``, or not, ``"hold"``:
+    :class:`BankedMemory`'s inputs one edge ahead)."""
 
     rd_addr: Value
     rd_addr_next: Value
+    rd_addr_ahead: dict[str, Value]
     rd_valid: Value
     bank_q: Value
     fresh_q: Value
     wr_addr: Value
+    wr_addr_ahead: dict[str, Value]
     wr_en: Value
     valid: Signal
+    valid_ahead: dict[str, Value]
     row: Value
     group: Value
     last: Value
@@ -242,21 +247,23 @@ class RvsmStreamArray(wiring.Component):
         """Input register, line buffer, window, masks, sums, state memories, output
         register: one method per stage group, in datapath order."""
         m = Module()
-        advance, clear, codes_in = self._input_register(m)
+        advance, advance_next, clear, codes_in = self._input_register(m)
         slabs = self._line_buffer(m, advance, clear, codes_in)
         centre = self._window_centre(m, advance, clear)
         pipe = Pipeline(m, advance, self.geometry.LEVELS_PER_STAGE, name="sum")
         sums, stage_q = self._window_sums(pipe, slabs, centre)
         tail = self._position_pipeline(m, pipe, advance, clear, centre, stage_q)
-        lanes, thr_memories = self._state_and_output(m, advance, sums, tail)
+        lanes, thr_memories = self._state_and_output(m, advance, advance_next, sums, tail)
         self.probes = StreamProbes(advance, clear, tail.rd_addr, advance & tail.rd_valid,
                                    tail.wr_en, tail.wr_addr, lanes, thr_memories)
         pipe.emit()
         return m
 
-    def _input_register(self, m: Module) -> tuple[Signal, Signal, Signal]:
-        """``(advance, clear_r, codes_r)``: an accepted beat (and clear) acts one cycle
-        later, so no combinational path runs from the ports into the datapath. Datapath
+    def _input_register(self, m: Module) -> tuple[Signal, Value, Signal, Signal]:
+        """``(advance, advance_next, clear_r, codes_r)``: an accepted beat (and clear)
+        acts one cycle later, so no combinational path runs from the ports into the
+        datapath (``advance_next``, the value ``advance`` takes at the next edge, feeds
+        only the ECP5 block RAMs' own enable registers). Datapath
         registers are reset-less (only control state and valid bits are reset): less
         reset fan-out, and no next-state logic of the datapath depends on ``rst``."""
         p, n = self.geometry.lanes, self.contract.adc_bits
@@ -270,7 +277,7 @@ class RvsmStreamArray(wiring.Component):
         m.d.sync += [advance.eq(taken), clear.eq(self.clear)]
         with m.If(self.codes.valid & ~self.clear):
             m.d.sync += codes_in.eq(self.codes.payload.as_value())
-        return advance, clear, codes_in
+        return advance, Mux(ResetSignal(), 0, taken), clear, codes_in
 
     def _line_buffer(self, m: Module, advance: Signal, clear: Signal, codes_in: Signal
                      ) -> list[Signal]:
@@ -437,8 +444,10 @@ class RvsmStreamArray(wiring.Component):
         # the value rd_addr takes at the next edge (for comparators registered ahead)
         if read == 0:  # rd_addr is the centre address itself (reset to 0)
             rd_addr_next = Mux(ResetSignal(), 0, centre.next_addr)
+            rd_addr_ahead = {"adv": rd_addr_next, "hold": rd_addr_next}
         else:
-            rd_addr_next = Mux(advance, pipe.at(addr0, read - 1).value, rd_addr)
+            rd_addr_ahead = {"adv": pipe.at(addr0, read - 1).value, "hold": rd_addr}
+            rd_addr_next = Mux(advance, rd_addr_ahead["adv"], rd_addr)
         # the banks' output registers hold the read two edges on: select among them there
         bank_q = pipe.at(addr0, read + 2).value >> (geo.bank_words - 1).bit_length()
         fresh_q = pipe.at(fresh_t, stage_q).value
@@ -447,11 +456,16 @@ class RvsmStreamArray(wiring.Component):
         out_row, out_group = pipe.at(row_t, tail).value, pipe.at(group_t, tail).value
         out_last = pipe.at(last_t, tail).value
         wr_en = advance & valid[tail]
-        return _Tail(rd_addr, rd_addr_next, valid[read], bank_q, fresh_q, wr_addr, wr_en,
-                     valid[tail], out_row, out_group, out_last)
+        # the values wr_addr and valid[tail] take at the next edge (tail >= 1)
+        wr_addr_ahead = {"adv": pipe.at(addr0, tail - 1).value, "hold": wr_addr}
+        kept = ~(ResetSignal() | clear)
+        valid_ahead = {"adv": kept & valid[tail - 1], "hold": kept & valid[tail]}
+        return _Tail(rd_addr, rd_addr_next, rd_addr_ahead, valid[read], bank_q, fresh_q,
+                     wr_addr, wr_addr_ahead, wr_en, valid[tail], valid_ahead, out_row,
+                     out_group, out_last)
 
-    def _state_and_output(self, m: Module, advance: Signal, sums: list[list[Timed]],
-                          tail: _Tail
+    def _state_and_output(self, m: Module, advance: Signal, advance_next: Value,
+                          sums: list[list[Timed]], tail: _Tail
                           ) -> tuple[list[list[dict[str, Value]]], list[BankedMemory]]:
         """Per scale the threshold and accumulator memories, then the tail: add,
         compare/saturate, fire/reset, write back; spikes and position on the output.
@@ -475,7 +489,8 @@ class RvsmStreamArray(wiring.Component):
         bus_scale = bus_addr[word_bits:]
         # bus_addr == rd_addr, registered: compared one edge ahead from the values both
         # take at that edge (the bus register loads every cycle), so no comparator sits
-        # between the read address and the block RAMs' read enables or the forwarding.
+        # between the read address and the forwarding (the ECP5 build's block RAMs
+        # register their own collision flags: BankedMemory's inputs one edge ahead).
         rd_match = Signal(name="thr_rd_match", init=1, reset_less=True)
         m.d.sync += rd_match.eq(bus.addr[:word_bits] == tail.rd_addr_next)
         fwd_data = [Signal.like(bus.data, name=f"thr_fwd{k}_data", reset_less=True)
@@ -491,18 +506,24 @@ class RvsmStreamArray(wiring.Component):
             probes.append([])
             thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True,
                                    init_word=top_threshold_word(tw, p),  # module docstring
-                                   same_addr=True, read_stages=geo.READ_STAGES)
+                                   read_stages=geo.READ_STAGES)
             m.submodules[f"thr_s{s}"] = thr_mem
             thr_memories.append(thr_mem)
             m.d.comb += [thr_mem.advance.eq(advance), thr_mem.read_addr.eq(rd_addr),
                          thr_mem.read_bank.eq(bank_q),
                          thr_mem.write_en.eq(bus_we & (bus_scale == s)),
                          thr_mem.write_addr.eq(bus_word), thr_mem.write_data.eq(bus_data),
-                         thr_mem.same_addr.eq(rd_match),
+                         thr_mem.advance_next.eq(advance_next),
                          thr_mem.forward_hit.eq(
                              bus_we & (bus_scale == s) & rd_match
                              if self.mutation != "stream.no_threshold_forwarding" else 0),
                          thr_mem.forward_data.eq(fwd_data[1])]
+            for case, rd_next in tail.rd_addr_ahead.items():  # the ECP5 build's
+                m.d.comb += [
+                    getattr(thr_mem, f"read_addr_{case}").eq(rd_next),
+                    getattr(thr_mem, f"write_en_{case}").eq(
+                        bus.we & (bus.addr[word_bits:] == s)),
+                    getattr(thr_mem, f"write_addr_{case}").eq(bus.addr[:word_bits])]
             thr_q = thr_mem.data
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
             acc_mem = BankedMemory(p * wa, words, geo.bank_words,
@@ -511,7 +532,15 @@ class RvsmStreamArray(wiring.Component):
             m.d.comb += [acc_mem.advance.eq(advance), acc_mem.read_addr.eq(rd_addr),
                          acc_mem.read_bank.eq(bank_q), acc_mem.write_en.eq(wr_en),
                          acc_mem.write_addr.eq(wr_addr), acc_mem.write_data.eq(after_flat),
-                         acc_mem.may_write.eq(tail.valid)]
+                         acc_mem.may_write.eq(tail.valid),
+                         acc_mem.advance_next.eq(advance_next)]
+            for case, rd_next in tail.rd_addr_ahead.items():  # the ECP5 build's
+                m.d.comb += [
+                    getattr(acc_mem, f"read_addr_{case}").eq(rd_next),
+                    getattr(acc_mem, f"write_en_{case}").eq(
+                        advance_next & tail.valid_ahead[case]),
+                    getattr(acc_mem, f"write_addr_{case}").eq(tail.wr_addr_ahead[case]),
+                    getattr(acc_mem, f"may_write_{case}").eq(tail.valid_ahead[case])]
             acc_q = acc_mem.data
             for i in range(p):
                 fresh = fresh_q

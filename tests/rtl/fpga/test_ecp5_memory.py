@@ -19,6 +19,7 @@ from rvsm.rtl.stream.architecture import stream_port_map
 from rvsm.rtl.stream.array import RvsmStreamArray
 
 MODEL = Path(__file__).with_name("dp16kd_model.v")
+FF_MODEL = Path(__file__).with_name("trellis_ff_model.v")
 
 
 def test_initval_puts_16_words_in_20_bit_slots() -> None:
@@ -112,13 +113,15 @@ def _run(tmp_path: Path, generic: str, fpga: str, tb: str) -> dict[str, int]:
     (tmp_path / "gen.v").write_text(generic)
     (tmp_path / "fpga.v").write_text(fpga)
     (tmp_path / "tb.v").write_text(tb)
-    subprocess.run(["iverilog", "-g2012", "-o", "tb.vvp", "tb.v", "gen.v", "fpga.v",
-                    str(MODEL)], cwd=tmp_path, check=True, capture_output=True, text=True)
+    subprocess.run(["iverilog", "-g2012", "-s", "tb", "-o", "tb.vvp", "tb.v", "gen.v", "fpga.v",
+                    str(MODEL), str(FF_MODEL)], cwd=tmp_path, check=True,
+                   capture_output=True, text=True)
     out = subprocess.run(["vvp", "-n", "tb.vvp"], cwd=tmp_path, check=True,
                          capture_output=True, text=True, timeout=120).stdout
     found = re.search(r"RESULT errors=(\d+) valid=(\d+) fired=(\d+)", out)
     assert found, out
-    return dict(zip(("errors", "valid", "fired"), map(int, found.groups()), strict=True))
+    return {**dict(zip(("errors", "valid", "fired"), map(int, found.groups()), strict=True)),
+            "collisions": out.count("COLLISION")}
 
 
 @pytest.mark.skipif(shutil.which("iverilog") is None, reason="needs Icarus Verilog")
@@ -135,5 +138,12 @@ def test_the_ecp5_array_equals_the_generic_array_cycle_by_cycle(small_contract,
     tb = _testbench(c, 2, 1500, seed=7)
     r = _run(tmp_path, generic, fpga, tb)
     assert r["errors"] == 0 and r["valid"] > 800 and r["fired"] > 100, r
+    assert r["collisions"] == 0  # every read meeting a write was gated off
     broken = fpga.replace('.REGMODE_B("OUTREG")', '.REGMODE_B("NOREG")')
     assert _run(tmp_path, generic, broken, tb)["errors"] > 0
+    # the block RAMs' own collision registers (loaded one edge ahead) held at 0: the
+    # threshold reads meeting writes are no longer gated
+    ungated, n = re.subn(r"(collide_(?:adv|hold)\d+_ff \(\s*\.CE\(1'h1\),\s*\.CLK\(clk\),"
+                         r"\s*)\.DI\(\w+\)", r".DI(1'h0)".join((r"\1", "")), fpga)
+    assert n == 2 * 18
+    assert _run(tmp_path, generic, ungated, tb)["collisions"] > 0
