@@ -17,31 +17,36 @@ the byte enables), ``WRITEMODE`` ``NORMAL`` (port A's own read data is unused), 
 selects and resets tied off, ``GSR`` disabled, the initial contents in ``INITVAL_00`` ..
 ``INITVAL_3F`` (16 words of 18 bits per 320-bit value, each in a 20-bit slot, the layout
 of yosys' own ``brams_map_16kd.v``). A read and a write of the same address at one edge
-(through the two ports) give undefined read data: the user gates the read enable then,
-as ``BankedMemory`` does. Only the 18-bit configuration is used: a bank of at most 1024
+(through the two ports) give undefined read data, which the user must not use
+(below). Only the 18-bit configuration is used: a bank of at most 1024
 words (``StreamGeometry.BANK_WORDS``); shallower banks waste the rest (the 36-bit
 pseudo-dual-port mode would halve the primitives at 512 words, but its data order is
 not pinned down by the open tools' sources, so it is not used).
 
 Cycle behaviour, equal to a generic synchronous read port with enable followed by a
-register with enable, both enabled by ``advance`` and the read by ``~collide``: at an edge
-where ``advance & ~collide`` the word at ``read_addr`` is latched; at an edge where
-``advance`` the latched word moves to ``data``. The enables are given **one edge ahead**
-and registered inside, per primitive, in flip-flops instantiated as ``TRELLIS_FF``
-(:func:`kept_register`; yosys does not merge instances, so every copy survives):
-``advance_next`` (the value ``advance`` takes at the next edge), ``advance`` itself, and
-``collide`` at the next edge in both cases, ``collide_adv_next`` if this cycle advances
-and ``collide_hold_next`` if not; after the edge ``collide`` is the registered pair's
-choice by the registered ``advance``. So no path runs from ``advance`` (a clock enable
-of thousands of registers) through logic to a block RAM, and each block RAM's CEB/OCEB
-is driven by registers of its own, placed beside it, instead of one control net reaching
-every block RAM of the device (the critical path at 64x64, P = 8: 8.4-10.3 ns of it
-routing).
+register with enable, both enabled by ``advance``: at an edge where ``advance`` the word
+at ``read_addr`` is latched and the latched word moves to ``data``. ``advance`` is given
+**one edge ahead** (``advance_next``: the value it takes at the next edge) and
+registered inside, per primitive, in a flip-flop instantiated as ``TRELLIS_FF``
+(:func:`kept_register`; yosys does not merge instances, so every copy survives) that
+drives the primitive's CEB and OCEB directly: no logic between a register and a block
+RAM's enables, and no control net from one register to every block RAM of the device
+(the critical path at 64x64, P = 8: 8.4-10.3 ns of it routing).
+
+**Collisions.** A read of the word the other port writes at the same edge is not gated
+off here (gating it put the collision logic between the enable registers and the block
+RAMs: 7.5 ns at P = 8): its data is undefined on the device, and the array never uses
+it (a threshold read meeting the registered write is replaced by the forwarded word, a
+valid accumulator read never meets the write-back, a read of another bank's word is
+discarded by the bank multiplexer). This assumes, as for block RAMs generally, that such
+a collision leaves the written word intact and only the read data undefined. The
+generic memories of simulation and ``rvsm verilog`` keep the gating (yosys needs it to
+map them without read-first emulation).
 """
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, ClockSignal, Const, Instance, Module, Mux, Signal, Value, unsigned
+from amaranth.hdl import Cat, ClockSignal, Const, Instance, Module, Signal, Value, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -97,8 +102,8 @@ class Ecp5BlockRam(wiring.Component):
     the output register on (see the module docstring).
 
     Ports: ``write_en``, ``write_addr``, ``write_data`` (port A); ``read_addr`` (port
-    B); ``advance_next``, ``advance``, ``collide_adv_next``, ``collide_hold_next`` (the
-    enables one edge ahead, module docstring)
+    B); ``advance_next`` (the read and output registers' enable one edge ahead, module
+    docstring)
     and ``data`` (the output register). ``init_word``: every word's value at
     configuration.
     """
@@ -115,8 +120,7 @@ class Ecp5BlockRam(wiring.Component):
         addr = unsigned(max(1, (depth - 1).bit_length()))
         super().__init__({
             "write_en": In(1), "write_addr": In(addr), "write_data": In(unsigned(width)),
-            "read_addr": In(addr), "advance_next": In(1), "advance": In(1),
-            "collide_adv_next": In(1), "collide_hold_next": In(1),
+            "read_addr": In(addr), "advance_next": In(1),
             "data": Out(unsigned(width)),
         })
 
@@ -135,14 +139,11 @@ class Ecp5BlockRam(wiring.Component):
             di = Signal(unsigned(DP16KD_WIDTH), name=f"di{k}")
             m.d.comb += di.eq(self.write_data[lo:hi])
             # this primitive's own registered enables (placed beside it)
-            adv = kept_register(m, self.advance_next, f"advance{k}")
-            advanced = kept_register(m, self.advance, f"advanced{k}")
-            col = Mux(advanced, kept_register(m, self.collide_adv_next, f"collide_adv{k}"),
-                      kept_register(m, self.collide_hold_next, f"collide_hold{k}"))
+            adv = kept_register(m, self.advance_next, f"advance{k}")  # beside it
             ports: dict = {
                 "i_CLKA": ClockSignal(), "i_CLKB": ClockSignal(),
                 "i_CEA": self.write_en, "i_WEA": self.write_en, "i_OCEA": Const(0),
-                "i_RSTA": Const(0), "i_CEB": adv & ~col, "i_WEB": Const(0),
+                "i_RSTA": Const(0), "i_CEB": adv, "i_WEB": Const(0),
                 "i_OCEB": adv, "i_RSTB": Const(0),
             }
             for p in ("A", "B"):

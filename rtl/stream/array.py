@@ -119,21 +119,18 @@ class _Centre:
 
 @dataclass(frozen=True)
 class _Tail:
-    """What the state memories and the tail need from the position pipeline (``*_ahead``:
-    the value at the next edge if this cycle advances, ``"adv"``, or not, ``"hold"``:
-    :class:`BankedMemory`'s inputs one edge ahead)."""
+    """What the state memories and the tail need from the position pipeline
+    (``rd_addr_next``: the value ``rd_addr`` takes at the next edge if this cycle
+    advances, and if it does not)."""
 
     rd_addr: Value
-    rd_addr_next: Value
-    rd_addr_ahead: dict[str, Value]
+    rd_addr_next: tuple[Value, Value]
     rd_valid: Value
     bank_q: Value
     fresh_q: Value
     wr_addr: Value
-    wr_addr_ahead: dict[str, Value]
     wr_en: Value
     valid: Signal
-    valid_ahead: dict[str, Value]
     row: Value
     group: Value
     last: Value
@@ -414,7 +411,11 @@ class RvsmStreamArray(wiring.Component):
             lane = q % p
             code = src[(d * p + lane) * n:(d * p + lane + 1) * n]
             keep = row_ok[d] & col_ok[j] if (j < r or j >= p + r) else row_ok[d]
-            window[(d, j)] = pipe.register(pipe.timed(Mux(keep, code, 0), 0),
+            # an AND, not Mux(keep, code, 0): yosys maps the latter to the flip-flops'
+            # synchronous reset, which on the ECP5 has priority over the clock enable,
+            # so the reset became advance & ~keep, a path from the beat advance (64x64,
+            # P = 8: 7.27 ns); the AND leaves advance on the clock enable alone
+            window[(d, j)] = pipe.register(pipe.timed(code & keep.replicate(n), 0),
                                            name=f"win_r{d}_c{j}")
         sums, stage_q = geo.build_sums(pipe, window)
         if stage_q != geo.sum_stage:
@@ -441,13 +442,13 @@ class RvsmStreamArray(wiring.Component):
         group_t, last_t = pipe.timed(gc), pipe.timed(last0)
         read = geo.read_stage
         rd_addr = pipe.at(addr0, read).value
-        # the value rd_addr takes at the next edge (for comparators registered ahead)
+        # the value rd_addr takes at the next edge (for comparators registered ahead),
+        # if this cycle advances and if not: neither depends on advance
         if read == 0:  # rd_addr is the centre address itself (reset to 0)
-            rd_addr_next = Mux(ResetSignal(), 0, centre.next_addr)
-            rd_addr_ahead = {"adv": rd_addr_next, "hold": rd_addr_next}
+            same = Mux(ResetSignal(), 0, centre.next_addr)
+            rd_addr_next = (same, same)
         else:
-            rd_addr_ahead = {"adv": pipe.at(addr0, read - 1).value, "hold": rd_addr}
-            rd_addr_next = Mux(advance, rd_addr_ahead["adv"], rd_addr)
+            rd_addr_next = (pipe.at(addr0, read - 1).value, rd_addr)
         # the banks' output registers hold the read two edges on: select among them there
         bank_q = pipe.at(addr0, read + 2).value >> (geo.bank_words - 1).bit_length()
         fresh_q = pipe.at(fresh_t, stage_q).value
@@ -456,13 +457,8 @@ class RvsmStreamArray(wiring.Component):
         out_row, out_group = pipe.at(row_t, tail).value, pipe.at(group_t, tail).value
         out_last = pipe.at(last_t, tail).value
         wr_en = advance & valid[tail]
-        # the values wr_addr and valid[tail] take at the next edge (tail >= 1)
-        wr_addr_ahead = {"adv": pipe.at(addr0, tail - 1).value, "hold": wr_addr}
-        kept = ~(ResetSignal() | clear)
-        valid_ahead = {"adv": kept & valid[tail - 1], "hold": kept & valid[tail]}
-        return _Tail(rd_addr, rd_addr_next, rd_addr_ahead, valid[read], bank_q, fresh_q,
-                     wr_addr, wr_addr_ahead, wr_en, valid[tail], valid_ahead, out_row,
-                     out_group, out_last)
+        return _Tail(rd_addr, rd_addr_next, valid[read], bank_q, fresh_q, wr_addr, wr_en,
+                     valid[tail], out_row, out_group, out_last)
 
     def _state_and_output(self, m: Module, advance: Signal, advance_next: Value,
                           sums: list[list[Timed]], tail: _Tail
@@ -489,10 +485,16 @@ class RvsmStreamArray(wiring.Component):
         bus_scale = bus_addr[word_bits:]
         # bus_addr == rd_addr, registered: compared one edge ahead from the values both
         # take at that edge (the bus register loads every cycle), so no comparator sits
-        # between the read address and the forwarding (the ECP5 build's block RAMs
-        # register their own collision flags: BankedMemory's inputs one edge ahead).
-        rd_match = Signal(name="thr_rd_match", init=1, reset_less=True)
-        m.d.sync += rd_match.eq(bus.addr[:word_bits] == tail.rd_addr_next)
+        # between the read address and the forwarding; compared for both values rd_addr
+        # may take and chosen after the edge by advance, registered: no path from
+        # advance (the clock enable of the whole pipeline) into the comparator.
+        matches = [Signal(name=f"thr_rd_match_{case}", init=1, reset_less=True)
+                   for case in ("adv", "hold")]
+        advanced = Signal(name="advanced", reset_less=True)
+        m.d.sync += [*(match.eq(bus.addr[:word_bits] == addr)
+                       for match, addr in zip(matches, tail.rd_addr_next, strict=True)),
+                     advanced.eq(advance)]
+        rd_match = Mux(advanced, *matches)
         fwd_data = [Signal.like(bus.data, name=f"thr_fwd{k}_data", reset_less=True)
                     for k in (1, 2)]  # shared by the scales
         with m.If(advance):
@@ -518,12 +520,6 @@ class RvsmStreamArray(wiring.Component):
                              bus_we & (bus_scale == s) & rd_match
                              if self.mutation != "stream.no_threshold_forwarding" else 0),
                          thr_mem.forward_data.eq(fwd_data[1])]
-            for case, rd_next in tail.rd_addr_ahead.items():  # the ECP5 build's
-                m.d.comb += [
-                    getattr(thr_mem, f"read_addr_{case}").eq(rd_next),
-                    getattr(thr_mem, f"write_en_{case}").eq(
-                        bus.we & (bus.addr[word_bits:] == s)),
-                    getattr(thr_mem, f"write_addr_{case}").eq(bus.addr[:word_bits])]
             thr_q = thr_mem.data
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
             acc_mem = BankedMemory(p * wa, words, geo.bank_words,
@@ -534,13 +530,6 @@ class RvsmStreamArray(wiring.Component):
                          acc_mem.write_addr.eq(wr_addr), acc_mem.write_data.eq(after_flat),
                          acc_mem.may_write.eq(tail.valid),
                          acc_mem.advance_next.eq(advance_next)]
-            for case, rd_next in tail.rd_addr_ahead.items():  # the ECP5 build's
-                m.d.comb += [
-                    getattr(acc_mem, f"read_addr_{case}").eq(rd_next),
-                    getattr(acc_mem, f"write_en_{case}").eq(
-                        advance_next & tail.valid_ahead[case]),
-                    getattr(acc_mem, f"write_addr_{case}").eq(tail.wr_addr_ahead[case]),
-                    getattr(acc_mem, f"may_write_{case}").eq(tail.valid_ahead[case])]
             acc_q = acc_mem.data
             for i in range(p):
                 fresh = fresh_q

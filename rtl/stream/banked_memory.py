@@ -14,7 +14,8 @@ array's beat advance), so stages count beats:
   as given; gate it with ``advance`` outside).
 * **Collisions.** A bank's read is disabled at an edge where the write port writes its
   address: the read data is then undefined (yosys needs no read-first bypass
-  multiplexer after the block RAM). Either such collisions never meet a valid read, or
+  multiplexer after the block RAM; the ECP5 build leaves such reads enabled and their
+  data unused, :mod:`rvsm.rtl.fpga.ecp5_memory`). Either such collisions never meet a valid read, or
   ``forward=True`` adds ``forward_hit`` / ``forward_data``: where ``forward_hit`` was set
   with the read address, ``data`` is ``forward_data`` (the forwarded word, delayed
   alike: two ``advance`` edges) instead of the read. ``guard_bits = k`` adds
@@ -24,13 +25,9 @@ array's beat advance), so stages count beats:
   written meets its word address read, whichever bank the read is for (a read of
   another bank's word is discarded after the bank registers, but is still a read).
 * **One edge ahead (ECP5 build).** ``advance_next``: the value ``advance`` takes at the
-  next edge; ``read_addr``, ``write_en``, ``write_addr`` (and ``may_write`` with
-  ``guard_bits``) at the next edge, twice: with the
-  suffix ``_adv`` the value if this cycle advances, ``_hold`` if not (so neither depends
-  on ``advance``). The ECP5 build computes each bank's collision from both and registers
-  them, with ``advance``, in every block RAM
-  (:class:`~rvsm.rtl.fpga.ecp5_memory.Ecp5BlockRam`), so no control net runs from one
-  register to all block RAMs; the generic build ignores these inputs.
+  next edge, registered again in every block RAM
+  (:class:`~rvsm.rtl.fpga.ecp5_memory.Ecp5BlockRam`) as its own enable, so no control
+  net runs from one register to all block RAMs; the generic build ignores it.
 * **Initial contents.** ``init_word``: every word's value at configuration (block-RAM
   initialisation; 0 by default). No reset reloads it.
 * **ECP5 block RAMs.** Elaborated for ``platform=ECP5_PLATFORM``
@@ -53,18 +50,13 @@ from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM, Ecp5BlockRam
 
 __all__ = ["BankedMemory"]
 
-#: Suffixes of the inputs one edge ahead: the value if this cycle advances, if it holds.
-_CASES = ("adv", "hold")
-
 
 class BankedMemory(wiring.Component):
     """``depth`` words of ``width`` bits in banks of ``bank_words``; see the module
     docstring for the ports ``advance``, ``read_addr``, ``read_bank``, ``write_en``,
     ``write_addr``, ``write_data``, ``data`` and the optional ``forward_hit``,
-    ``forward_data`` (``forward=True``), ``may_write`` (``guard_bits``), and the ECP5
-    build's inputs one edge ahead: ``advance_next`` and, each with the suffixes ``_adv``
-    and ``_hold``, ``read_addr``, ``write_en``, ``write_addr``, ``may_write``
-    (``guard_bits``)."""
+    ``forward_data`` (``forward=True``), ``may_write`` (``guard_bits``) and the ECP5
+    build's ``advance_next``."""
 
     def __init__(self, width: int, depth: int, bank_words: int, forward: bool = False,
                  guard_bits: int | None = None, init_word: int = 0,
@@ -95,15 +87,10 @@ class BankedMemory(wiring.Component):
             "data": Out(unsigned(width)),
             "advance_next": In(1),
         }
-        ahead = {"read_addr": addr, "write_en": 1, "write_addr": addr}
         if forward:
             members.update(forward_hit=In(1), forward_data=In(unsigned(width)))
         if guard_bits is not None:
             members["may_write"] = In(1)
-            ahead["may_write"] = 1
-        for name, shape in ahead.items():
-            for case in _CASES:
-                members[f"{name}_{case}"] = In(shape)
         super().__init__(members)
 
     def _offset(self, addr: Value) -> Value:
@@ -143,12 +130,7 @@ class BankedMemory(wiring.Component):
                 m.submodules[f"b{b}"] = ram
                 wr_addr, rd_addr = ram.write_addr, ram.read_addr
                 m.d.comb += [ram.write_en.eq(wr_en), ram.write_data.eq(self.write_data),
-                             ram.advance_next.eq(self.advance_next),
-                             ram.advance.eq(self.advance)]
-                for case in _CASES:
-                    m.d.comb += getattr(ram, f"collide_{case}_next").eq(self._collide(
-                        b, *(getattr(self, f"{name}_{case}", None) for name in (
-                            "write_en", "write_addr", "read_addr", "may_write"))))
+                             ram.advance_next.eq(self.advance_next)]
                 outs.append(ram.data)
             else:
                 mem = Memory(shape=unsigned(self.width), depth=depth,
