@@ -17,27 +17,43 @@ the byte enables), ``WRITEMODE`` ``NORMAL`` (port A's own read data is unused), 
 selects and resets tied off, ``GSR`` disabled, the initial contents in ``INITVAL_00`` ..
 ``INITVAL_3F`` (16 words of 18 bits per 320-bit value, each in a 20-bit slot, the layout
 of yosys' own ``brams_map_16kd.v``). A read and a write of the same address at one edge
-(through the two ports) give undefined read data: the user gates the read enable then,
-as ``BankedMemory`` does. Only the 18-bit configuration is used: a bank of at most 1024
+(through the two ports) give undefined read data, which the user must not use
+(below). Only the 18-bit configuration is used: a bank of at most 1024
 words (``StreamGeometry.BANK_WORDS``); shallower banks waste the rest (the 36-bit
 pseudo-dual-port mode would halve the primitives at 512 words, but its data order is
 not pinned down by the open tools' sources, so it is not used).
 
 Cycle behaviour, equal to a generic synchronous read port with enable followed by a
-register with enable: at an edge where ``read_en`` is high the word at ``read_addr`` is
-latched; at an edge where ``out_en`` is high the latched word moves to ``data``.
+register with enable, both enabled by ``advance``: at an edge where ``advance`` the word
+at ``read_addr`` is latched and the latched word moves to ``data``. ``advance`` is given
+**one edge ahead** (``advance_next``: the value it takes at the next edge) and
+registered inside, per primitive, in a flip-flop instantiated as ``TRELLIS_FF``
+(:func:`kept_register`; yosys does not merge instances, so every copy survives) that
+drives the primitive's CEB and OCEB directly: no logic between a register and a block
+RAM's enables, and no control net from one register to every block RAM of the device
+(the critical path at 64x64, P = 8: 8.4-10.3 ns of it routing).
+
+**Collisions.** A read of the word the other port writes at the same edge is not gated
+off here (gating it put the collision logic between the enable registers and the block
+RAMs: 7.5 ns at P = 8): its data is undefined on the device, and the array never uses
+it (a threshold read meeting the registered write is replaced by the forwarded word, a
+valid accumulator read never meets the write-back, a read of another bank's word is
+discarded by the bank multiplexer). This assumes, as for block RAMs generally, that such
+a collision leaves the written word intact and only the read data undefined. The
+generic memories of simulation and ``rvsm verilog`` keep the gating (yosys needs it to
+map them without read-first emulation).
 """
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, ClockSignal, Const, Instance, Module, Signal, unsigned
+from amaranth.hdl import Cat, ClockSignal, Const, Instance, Module, Signal, Value, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from rvsm.model.infra.errors import RvsmError
 
 __all__ = ["DP16KD_DEPTH", "DP16KD_WIDTH", "ECP5_PLATFORM", "Ecp5BlockRam", "dp16kd_count",
-           "initval"]
+           "initval", "kept_register"]
 
 #: The ``platform`` value that makes :class:`~rvsm.rtl.stream.banked_memory.BankedMemory`
 #: elaborate :class:`Ecp5BlockRam` banks (``verilog.convert(..., platform=ECP5_PLATFORM)``).
@@ -68,14 +84,28 @@ def initval(words: list[int]) -> dict[str, Const]:
     return params
 
 
+def kept_register(m: Module, d: Value, name: str) -> Signal:
+    """A one-bit register ``q <= d`` at every ``sync`` edge (no reset, no enable) as a
+    ``TRELLIS_FF`` instance in ``m``: a cell yosys does not merge with an equivalent one
+    (``opt_merge`` merges only its internal cells), so each copy keeps its own placement.
+    Returns ``q``."""
+    q = Signal(name=name)
+    m.submodules[f"{name}_ff"] = Instance(
+        "TRELLIS_FF", p_GSR="DISABLED", p_CEMUX="1", p_CLKMUX="CLK", p_LSRMUX="LSR",
+        p_REGSET="RESET", p_SRMODE="LSR_OVER_CE",
+        i_CLK=ClockSignal(), i_LSR=Const(0), i_CE=Const(1), i_DI=d, o_Q=q)
+    return q
+
+
 class Ecp5BlockRam(wiring.Component):
     """``depth`` (at most 1024) words of ``width`` bits in ``ceil(width / 18)`` DP16KD with
     the output register on (see the module docstring).
 
-    Ports: ``write_en``, ``write_addr``, ``write_data`` (port A); ``read_en``,
-    ``read_addr`` (port B, the read latch's clock enable), ``out_en`` (the output
-    register's clock enable) and ``data`` (the output register). ``init_word``: every
-    word's value at configuration.
+    Ports: ``write_en``, ``write_addr``, ``write_data`` (port A); ``read_addr`` (port
+    B); ``advance_next`` (the read and output registers' enable one edge ahead, module
+    docstring)
+    and ``data`` (the output register). ``init_word``: every word's value at
+    configuration.
     """
 
     def __init__(self, width: int, depth: int, init_word: int = 0):
@@ -90,7 +120,7 @@ class Ecp5BlockRam(wiring.Component):
         addr = unsigned(max(1, (depth - 1).bit_length()))
         super().__init__({
             "write_en": In(1), "write_addr": In(addr), "write_data": In(unsigned(width)),
-            "read_en": In(1), "read_addr": In(addr), "out_en": In(1),
+            "read_addr": In(addr), "advance_next": In(1),
             "data": Out(unsigned(width)),
         })
 
@@ -108,11 +138,13 @@ class Ecp5BlockRam(wiring.Component):
             do = Signal(unsigned(DP16KD_WIDTH), name=f"do{k}")
             di = Signal(unsigned(DP16KD_WIDTH), name=f"di{k}")
             m.d.comb += di.eq(self.write_data[lo:hi])
+            # this primitive's own registered enables (placed beside it)
+            adv = kept_register(m, self.advance_next, f"advance{k}")  # beside it
             ports: dict = {
                 "i_CLKA": ClockSignal(), "i_CLKB": ClockSignal(),
                 "i_CEA": self.write_en, "i_WEA": self.write_en, "i_OCEA": Const(0),
-                "i_RSTA": Const(0), "i_CEB": self.read_en, "i_WEB": Const(0),
-                "i_OCEB": self.out_en, "i_RSTB": Const(0),
+                "i_RSTA": Const(0), "i_CEB": adv, "i_WEB": Const(0),
+                "i_OCEB": adv, "i_RSTB": Const(0),
             }
             for p in ("A", "B"):
                 for c in range(3):

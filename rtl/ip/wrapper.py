@@ -4,17 +4,25 @@ One clock domain ``sync`` (synchronous reset ``rst``)::
 
     s_axis (video: P codes/beat, tuser = start of frame, tlast = end of line)
       -> input gate: tready = ~busy & (drop policy | credit_r)   [framing check]
-      -> RvsmStreamArray (codes, clear, thr)  <- flush beats, clear, threshold writes
+      -> input register (the beat or a flush beat, and clear)
+      -> RvsmStreamArray (codes, clear, thr)  <- threshold writes
       -> spikes beat (+ tuser, tlast) -> SyncFIFOBuffered(fifo_depth) -> m_axis
     s_axil -> AxiLiteRegisters(ip_register_map) <-> control, status, counters, THR_*
 
+**Input register.** What the gate lets through (an accepted beat, a flush beat, a
+clear) passes one register before the array's own input register: no path runs from
+the gate's control state (flush and clear requests, credit) to the array, whose input
+register may sit far from it (the IP's critical path at 150 MHz on the ECP5). It costs
+one cycle of release latency (:attr:`RvsmAxisIp.RELEASE_CYCLES`).
+
 **Policies** (``CONTROL.drop``). *Stall* (0, the reset value; replay from memory): the
-array has no output back-pressure and an output beat appears two cycles after the
-input beat that releases it, so the input is gated by credits, never by the FIFO's
-fullness: ``tready`` is high only in a cycle after one with ``level + r1 + v + 1 <
-fifo_depth`` (``level`` the FIFO's beats, ``r1`` a beat accepted in the previous cycle,
-``v`` the array's output that cycle; the credit is registered, so no path runs from the
-FIFO's level or ``m_axis_tready`` to ``s_axis_tready`` or the array's clock enable, and
+array has no output back-pressure and an output beat reaches the FIFO
+:attr:`RvsmAxisIp.IN_FLIGHT` cycles after the gate accepts the input beat that releases
+it, so the input is gated by credits, never by the FIFO's fullness: ``tready`` is high
+only in a cycle after one with ``level + r1 + r2 + v + 1 < fifo_depth`` (``level`` the
+FIFO's beats, ``r1`` and ``r2`` beats accepted one and two cycles before, in the input
+registers, ``v`` the array's output that cycle; the credit is registered, so no path
+runs from the FIFO's level or ``m_axis_tready`` to ``s_axis_tready`` or the array, and
 the ``+ 1`` covers the beat accepted meanwhile). Every beat in flight then finds room:
 no beat is lost, whatever the sink does. *Drop* (1; a live sensor, which cannot
 stall): ``tready`` stays high (except
@@ -74,19 +82,22 @@ class RvsmAxisIp(wiring.Component):
     properties below.
     """
 
-    #: Smallest output FIFO (beats): the credit rule needs room for the 3 beats that
-    #: can be in flight between the input gate and the FIFO.
+    #: Registers from the input gate to the FIFO's write: the IP's input register and
+    #: the array's input and output registers (cycles; beats in flight).
+    IN_FLIGHT = 3
+    #: Smallest output FIFO (beats) accepted.
     MIN_FIFO_DEPTH = 4
     #: Smallest output FIFO that takes a beat every cycle while the sink is always ready
-    #: (two beats in the FIFO, one in the array's output, one accepted the cycle before,
-    #: one accepted while the registered credit is formed).
-    FULL_RATE_DEPTH = 6
+    #: (two beats in the FIFO, IN_FLIGHT in flight, one accepted while the registered
+    #: credit is formed).
+    FULL_RATE_DEPTH = IN_FLIGHT + 4
     #: Default output FIFO depth (beats).
     FIFO_DEPTH = 16
     #: Cycles from the edge accepting a releasing input beat to the cycle its output is
-    #: offered on ``m_axis`` (FIFO empty): the array's input and output registers (2),
-    #: the FIFO write (1) and the FIFO's output register (1).
-    RELEASE_CYCLES = 4
+    #: offered on ``m_axis`` (FIFO empty): the IP's input register and the array's input
+    #: and output registers (IN_FLIGHT), the FIFO write (1) and the FIFO's output
+    #: register (1).
+    RELEASE_CYCLES = IN_FLIGHT + 2
 
     def __init__(self, contract: ArrayContract, lanes: int = 1,
                  fifo_depth: int = FIFO_DEPTH):
@@ -138,8 +149,8 @@ class RvsmAxisIp(wiring.Component):
     @property
     def latency(self) -> int:
         """Cycles from the edge accepting beat ``p + window_lag`` to ``p``'s output on
-        ``m_axis`` (beats back to back, FIFO empty): the array's latency plus the FIFO's
-        two cycles."""
+        ``m_axis`` (beats back to back, FIFO empty): the array's latency plus the IP's
+        input register and the FIFO's two cycles."""
         return self.geometry.latency + self.RELEASE_CYCLES - 2
 
     @property
@@ -161,11 +172,15 @@ class RvsmAxisIp(wiring.Component):
         flush_left = Signal(range(self.lag + 1), name="flush_left")
         drop_policy = regs.value["CONTROL.drop"]
         busy = init | flush_req | clear_req
-        r1 = Signal(name="accepted_r1")  # a beat entered the array in the previous cycle
+        if self.IN_FLIGHT != 3:
+            raise AssertionError("IN_FLIGHT counts the registers built here")
+        r1 = Signal(name="accepted_r1")  # the beat in the IP's input register
+        r2 = Signal(name="accepted_r2")  # the beat in the array's input register
         # room next cycle for every beat then in flight: registered (timing), with one
         # more beat of margin for the beat this cycle may accept
         credit_r = Signal(init=1, name="credit_r")
-        m.d.sync += credit_r.eq(fifo.level + r1 + arr.spikes.valid + 1 < self.fifo_depth)
+        m.d.sync += credit_r.eq(fifo.level + r1 + r2 + arr.spikes.valid + 1
+                                < self.fifo_depth)
         credit = drop_policy | credit_r
         s_in = self.s_axis
         m.d.comb += s_in.tready.eq(~busy & credit)
@@ -174,10 +189,13 @@ class RvsmAxisIp(wiring.Component):
         clear_now = ~init & ~flush_req & clear_req
         lane_bits = video_lane_bits(n)
         codes = Cat(*(s_in.tdata[i * lane_bits:i * lane_bits + n] for i in range(p)))
-        m.d.comb += [arr.codes.valid.eq(fire | inject),
-                     arr.codes.payload.as_value().eq(Mux(inject, 0, codes)),
-                     arr.clear.eq(clear_now)]
-        m.d.sync += r1.eq(fire | inject)
+        # the input register (module docstring): r1 is its valid bit
+        in_codes = Signal(len(codes), name="in_codes_r", reset_less=True)
+        in_clear = Signal(name="in_clear_r")
+        m.d.sync += [r1.eq(fire | inject), r2.eq(r1), in_clear.eq(clear_now),
+                     in_codes.eq(Mux(inject, 0, codes))]
+        m.d.comb += [arr.codes.valid.eq(r1), arr.codes.payload.as_value().eq(in_codes),
+                     arr.clear.eq(in_clear)]
 
         # flush and clear requests (CONTROL pulses, the cycle after the write)
         with m.If(regs.pulse["CONTROL.flush"] & ~flush_req):

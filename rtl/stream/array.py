@@ -119,10 +119,12 @@ class _Centre:
 
 @dataclass(frozen=True)
 class _Tail:
-    """What the state memories and the tail need from the position pipeline."""
+    """What the state memories and the tail need from the position pipeline
+    (``rd_addr_next``: the value ``rd_addr`` takes at the next edge if this cycle
+    advances, and if it does not)."""
 
     rd_addr: Value
-    rd_addr_next: Value
+    rd_addr_next: tuple[Value, Value]
     rd_valid: Value
     bank_q: Value
     fresh_q: Value
@@ -242,21 +244,23 @@ class RvsmStreamArray(wiring.Component):
         """Input register, line buffer, window, masks, sums, state memories, output
         register: one method per stage group, in datapath order."""
         m = Module()
-        advance, clear, codes_in = self._input_register(m)
+        advance, advance_next, clear, codes_in = self._input_register(m)
         slabs = self._line_buffer(m, advance, clear, codes_in)
         centre = self._window_centre(m, advance, clear)
         pipe = Pipeline(m, advance, self.geometry.LEVELS_PER_STAGE, name="sum")
         sums, stage_q = self._window_sums(pipe, slabs, centre)
         tail = self._position_pipeline(m, pipe, advance, clear, centre, stage_q)
-        lanes, thr_memories = self._state_and_output(m, advance, sums, tail)
+        lanes, thr_memories = self._state_and_output(m, advance, advance_next, sums, tail)
         self.probes = StreamProbes(advance, clear, tail.rd_addr, advance & tail.rd_valid,
                                    tail.wr_en, tail.wr_addr, lanes, thr_memories)
         pipe.emit()
         return m
 
-    def _input_register(self, m: Module) -> tuple[Signal, Signal, Signal]:
-        """``(advance, clear_r, codes_r)``: an accepted beat (and clear) acts one cycle
-        later, so no combinational path runs from the ports into the datapath. Datapath
+    def _input_register(self, m: Module) -> tuple[Signal, Value, Signal, Signal]:
+        """``(advance, advance_next, clear_r, codes_r)``: an accepted beat (and clear)
+        acts one cycle later, so no combinational path runs from the ports into the
+        datapath (``advance_next``, the value ``advance`` takes at the next edge, feeds
+        only the ECP5 block RAMs' own enable registers). Datapath
         registers are reset-less (only control state and valid bits are reset): less
         reset fan-out, and no next-state logic of the datapath depends on ``rst``."""
         p, n = self.geometry.lanes, self.contract.adc_bits
@@ -270,7 +274,7 @@ class RvsmStreamArray(wiring.Component):
         m.d.sync += [advance.eq(taken), clear.eq(self.clear)]
         with m.If(self.codes.valid & ~self.clear):
             m.d.sync += codes_in.eq(self.codes.payload.as_value())
-        return advance, clear, codes_in
+        return advance, Mux(ResetSignal(), 0, taken), clear, codes_in
 
     def _line_buffer(self, m: Module, advance: Signal, clear: Signal, codes_in: Signal
                      ) -> list[Signal]:
@@ -407,7 +411,11 @@ class RvsmStreamArray(wiring.Component):
             lane = q % p
             code = src[(d * p + lane) * n:(d * p + lane + 1) * n]
             keep = row_ok[d] & col_ok[j] if (j < r or j >= p + r) else row_ok[d]
-            window[(d, j)] = pipe.register(pipe.timed(Mux(keep, code, 0), 0),
+            # an AND, not Mux(keep, code, 0): yosys maps the latter to the flip-flops'
+            # synchronous reset, which on the ECP5 has priority over the clock enable,
+            # so the reset became advance & ~keep, a path from the beat advance (64x64,
+            # P = 8: 7.27 ns); the AND leaves advance on the clock enable alone
+            window[(d, j)] = pipe.register(pipe.timed(code & keep.replicate(n), 0),
                                            name=f"win_r{d}_c{j}")
         sums, stage_q = geo.build_sums(pipe, window)
         if stage_q != geo.sum_stage:
@@ -434,11 +442,13 @@ class RvsmStreamArray(wiring.Component):
         group_t, last_t = pipe.timed(gc), pipe.timed(last0)
         read = geo.read_stage
         rd_addr = pipe.at(addr0, read).value
-        # the value rd_addr takes at the next edge (for comparators registered ahead)
+        # the value rd_addr takes at the next edge (for comparators registered ahead),
+        # if this cycle advances and if not: neither depends on advance
         if read == 0:  # rd_addr is the centre address itself (reset to 0)
-            rd_addr_next = Mux(ResetSignal(), 0, centre.next_addr)
+            same = Mux(ResetSignal(), 0, centre.next_addr)
+            rd_addr_next = (same, same)
         else:
-            rd_addr_next = Mux(advance, pipe.at(addr0, read - 1).value, rd_addr)
+            rd_addr_next = (pipe.at(addr0, read - 1).value, rd_addr)
         # the banks' output registers hold the read two edges on: select among them there
         bank_q = pipe.at(addr0, read + 2).value >> (geo.bank_words - 1).bit_length()
         fresh_q = pipe.at(fresh_t, stage_q).value
@@ -450,8 +460,8 @@ class RvsmStreamArray(wiring.Component):
         return _Tail(rd_addr, rd_addr_next, valid[read], bank_q, fresh_q, wr_addr, wr_en,
                      valid[tail], out_row, out_group, out_last)
 
-    def _state_and_output(self, m: Module, advance: Signal, sums: list[list[Timed]],
-                          tail: _Tail
+    def _state_and_output(self, m: Module, advance: Signal, advance_next: Value,
+                          sums: list[list[Timed]], tail: _Tail
                           ) -> tuple[list[list[dict[str, Value]]], list[BankedMemory]]:
         """Per scale the threshold and accumulator memories, then the tail: add,
         compare/saturate, fire/reset, write back; spikes and position on the output.
@@ -475,9 +485,16 @@ class RvsmStreamArray(wiring.Component):
         bus_scale = bus_addr[word_bits:]
         # bus_addr == rd_addr, registered: compared one edge ahead from the values both
         # take at that edge (the bus register loads every cycle), so no comparator sits
-        # between the read address and the block RAMs' read enables or the forwarding.
-        rd_match = Signal(name="thr_rd_match", init=1, reset_less=True)
-        m.d.sync += rd_match.eq(bus.addr[:word_bits] == tail.rd_addr_next)
+        # between the read address and the forwarding; compared for both values rd_addr
+        # may take and chosen after the edge by advance, registered: no path from
+        # advance (the clock enable of the whole pipeline) into the comparator.
+        matches = [Signal(name=f"thr_rd_match_{case}", init=1, reset_less=True)
+                   for case in ("adv", "hold")]
+        advanced = Signal(name="advanced", reset_less=True)
+        m.d.sync += [*(match.eq(bus.addr[:word_bits] == addr)
+                       for match, addr in zip(matches, tail.rd_addr_next, strict=True)),
+                     advanced.eq(advance)]
+        rd_match = Mux(advanced, *matches)
         fwd_data = [Signal.like(bus.data, name=f"thr_fwd{k}_data", reset_less=True)
                     for k in (1, 2)]  # shared by the scales
         with m.If(advance):
@@ -491,14 +508,14 @@ class RvsmStreamArray(wiring.Component):
             probes.append([])
             thr_mem = BankedMemory(p * tw, words, geo.bank_words, forward=True,
                                    init_word=top_threshold_word(tw, p),  # module docstring
-                                   same_addr=True, read_stages=geo.READ_STAGES)
+                                   read_stages=geo.READ_STAGES)
             m.submodules[f"thr_s{s}"] = thr_mem
             thr_memories.append(thr_mem)
             m.d.comb += [thr_mem.advance.eq(advance), thr_mem.read_addr.eq(rd_addr),
                          thr_mem.read_bank.eq(bank_q),
                          thr_mem.write_en.eq(bus_we & (bus_scale == s)),
                          thr_mem.write_addr.eq(bus_word), thr_mem.write_data.eq(bus_data),
-                         thr_mem.same_addr.eq(rd_match),
+                         thr_mem.advance_next.eq(advance_next),
                          thr_mem.forward_hit.eq(
                              bus_we & (bus_scale == s) & rd_match
                              if self.mutation != "stream.no_threshold_forwarding" else 0),
@@ -511,7 +528,8 @@ class RvsmStreamArray(wiring.Component):
             m.d.comb += [acc_mem.advance.eq(advance), acc_mem.read_addr.eq(rd_addr),
                          acc_mem.read_bank.eq(bank_q), acc_mem.write_en.eq(wr_en),
                          acc_mem.write_addr.eq(wr_addr), acc_mem.write_data.eq(after_flat),
-                         acc_mem.may_write.eq(tail.valid)]
+                         acc_mem.may_write.eq(tail.valid),
+                         acc_mem.advance_next.eq(advance_next)]
             acc_q = acc_mem.data
             for i in range(p):
                 fresh = fresh_q

@@ -14,16 +14,20 @@ array's beat advance), so stages count beats:
   as given; gate it with ``advance`` outside).
 * **Collisions.** A bank's read is disabled at an edge where the write port writes its
   address: the read data is then undefined (yosys needs no read-first bypass
-  multiplexer after the block RAM). Either such collisions never meet a valid read, or
+  multiplexer after the block RAM; the ECP5 build leaves such reads enabled and their
+  data unused, :mod:`rvsm.rtl.fpga.ecp5_memory`). Either such collisions never meet a valid read, or
   ``forward=True`` adds ``forward_hit`` / ``forward_data``: where ``forward_hit`` was set
   with the read address, ``data`` is ``forward_data`` (the forwarded word, delayed
   alike: two ``advance`` edges) instead of the read. ``guard_bits = k`` adds
   ``may_write`` and gates the read where ``may_write`` holds and the low ``k`` address
   bits match: a cheaper superset of the collisions, for a memory whose valid reads and
-  writes never match in those bits. ``same_addr=True`` adds ``same_addr``: the user's
-  own (e.g. registered) ``write_addr == read_addr``, used instead of the comparator in
-  the ECP5 build (the generic build keeps its comparator, from which yosys proves the
-  collisions harmless).
+  writes never match in those bits. The collision is a bank's: its word address
+  written meets its word address read, whichever bank the read is for (a read of
+  another bank's word is discarded after the bank registers, but is still a read).
+* **One edge ahead (ECP5 build).** ``advance_next``: the value ``advance`` takes at the
+  next edge, registered again in every block RAM
+  (:class:`~rvsm.rtl.fpga.ecp5_memory.Ecp5BlockRam`) as its own enable, so no control
+  net runs from one register to all block RAMs; the generic build ignores it.
 * **Initial contents.** ``init_word``: every word's value at configuration (block-RAM
   initialisation; 0 by default). No reset reloads it.
 * **ECP5 block RAMs.** Elaborated for ``platform=ECP5_PLATFORM``
@@ -37,7 +41,7 @@ array's beat advance), so stages count beats:
 
 from __future__ import annotations
 
-from amaranth.hdl import Const, Module, Mux, Shape, Signal, unsigned
+from amaranth.hdl import Const, Module, Mux, Shape, Signal, Value, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -51,12 +55,12 @@ class BankedMemory(wiring.Component):
     """``depth`` words of ``width`` bits in banks of ``bank_words``; see the module
     docstring for the ports ``advance``, ``read_addr``, ``read_bank``, ``write_en``,
     ``write_addr``, ``write_data``, ``data`` and the optional ``forward_hit``,
-    ``forward_data`` (``forward=True``), ``may_write`` (``guard_bits``) and ``same_addr``
-    (``same_addr=True``)."""
+    ``forward_data`` (``forward=True``), ``may_write`` (``guard_bits``) and the ECP5
+    build's ``advance_next``."""
 
     def __init__(self, width: int, depth: int, bank_words: int, forward: bool = False,
                  guard_bits: int | None = None, init_word: int = 0,
-                 same_addr: bool = False, read_stages: int = 2):
+                 read_stages: int = 2):
         if read_stages not in (2, 3):
             raise ValueError(f"read_stages must be 2 or 3, got {read_stages}")
         self.read_stages = read_stages
@@ -81,15 +85,36 @@ class BankedMemory(wiring.Component):
             "write_addr": In(addr),
             "write_data": In(unsigned(width)),
             "data": Out(unsigned(width)),
+            "advance_next": In(1),
         }
         if forward:
             members.update(forward_hit=In(1), forward_data=In(unsigned(width)))
         if guard_bits is not None:
             members["may_write"] = In(1)
-        if same_addr:
-            members["same_addr"] = In(1)
-        self.same_addr_input = same_addr
         super().__init__(members)
+
+    def _offset(self, addr: Value) -> Value:
+        """The word address inside a bank."""
+        return addr[:(self.bank_words - 1).bit_length()] if len(self.bank_sizes) > 1 \
+            else addr
+
+    def _hit(self, addr: Value, b: int) -> Value:
+        """``addr`` is in bank ``b``."""
+        if len(self.bank_sizes) == 1:
+            return Const(1)
+        return (addr >> (self.bank_words - 1).bit_length()) == b
+
+    def _collide(self, b: int, write_en: Value, write_addr: Value, read_addr: Value,
+                 may_write: Value | None) -> Value:
+        """Bank ``b``'s read must be disabled: its write port writes the word address it
+        reads, or with ``guard_bits`` the cheaper superset (``may_write`` and the low
+        address bits)."""
+        hit = self._hit(write_addr, b)
+        wr, rd = self._offset(write_addr), self._offset(read_addr)
+        if self.guard_bits is None:
+            return write_en & hit & (wr == rd)
+        k = min(self.guard_bits, len(rd))
+        return may_write & hit & (wr[:k] == rd[:k])
 
     def elaborate(self, platform: object) -> Module:
         """The banks, their read registers, the bank multiplexer and the forwarding."""
@@ -99,14 +124,13 @@ class BankedMemory(wiring.Component):
         outs, probes = [], []
         ecp5 = platform == ECP5_PLATFORM
         for b, depth in enumerate(self.bank_sizes):
-            hit = (self.write_addr >> offset_bits) == b if banked else Const(1)
-            wr_en = self.write_en & hit
+            wr_en = self.write_en & self._hit(self.write_addr, b)
             if ecp5:  # the bank register is the block RAM's output register
                 ram = Ecp5BlockRam(self.width, depth, self.init_word)
                 m.submodules[f"b{b}"] = ram
-                wr_addr, rd_addr, rd_en = ram.write_addr, ram.read_addr, ram.read_en
+                wr_addr, rd_addr = ram.write_addr, ram.read_addr
                 m.d.comb += [ram.write_en.eq(wr_en), ram.write_data.eq(self.write_data),
-                             ram.out_en.eq(self.advance)]
+                             ram.advance_next.eq(self.advance_next)]
                 outs.append(ram.data)
             else:
                 mem = Memory(shape=unsigned(self.width), depth=depth,
@@ -120,23 +144,16 @@ class BankedMemory(wiring.Component):
                                               else self.probe_addr)
                     probes.append(probe.data)
                 rp = mem.read_port()
-                wr_addr, rd_addr, rd_en = wp.addr, rp.addr, rp.en
+                wr_addr, rd_addr = wp.addr, rp.addr
+                collide = self._collide(b, self.write_en, self.write_addr, self.read_addr,
+                                        getattr(self, "may_write", None))
+                m.d.comb += rp.en.eq(self.advance & ~collide)
                 reg = Signal(unsigned(self.width), name=f"b{b}_q", reset_less=True)
                 with m.If(self.advance):
                     m.d.sync += reg.eq(rp.data)
                 outs.append(reg)
-            m.d.comb += [wr_addr.eq(self.write_addr[:offset_bits] if banked
-                                    else self.write_addr),
-                         rd_addr.eq(self.read_addr[:offset_bits] if banked
-                                    else self.read_addr)]
-            if ecp5 and self.same_addr_input:
-                collide = wr_en & self.same_addr
-            elif self.guard_bits is None:
-                collide = wr_en & (wr_addr == rd_addr)
-            else:
-                k = min(self.guard_bits, len(rd_addr))
-                collide = self.may_write & hit & (wr_addr[:k] == rd_addr[:k])
-            m.d.comb += rd_en.eq(self.advance & ~collide)
+            m.d.comb += [wr_addr.eq(self._offset(self.write_addr)),
+                         rd_addr.eq(self._offset(self.read_addr))]
         out = outs[-1]
         for b in range(len(outs) - 2, -1, -1):
             out = Mux(self.read_bank == b, outs[b], out)

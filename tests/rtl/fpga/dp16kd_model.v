@@ -7,7 +7,9 @@
 // zero, the initial contents from INITVAL_00..3F (word k of INITVAL_j in bits
 // [20k +: 18], address 16j + k: the layout of yosys' brams_map_16kd.v). A read of the
 // address the other port writes at the same edge gives X (undefined on the device), so
-// a design that lets such a read reach its outputs fails the comparison. Any other
+// a design that lets such a read reach its outputs fails the comparison; it also prints
+// a COLLISION line, so a read left ungated is seen even when its X never reaches an
+// output (a discarded read of another bank's word). Any other
 // configuration stops the simulation.
 `timescale 1ns / 1ps
 module DP16KD (
@@ -197,6 +199,8 @@ module DP16KD (
       $display("DP16KD model: port B writes, chip selects and resets are not modelled");
       $finish_and_return(2);
     end
+    if (CEB && CEA && WEA && ada[13:4] == adb[13:4])
+      $display("DP16KD model: COLLISION (a read meets a write of its address) %m");
     if (CEB)
       latch_b <= (CEA && WEA && ada[13:4] == adb[13:4]) ? 18'bx : mem[adb[13:4]];
     if (OCEB) out_b <= latch_b;
