@@ -33,7 +33,8 @@ __all__ = ["CHECK_ORDER", "CheckResult", "Counterexample", "FormalReport",
            "PropertyStatus", "available_checks", "run_checks"]
 
 #: Checks in the order they run (any other a harness registers runs after these).
-CHECK_ORDER = ("properties", "protocol", "state", "thresholds", "tail", "equivalence")
+CHECK_ORDER = ("properties", "protocol", "state", "thresholds", "tail", "equivalence",
+               "window", "sums", "composed")
 
 
 @dataclass(frozen=True)
