@@ -38,19 +38,23 @@ is the same expression of the same accepted beats.
 
 from __future__ import annotations
 
+import inspect
+import os
+
 from amaranth.asserts import AnySeq
 from amaranth.hdl import Array, Cat, Const, Module, Mux, Signal
 
 from rvsm.model.fixed.core import ArrayContract
 from rvsm.rtl.architecture import require_spike_sensor
-from rvsm.rtl.formal import ElaborateAfter, FormalHarness
+from rvsm.rtl.formal import ElaborateAfter, FormalHarness, Property
+from rvsm.rtl.linear_form import linear_form
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.array import RvsmArray, accumulator_index, receptive_taps
 from rvsm.rtl.receptive_sum import weighted_sum
 from rvsm.rtl.stream.array import RvsmStreamArray, StreamProbes
 from rvsm.rtl.stream.formal import StreamEquivalence, _StreamHarness
 from rvsm.rtl.stream.geometry import StreamGeometry
-from rvsm.rtl.stream.pipelined_sum import Pipeline
+from rvsm.rtl.stream.pipelined_sum import Pipeline, Timed
 
 __all__ = ["ComposedEquivalence", "StreamSumLemma", "StreamWindowLemma",
            "composed_equivalence", "sum_lemma", "window_lemma"]
@@ -115,16 +119,34 @@ class StreamWindowLemma(_StreamHarness):
         return m
 
 
+class _Unregistered(Pipeline):
+    """A :class:`Pipeline` whose registers are wires: the same adder trees, paired in the
+    same order at the same widths (stages are tracked as before), combinational."""
+
+    def register(self, t: Timed, name: str | None = None) -> Timed:
+        if t._next is None:
+            self.registers += 1
+            t._next = Timed(t.value, t.stage + 1, 0)
+        return t._next
+
+
 class StreamSumLemma(FormalHarness):
-    """``sums.stage_q``: the stream's sum circuit (:meth:`StreamGeometry.stage_q_sums`,
-    registers always loading) maps a window with zeros outside the array around a
-    position to the parallel array's sum of that position's pixel, ``Q - 1`` cycles
-    later, for every position, scale and lane: one ``(position, scale, lane)`` per
-    cycle (:attr:`schedule`), so that each solver query holds one sum (smtbmc assumes
-    the earlier cycles' assertions: the query of one cycle is one adder-tree
-    equivalence, not all of them at once)."""
+    """The sum lemma in two parts (docs/formal.md, "The compositional proof"):
+
+    * ``sums.retiming`` (the solver): the stream's sum circuit
+      (:meth:`StreamGeometry.stage_q_sums`, registers always loading) gives at stage Q
+      the same words as the same adder trees without their registers
+      (:class:`_Unregistered`) applied to the window ``Q - 1`` cycles earlier, for free
+      windows, every scale and lane: a comparison of one circuit with itself;
+    * ``sums.linear_forms`` (exact, in Python, :meth:`offline_failures`): for every
+      position, scale and lane, that register-free expression, with the window cells
+      outside the array at 0, and the parallel array's :func:`weighted_sum` over
+      :func:`receptive_taps` (the expression :class:`RvsmArray` builds) are the same
+      linear form in the pixels' codes modulo ``2**W`` (:func:`linear_form`).
+    """
 
     provable = False
+    offline_properties = ("sums.linear_forms",)
 
     def __init__(self, contract: ArrayContract, lanes: int = 1,
                  mutation: str | None = None) -> None:
@@ -132,23 +154,16 @@ class StreamSumLemma(FormalHarness):
         self.contract = contract
         self.geometry = StreamGeometry(contract, lanes)
         self.mutation = check_mutation(mutation, "stream")
-        geo = self.geometry
-        #: ``(position, scale, lane)`` whose window enters at cycle k (checked Q-1 later).
-        self.schedule = [(a, s, i) for a in range(geo.beats_per_frame)
-                         for s in range(contract.num_scales) for i in range(geo.lanes)]
-        #: Every scheduled window through the pipeline: ``Q - 1 + len(schedule)`` cycles.
-        self.depth = geo.sum_stage - 1 + len(self.schedule)
+        #: Every stage-Q output has a window ``Q - 1`` cycles before, plus one cycle.
+        self.depth = self.geometry.sum_stage + 1
         self.cover_depth = self.depth
 
     def elaborate(self, platform: object) -> Module:
         m = Module()
-        c, geo = self.contract, self.geometry
-        p, n, g_count, r = geo.lanes, c.adc_bits, geo.groups, geo.radius
-        h, w = c.height, c.width
+        geo, n = self.geometry, self.contract.adc_bits
         stage_q = geo.sum_stage
-        last = stage_q - 1 + len(self.schedule)
-        age = Signal(range(last + 1), name="age")  # the cycle, saturating
-        with m.If(age != last):
+        age = Signal(range(stage_q), name="age")  # the cycle, saturating at Q - 1
+        with m.If(age != stage_q - 1):
             m.d.sync += age.eq(age + 1)
         cells = geo.window_cells()
         codes = {}
@@ -156,14 +171,6 @@ class StreamSumLemma(FormalHarness):
             code = Signal(n, name=f"window_r{d}_c{j}")
             m.d.comb += code.eq(AnySeq(n))
             codes[(d, j)] = code
-        outside = [Cat(*[codes[(d, j)] for d, j in cells
-                         if not (0 <= a // g_count + d - r < h
-                                 and 0 <= (a % g_count) * p + j - r < w)])
-                   for a, _, _ in self.schedule]
-        self.check(m, "assume.padding", Cat(*[(age != k) | (cell == 0) for k, cell
-                                              in enumerate(outside)]).all(),
-                   "window cells outside the array around the scheduled position are 0",
-                   "assume")
         pipe = Pipeline(m, None, geo.LEVELS_PER_STAGE, name="sum")
         sums, _ = geo.stage_q_sums(pipe, {cell: pipe.timed(code, 1)
                                           for cell, code in codes.items()})
@@ -174,19 +181,73 @@ class StreamSumLemma(FormalHarness):
                        for cell in cells}
             m.d.sync += [delayed[cell].eq(then[cell]) for cell in cells]
             then = delayed
-        ok = []
-        for k, (a, s, i) in enumerate(self.schedule):
-            y, x = a // g_count, (a % g_count) * p + i
-            taps = receptive_taps(c, s, y, x)
-            expected = weighted_sum([then[(r + yy - y, r + i + xx - x)]
-                                     for (yy, xx), _ in taps],
-                                    [wt for _, wt in taps], *c.sum_range(s))
-            ok.append((age != stage_q - 1 + k)
-                      | (sums[i][s].value == expected.as_unsigned()))
-        self.check(m, "sums.stage_q", Cat(*ok).all(),
-                   "the stream's sum at stage Q is the parallel array's sum of the "
-                   "window's pixel (each position, scale and lane in turn)")
+        flat = _Unregistered(m, None, geo.LEVELS_PER_STAGE, name="flat")
+        direct, _ = geo.stage_q_sums(flat, {cell: flat.timed(code, 1)
+                                            for cell, code in then.items()})
+        same = Cat(*[sums[i][s].value == direct[i][s].value
+                     for i in range(geo.lanes) for s in range(self.contract.num_scales)])
+        self.check(m, "sums.retiming", (age != stage_q - 1) | same.all(),
+                   "the stream's sums at stage Q are its adder trees without registers "
+                   "applied to the window Q-1 cycles earlier (every scale and lane)")
+        frame = inspect.stack()[0]
+        self.properties.append(Property(
+            "sums.linear_forms", "assert", "without registers, with zeros outside the "
+            "array, the stream's sums are the parallel array's as linear forms in the "
+            "codes (every position, scale and lane; exact, checked in Python)",
+            f"{os.path.abspath(frame.filename)}:{frame.lineno}"))
         return m
+
+    def offline_failures(self) -> list[tuple[str, str]]:
+        """``sums.linear_forms``: ``(property, message)`` per position, scale and lane
+        whose stream and parallel sums differ as linear forms (none when it holds)."""
+        c, geo = self.contract, self.geometry
+        p, n, g_count, r = geo.lanes, c.adc_bits, geo.groups, geo.radius
+        h, w = c.height, c.width
+        m = Module()
+        cells = {cell: Signal(n, name=f"cell_r{cell[0]}_c{cell[1]}")
+                 for cell in geo.window_cells()}
+        pix = [[Signal(n, name=f"pix_y{y}_x{x}") for x in range(w)] for y in range(h)]
+        flat = _Unregistered(m, None, geo.LEVELS_PER_STAGE, name="flat")
+        direct, _ = geo.stage_q_sums(flat, {cell: flat.timed(code, 1)
+                                            for cell, code in cells.items()})
+        cell_leaf = {id(sig): cell for cell, sig in cells.items()}
+        pix_leaf = {id(pix[y][x]): (y, x) for y in range(h) for x in range(w)}
+        failures = []
+        for s in range(c.num_scales):
+            lo, hi = c.sum_range(s)
+            width = geo.sum_bits(s)
+            stream_form = [linear_form(direct[i][s].value, cell_leaf) for i in range(p)]
+            for a in range(geo.beats_per_frame):
+                for i in range(p):
+                    y, x = a // g_count, (a % g_count) * p + i
+                    taps = receptive_taps(c, s, y, x)
+                    par = linear_form(weighted_sum([pix[yy][xx] for (yy, xx), _ in taps],
+                                                   [wt for _, wt in taps], lo, hi),
+                                      pix_leaf)
+                    st = stream_form[i]
+                    # the window lemma's map: cell (d, j) holds pixel (y+d-r, x-i+j-r)
+                    coefs: dict[tuple[int, int], int] = {}
+                    for (d, j), coef in st.coefs.items():
+                        yy, xx = y + d - r, x - i + j - r
+                        if 0 <= yy < h and 0 <= xx < w:
+                            coefs[(yy, xx)] = coef
+                    where = f"scale {s}, position {a} (row {y}, column {x}), lane {i}"
+                    for name, f in (("stream", st), ("parallel", par)):
+                        if f.bits is not None and f.bits < width:
+                            failures.append(("sums.linear_forms", (
+                                f"{where}: the {name} sum is a linear form in the codes "
+                                f"modulo 2**{f.bits} only, not the sum's {width} bits")))
+                    if st.const != par.const:
+                        failures.append(("sums.linear_forms", (
+                            f"{where}: constant {st.const} in the stream's sum, "
+                            f"{par.const} in the parallel array's")))
+                    for pixel in sorted(set(coefs) | set(par.coefs)):
+                        cs, cp = coefs.get(pixel, 0), par.coefs.get(pixel, 0)
+                        if cs != cp:
+                            failures.append(("sums.linear_forms", (
+                                f"{where}: pixel {pixel} has weight {cs} in the stream's "
+                                f"sum, {cp} in the parallel array's")))
+        return failures
 
 
 class ComposedEquivalence(StreamEquivalence):

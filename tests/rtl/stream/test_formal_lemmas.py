@@ -1,7 +1,9 @@
 """The compositional equivalence checks (``window``, ``sums``, ``composed``): each holds
 on the shipped array at 3x4 with 2 lanes, each can fail (a padding bug breaks the window
-lemma, sums built from another model's kernels break the sum lemma, swapped lanes break
-the composed miter), and the composed miter's assumption leaves its cover reachable."""
+lemma, sums built from another model's kernels break the sum lemma's linear forms, a
+register-free tree that is not the pipeline's breaks its retiming part, swapped lanes
+break the composed miter), and the composed miter's assumption leaves its cover
+reachable."""
 
 from __future__ import annotations
 
@@ -34,7 +36,7 @@ def test_lemmas_are_registered_and_name_their_properties(formal_point):
     checks = get_architecture("stream").formal
     contract = _contract(formal_point)
     expected = {"window": (StreamWindowLemma, {"window.codes"}),
-                "sums": (StreamSumLemma, {"sums.stage_q"}),
+                "sums": (StreamSumLemma, {"sums.retiming", "sums.linear_forms"}),
                 "composed": (ComposedEquivalence, {
                     "equivalence.spikes", "equivalence.spikes_early",
                     "equivalence.accumulators", "equivalence.accumulators_early"})}
@@ -48,14 +50,59 @@ def test_lemmas_are_registered_and_name_their_properties(formal_point):
     assert "assume.sums" in assumes
 
 
-def test_sum_lemma_schedules_every_position_scale_and_lane(formal_point):
+def test_sum_lemma_covers_every_stage_q_output(formal_point):
     contract = _contract(formal_point)
-    geo = StreamGeometry(contract, 2)
     lemma = StreamSumLemma(contract, 2)
-    assert sorted(lemma.schedule) == sorted(
-        (a, s, i) for a in range(geo.beats_per_frame) for s in range(contract.num_scales)
-        for i in range(2))
-    assert lemma.depth == geo.sum_stage - 1 + len(lemma.schedule)
+    assert lemma.depth == StreamGeometry(contract, 2).sum_stage + 1
+    assert lemma.offline_properties == ("sums.linear_forms",)
+
+
+@pytest.mark.parametrize("model, size, lanes", [
+    ("dog2", (3, 4), 2), ("dog4", (3, 4), 2), ("dog4", (3, 6), 3), ("dog4", (3, 3), 1)])
+def test_sum_linear_forms_hold_on_the_shipped_sums(formal_point, model, size, lanes):
+    assert StreamSumLemma(_contract(formal_point, model, size=size), lanes
+                          ).offline_failures() == []
+
+
+def test_sum_linear_forms_catch_a_wrong_kernel(formal_point):
+    """The trees built from dog1's kernels are not the parallel array's gauss1 sums:
+    the message names the scale, position, lane and pixel."""
+    harness = StreamSumLemma(_contract(formal_point, "gauss1"), 2)
+    harness.geometry = StreamGeometry(_contract(formal_point, "dog1"), 2)
+    failures = harness.offline_failures()
+    assert failures and {name for name, _ in failures} == {"sums.linear_forms"}
+    assert failures[0][1].startswith("scale 0, position 0 (row 0, column 0), lane 0: "
+                                     "pixel (0, 0) has weight ")
+
+
+def test_sum_linear_forms_catch_a_wrong_tap(formal_point, monkeypatch):
+    """One parallel tap moved by a column (a seeded wrong tap) fails the comparison."""
+    import rvsm.rtl.stream.formal_lemmas as lemmas
+
+    real = lemmas.receptive_taps
+
+    def shifted(contract, scale, row, col):
+        taps = real(contract, scale, row, col)
+        (yy, xx), wt = taps[0]
+        return [((yy, (xx + 1) % contract.width), wt)] + taps[1:]
+
+    monkeypatch.setattr(lemmas, "receptive_taps", shifted)
+    failures = StreamSumLemma(_contract(formal_point), 2).offline_failures()
+    assert failures and all(name == "sums.linear_forms" for name, _ in failures)
+
+
+def test_sum_lemma_fails_before_the_solver(formal_point, tmp_path):
+    """A linear-form failure is the check's counterexample, with no sby run."""
+    from rvsm.sim.formal.report import _run_check
+
+    harness = StreamSumLemma(_contract(formal_point, "gauss1"), 2)
+    harness.geometry = StreamGeometry(_contract(formal_point, "dog1"), 2)
+    result = _run_check("sums", harness, "bmc", harness.depth, tmp_path, None, "yices",
+                        None)
+    assert result.status == "fail"
+    assert result.counterexample.property == "sums.linear_forms"
+    assert "pixel (0, 0)" in result.counterexample.description
+    assert not (tmp_path / "sums").exists()
 
 
 @pytest.mark.parametrize("kind", [
@@ -69,19 +116,33 @@ def test_lemma_holds_on_the_shipped_array(formal_point, tmp_path, kind):
 
 
 def test_sum_lemma_holds_on_the_shipped_sums(formal_point, tmp_path):
-    harness = StreamSumLemma(_contract(formal_point, "dog1"), 2)
+    harness = StreamSumLemma(_contract(formal_point, "dog4"), 2)
     result = run_sby(harness, tmp_path, mode="bmc", depth=harness.depth)
     assert result.status == "PASS", result.log.read_text()[-2000:]
 
 
-def test_sum_lemma_catches_wrong_sums(formal_point, tmp_path):
-    """The pipeline built from another model's kernel (dog1's centre-surround instead
-    of gauss1's single tap) is not the parallel array's sum."""
+def test_sum_retiming_catches_a_tree_that_is_not_the_pipeline(formal_point, tmp_path):
+    """The register-free side built from another model's trees differs from the
+    pipeline: ``sums.retiming`` fails (the solver part can fail too)."""
+    import rvsm.rtl.stream.formal_lemmas as lemmas
+
     harness = StreamSumLemma(_contract(formal_point, "gauss1"), 2)
-    harness.geometry = StreamGeometry(_contract(formal_point, "dog1"), 2)
+    other = StreamGeometry(_contract(formal_point, "dog1"), 2)
+
+    real = harness.geometry.stage_q_sums
+
+    def stage_q_sums(pipe, window):
+        if isinstance(pipe, lemmas._Unregistered):
+            window = {cell: window.get(cell, next(iter(window.values())))
+                      for cell in other.window_cells()}
+            sums, _ = other.build_sums(pipe, window)
+            return [[pipe.at(t, other.sum_stage) for t in lane] for lane in sums], 0
+        return real(pipe, window)
+
+    harness.geometry.stage_q_sums = stage_q_sums
     result = run_sby(harness, tmp_path, mode="bmc", depth=harness.depth)
     assert result.status == "FAIL"
-    assert _failing(harness, result) == {"sums.stage_q"}
+    assert _failing(harness, result) == {"sums.retiming"}
 
 
 @pytest.mark.parametrize("kind, mutation, broken", [
