@@ -66,6 +66,9 @@ class FormalHarness(Elaboratable):
 
     depth: int = 20
     provable: bool = False
+    #: Properties decided exactly in Python before the solver runs
+    #: (:meth:`offline_failures`), e.g. the stream's ``sums.linear_forms``.
+    offline_properties: tuple[str, ...] = ()
 
     def __init__(self) -> None:
         self.properties: list[Property] = []
@@ -83,6 +86,10 @@ class FormalHarness(Elaboratable):
         m.d.comb += statement(test, name, src_loc_at=1 + src_loc_at)
         if not any(p.name == name and p.kind == kind for p in self.properties):
             self.properties.append(Property(name, kind, description, src))
+
+    def offline_failures(self) -> list[tuple[str, str]]:
+        """``(property, message)`` for each failure of :attr:`offline_properties`."""
+        return []
 
     def statements(self) -> list[Property]:
         """Elaborate once (platform ``"formal"``) and list the properties."""

@@ -39,7 +39,20 @@ from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.pixel_cell import PixelCell
 from rvsm.rtl.receptive_sum import sum_width, weighted_sum
 
-__all__ = ["RvsmArray", "accumulator_index"]
+__all__ = ["RvsmArray", "accumulator_index", "receptive_taps"]
+
+
+def receptive_taps(contract: ArrayContract, scale: int, row: int, col: int
+                   ) -> list[tuple[tuple[int, int], int]]:
+    """The taps of accumulator ``(scale, row, col)``'s weighted sum, in the order its
+    adder network takes them (kernel rows, then columns): ``((y, x), weight)`` for every
+    non-zero weight over a pixel inside the array (padding drops the rest)."""
+    kernel = contract.weights[scale]
+    half = len(kernel) // 2
+    h, w = contract.height, contract.width
+    return [((row + di - half, col + dj - half), wt)
+            for di, krow in enumerate(kernel) for dj, wt in enumerate(krow)
+            if wt and 0 <= row + di - half < h and 0 <= col + dj - half < w]
 
 
 def accumulator_index(contract: ArrayContract, scale: int, row: int, col: int) -> int:
@@ -127,18 +140,13 @@ class RvsmArray(wiring.Component):
             m.d.sync += stage.eq(go if i == 0 else valid_pipe[i - 1])
         m.d.comb += self.valid.eq(valid_pipe[-1])
 
-        for s, kernel in enumerate(c.weights):
+        for s in range(c.num_scales):
             lo, hi = c.sum_range(s)
-            half = len(kernel) // 2
             for y in range(h):
                 for x in range(w):
-                    taps, wts = [], []
-                    for di, row in enumerate(kernel):
-                        for dj, wt in enumerate(row):
-                            yy, xx = y + di - half, x + dj - half
-                            if wt and 0 <= yy < h and 0 <= xx < w:
-                                taps.append(pix[yy][xx])
-                                wts.append(wt)
+                    pixels_weights = receptive_taps(c, s, y, x)
+                    taps = [pix[yy][xx] for (yy, xx), _ in pixels_weights]
+                    wts = [wt for _, wt in pixels_weights]
                     a = accumulator_index(c, s, y, x)
                     cell = PixelCell(sum_width(lo, hi), c.shift, c.accumulator_bits,
                                      c.signed, c.reset, self.mutation,

@@ -10,6 +10,7 @@ from rvsm.rtl.ports import port_map
 from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.drive import simulate
 from rvsm.rtl.stream.formal import PROPERTY_GROUPS, stream_check, stream_equivalence
+from rvsm.rtl.stream.formal_lemmas import composed_equivalence, sum_lemma, window_lemma
 from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, check_beats
 
@@ -100,5 +101,6 @@ STREAM = Architecture(
     compare=_compare,
     testbench="rvsm.sim.cosim.tb_stream",
     formal={**{group: stream_check(group) for group in PROPERTY_GROUPS},
-            "equivalence": stream_equivalence},
+            "equivalence": stream_equivalence, "window": window_lemma, "sums": sum_lemma,
+            "composed": composed_equivalence},
 )

@@ -134,6 +134,7 @@ class _Tail:
     row: Value
     group: Value
     last: Value
+    valid_at: list[Signal]  # the valid bit of every stage (0 .. the tail)
 
 
 @dataclass
@@ -158,6 +159,10 @@ class StreamProbes:
     acc_write_addr: Value
     lanes: list[list[dict[str, Value]]]
     threshold_memories: list[BankedMemory]
+    window: dict[tuple[int, int], Value]
+    window_valid: Value
+    sums: list[list[Value]]
+    sum_valid: Value
 
 
 class RvsmStreamArray(wiring.Component):
@@ -248,11 +253,16 @@ class RvsmStreamArray(wiring.Component):
         slabs = self._line_buffer(m, advance, clear, codes_in)
         centre = self._window_centre(m, advance, clear)
         pipe = Pipeline(m, advance, self.geometry.LEVELS_PER_STAGE, name="sum")
-        sums, stage_q = self._window_sums(pipe, slabs, centre)
+        window, sums, stage_q = self._window_sums(pipe, slabs, centre)
         tail = self._position_pipeline(m, pipe, advance, clear, centre, stage_q)
         lanes, thr_memories = self._state_and_output(m, advance, advance_next, sums, tail)
         self.probes = StreamProbes(advance, clear, tail.rd_addr, advance & tail.rd_valid,
-                                   tail.wr_en, tail.wr_addr, lanes, thr_memories)
+                                   tail.wr_en, tail.wr_addr, lanes, thr_memories,
+                                   {cell: t.value for cell, t in window.items()},
+                                   tail.valid_at[1],
+                                   [[lane[s].value for lane in sums]
+                                    for s in range(self.contract.num_scales)],
+                                   tail.valid_at[stage_q])
         pipe.emit()
         return m
 
@@ -398,9 +408,9 @@ class RvsmStreamArray(wiring.Component):
         return _Centre(valid0, yc, gc, ac, fresh0, last0, row_ok, col_ok, na)
 
     def _window_sums(self, pipe: Pipeline, slabs: list[Signal], centre: _Centre
-                     ) -> tuple[list[list[Timed]], int]:
+                     ) -> tuple[dict[tuple[int, int], Timed], list[list[Timed]], int]:
         """The masked window (stage 1) and every lane's per-scale sums at stage Q:
-        ``(sums[lane][scale], Q)``."""
+        ``(window, sums[lane][scale], Q)``."""
         geo = self.geometry
         n, p, r, e = self.contract.adc_bits, geo.lanes, geo.radius, geo.edge_groups
         row_ok, col_ok = centre.row_ok, centre.col_ok
@@ -417,11 +427,8 @@ class RvsmStreamArray(wiring.Component):
             # P = 8: 7.27 ns); the AND leaves advance on the clock enable alone
             window[(d, j)] = pipe.register(pipe.timed(code & keep.replicate(n), 0),
                                            name=f"win_r{d}_c{j}")
-        sums, stage_q = geo.build_sums(pipe, window)
-        if stage_q != geo.sum_stage:
-            raise AssertionError("planned and built sum stages differ")
-        sums = [[pipe.at(t, stage_q) for t in lane] for lane in sums]
-        return sums, stage_q
+        sums, stage_q = geo.stage_q_sums(pipe, window)
+        return window, sums, stage_q
 
     def _position_pipeline(self, m: Module, pipe: Pipeline, advance: Signal, clear: Signal,
                            centre: _Centre, stage_q: int) -> _Tail:
@@ -458,7 +465,7 @@ class RvsmStreamArray(wiring.Component):
         out_last = pipe.at(last_t, tail).value
         wr_en = advance & valid[tail]
         return _Tail(rd_addr, rd_addr_next, valid[read], bank_q, fresh_q, wr_addr, wr_en,
-                     valid[tail], out_row, out_group, out_last)
+                     valid[tail], out_row, out_group, out_last, valid)
 
     def _state_and_output(self, m: Module, advance: Signal, advance_next: Value,
                           sums: list[list[Timed]], tail: _Tail

@@ -191,3 +191,13 @@ class StreamGeometry:
                          for s in range(c.num_scales)])
         stage = max([self.READ_STAGES] + [t.stage for lane in sums for t in lane])
         return sums, stage
+
+    def stage_q_sums(self, pipe: Pipeline, window: Mapping[tuple[int, int], Timed]
+                     ) -> tuple[list[list[Timed]], int]:
+        """:meth:`build_sums` with every sum delayed to the common stage Q
+        (:attr:`sum_stage`): ``(sums[lane][scale], Q)``, what the array adds to its
+        accumulators (the formal lemma ``sums`` checks this very circuit)."""
+        sums, stage_q = self.build_sums(pipe, window)
+        if stage_q != self.sum_stage:
+            raise AssertionError("planned and built sum stages differ")
+        return [[pipe.at(t, stage_q) for t in lane] for lane in sums], stage_q

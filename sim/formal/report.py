@@ -13,6 +13,7 @@ step and the VCD of the trace, copied into ``workdir`` (``<check>.counterexample
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import shutil
 import time
@@ -33,7 +34,8 @@ __all__ = ["CHECK_ORDER", "CheckResult", "Counterexample", "FormalReport",
            "PropertyStatus", "available_checks", "run_checks"]
 
 #: Checks in the order they run (any other a harness registers runs after these).
-CHECK_ORDER = ("properties", "protocol", "state", "thresholds", "tail", "equivalence")
+CHECK_ORDER = ("properties", "protocol", "state", "thresholds", "tail", "equivalence",
+               "window", "sums", "composed")
 
 
 @dataclass(frozen=True)
@@ -205,6 +207,32 @@ def _run_check(name: str, harness: FormalHarness, mode: str, depth: int, root: P
                progress: Callable[[str], None] | None) -> CheckResult:
     started = time.perf_counter()
     props = harness.statements()
+    offline = harness.offline_failures()
+    if offline:  # decided in Python: no solver run
+        names = [name for name, _ in offline]
+        asserts = [p for p in props if p.kind == "assert"]
+        first = next(p for p in asserts if p.name == names[0])
+        more = f" (and {len(offline) - 1} more)" if len(offline) > 1 else ""
+        return CheckResult(
+            name, mode, depth, "fail", time.perf_counter() - started,
+            [_status(p, "failed" if p.name in names else "not checked", None)
+             for p in asserts],
+            Counterexample(first.name, first.src, None, None,
+                           f"{offline[0][1]}{more}"),
+            root / name / "formal.log", "; ".join(msg for _, msg in offline[:3]))
+    result = _run_solver(name, harness, props, mode, depth, root, timeout, solver,
+                         progress, started)
+    if result.status != "pass" or mode == "cover" or not harness.offline_properties:
+        return result
+    return dataclasses.replace(result, properties=[
+        _status(p, "proven", None) if p.name in harness.offline_properties else s
+        for p, s in zip([p for p in props if p.kind == "assert"], result.properties,
+                        strict=True)])
+
+
+def _run_solver(name: str, harness: FormalHarness, props: list[Property], mode: str,
+                depth: int, root: Path, timeout: float | None, solver: str,
+                progress: Callable[[str], None] | None, started: float) -> CheckResult:
     try:
         sby = run_sby(harness, root / name, mode=mode, depth=depth, name="formal",
                       timeout=timeout, solver=solver,

@@ -39,7 +39,7 @@ def _contract(point, model: str = "dog2", reset: str = "subtract", size=(3, 4)):
 
 def test_every_check_is_registered(formal_point):
     checks = get_architecture("stream").formal
-    assert set(checks) == {*PROPERTY_GROUPS, "equivalence"}
+    assert set(checks) == {*PROPERTY_GROUPS, "equivalence", "window", "sums", "composed"}
     contract = _contract(formal_point)
     for group in PROPERTY_GROUPS:
         harness = checks[group](contract, mutation=None, lanes=2)
