@@ -84,16 +84,18 @@ def initval(words: list[int]) -> dict[str, Const]:
     return params
 
 
-def kept_register(m: Module, d: Value, name: str) -> Signal:
-    """A one-bit register ``q <= d`` at every ``sync`` edge (no reset, no enable) as a
-    ``TRELLIS_FF`` instance in ``m``: a cell yosys does not merge with an equivalent one
-    (``opt_merge`` merges only its internal cells), so each copy keeps its own placement.
-    Returns ``q``."""
+def kept_register(m: Module, d: Value, name: str, en: Value | None = None) -> Signal:
+    """A one-bit register ``q <= d`` at every ``sync`` edge (or at edges where ``en``:
+    the flip-flop's own clock enable, ``CEMUX = "CE"``; no reset, 0 at configuration) as
+    a ``TRELLIS_FF`` instance in ``m``: a cell yosys does not merge with an equivalent
+    one (``opt_merge`` merges only its internal cells), so each copy keeps its own
+    placement. Returns ``q``."""
     q = Signal(name=name)
     m.submodules[f"{name}_ff"] = Instance(
-        "TRELLIS_FF", p_GSR="DISABLED", p_CEMUX="1", p_CLKMUX="CLK", p_LSRMUX="LSR",
-        p_REGSET="RESET", p_SRMODE="LSR_OVER_CE",
-        i_CLK=ClockSignal(), i_LSR=Const(0), i_CE=Const(1), i_DI=d, o_Q=q)
+        "TRELLIS_FF", p_GSR="DISABLED", p_CEMUX="1" if en is None else "CE",
+        p_CLKMUX="CLK", p_LSRMUX="LSR", p_REGSET="RESET", p_SRMODE="LSR_OVER_CE",
+        i_CLK=ClockSignal(), i_LSR=Const(0), i_CE=Const(1) if en is None else en,
+        i_DI=d, o_Q=q)
     return q
 
 
@@ -105,16 +107,20 @@ class Ecp5BlockRam(wiring.Component):
     B); ``advance_next`` (the read and output registers' enable one edge ahead, module
     docstring)
     and ``data`` (the output register). ``init_word``: every word's value at
-    configuration.
+    configuration. ``write_ahead=True`` adds ``write_en_next``: the write enable one
+    edge ahead, registered per primitive (:func:`kept_register`) and ANDed with
+    ``write_en`` (then a bank select, constant 1 for a single bank).
     """
 
-    def __init__(self, width: int, depth: int, init_word: int = 0):
+    def __init__(self, width: int, depth: int, init_word: int = 0,
+                 write_ahead: bool = False):
         if not 1 <= depth <= DP16KD_DEPTH:
             raise RvsmError(f"an ECP5 block-RAM bank holds 1..{DP16KD_DEPTH} words (banks "
                             f"of at most {DP16KD_DEPTH} words), got {depth}")
         if width < 1:
             raise RvsmError(f"word width must be >= 1 bit, got {width}")
         self.width, self.depth, self.init_word = width, depth, init_word
+        self.write_ahead = write_ahead
         #: Primitives side by side (DP16KD).
         self.primitives = dp16kd_count(width)
         addr = unsigned(max(1, (depth - 1).bit_length()))
@@ -122,6 +128,7 @@ class Ecp5BlockRam(wiring.Component):
             "write_en": In(1), "write_addr": In(addr), "write_data": In(unsigned(width)),
             "read_addr": In(addr), "advance_next": In(1),
             "data": Out(unsigned(width)),
+            **({"write_en_next": In(1)} if write_ahead else {}),
         })
 
     def elaborate(self, platform: object) -> Module:
@@ -140,9 +147,11 @@ class Ecp5BlockRam(wiring.Component):
             m.d.comb += di.eq(self.write_data[lo:hi])
             # this primitive's own registered enables (placed beside it)
             adv = kept_register(m, self.advance_next, f"advance{k}")  # beside it
+            we = (kept_register(m, self.write_en_next, f"write{k}") & self.write_en
+                  if self.write_ahead else self.write_en)
             ports: dict = {
                 "i_CLKA": ClockSignal(), "i_CLKB": ClockSignal(),
-                "i_CEA": self.write_en, "i_WEA": self.write_en, "i_OCEA": Const(0),
+                "i_CEA": we, "i_WEA": we, "i_OCEA": Const(0),
                 "i_RSTA": Const(0), "i_CEB": adv, "i_WEB": Const(0),
                 "i_OCEB": adv, "i_RSTB": Const(0),
             }

@@ -84,6 +84,7 @@ from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from rvsm.model.fixed.core import ArrayContract
+from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM, kept_register
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.stream.banked_memory import BankedMemory
 from rvsm.rtl.stream.geometry import StreamGeometry
@@ -121,15 +122,18 @@ class _Centre:
 class _Tail:
     """What the state memories and the tail need from the position pipeline
     (``rd_addr_next``: the value ``rd_addr`` takes at the next edge if this cycle
-    advances, and if it does not)."""
+    advances, and if it does not; ``fresh_prev``: ``fresh_q`` one stage before, for
+    copies of it; ``wr_valid_next``: the value ``valid`` takes at the next edge)."""
 
     rd_addr: Value
     rd_addr_next: tuple[Value, Value]
     rd_valid: Value
     bank_q: Value
     fresh_q: Value
+    fresh_prev: Value
     wr_addr: Value
     wr_en: Value
+    wr_valid_next: Value
     valid: Signal
     row: Value
     group: Value
@@ -255,7 +259,8 @@ class RvsmStreamArray(wiring.Component):
         pipe = Pipeline(m, advance, self.geometry.LEVELS_PER_STAGE, name="sum")
         window, sums, stage_q = self._window_sums(pipe, slabs, centre)
         tail = self._position_pipeline(m, pipe, advance, clear, centre, stage_q)
-        lanes, thr_memories = self._state_and_output(m, advance, advance_next, sums, tail)
+        lanes, thr_memories = self._state_and_output(m, advance, advance_next, sums, tail,
+                                                     ecp5=platform == ECP5_PLATFORM)
         self.probes = StreamProbes(advance, clear, tail.rd_addr, advance & tail.rd_valid,
                                    tail.wr_en, tail.wr_addr, lanes, thr_memories,
                                    {cell: t.value for cell, t in window.items()},
@@ -458,22 +463,35 @@ class RvsmStreamArray(wiring.Component):
             rd_addr_next = (pipe.at(addr0, read - 1).value, rd_addr)
         # the banks' output registers hold the read two edges on: select among them there
         bank_q = pipe.at(addr0, read + 2).value >> (geo.bank_words - 1).bit_length()
+        fresh_prev = pipe.at(fresh_t, stage_q - 1).value
         fresh_q = pipe.at(fresh_t, stage_q).value
         tail = stage_q + geo.TAIL_STAGES - 1  # the stage that writes back
         wr_addr = pipe.at(addr0, tail).value
         out_row, out_group = pipe.at(row_t, tail).value, pipe.at(group_t, tail).value
         out_last = pipe.at(last_t, tail).value
         wr_en = advance & valid[tail]
-        return _Tail(rd_addr, rd_addr_next, valid[read], bank_q, fresh_q, wr_addr, wr_en,
-                     valid[tail], out_row, out_group, out_last, valid)
+        # valid[tail] at the next edge (its reset, clear and advance above)
+        wr_valid_next = Mux(ResetSignal() | clear, 0,
+                            Mux(advance, valid[tail - 1], valid[tail]))
+        return _Tail(rd_addr, rd_addr_next, valid[read], bank_q, fresh_q, fresh_prev,
+                     wr_addr, wr_en, wr_valid_next, valid[tail], out_row, out_group,
+                     out_last, valid)
 
     def _state_and_output(self, m: Module, advance: Signal, advance_next: Value,
-                          sums: list[list[Timed]], tail: _Tail
+                          sums: list[list[Timed]], tail: _Tail, ecp5: bool = False
                           ) -> tuple[list[list[dict[str, Value]]], list[BankedMemory]]:
         """Per scale the threshold and accumulator memories, then the tail: add,
         compare/saturate, fire/reset, write back; spikes and position on the output.
         Returns what :class:`StreamProbes` needs: the lanes' tail registers (per scale)
-        and the threshold memories."""
+        and the threshold memories.
+
+        ``ecp5`` (the ECP5 build): the accumulator block RAMs write where their own
+        registered copy of ``valid`` holds (``held_write``: a stalled write repeats the
+        same word to the same address, and the write of a clear edge lands in a word
+        the fresh frame after the clear reads as zero or captures, and overwrites), and
+        every scale and lane has its own copy of the fresh-frame flag (no net from one
+        register to the zero multiplexers of every accumulator-adder input); both are
+        :func:`~rvsm.rtl.fpga.ecp5_memory.kept_register` flip-flops."""
         c, geo = self.contract, self.geometry
         p, words, wa = geo.lanes, geo.beats_per_frame, c.accumulator_bits
         rd_addr, bank_q, fresh_q, wr_addr, wr_en = (tail.rd_addr, tail.bank_q, tail.fresh_q,
@@ -530,16 +548,20 @@ class RvsmStreamArray(wiring.Component):
             thr_q = thr_mem.data
             after_flat = Signal(unsigned(p * wa), name=f"acc_s{s}_wdata")
             acc_mem = BankedMemory(p * wa, words, geo.bank_words,
-                                   guard_bits=geo.rmw_guard_bits, read_stages=geo.READ_STAGES)
+                                   guard_bits=geo.rmw_guard_bits, read_stages=geo.READ_STAGES,
+                                   held_write=ecp5)
             m.submodules[f"acc_s{s}"] = acc_mem
             m.d.comb += [acc_mem.advance.eq(advance), acc_mem.read_addr.eq(rd_addr),
                          acc_mem.read_bank.eq(bank_q), acc_mem.write_en.eq(wr_en),
                          acc_mem.write_addr.eq(wr_addr), acc_mem.write_data.eq(after_flat),
                          acc_mem.may_write.eq(tail.valid),
                          acc_mem.advance_next.eq(advance_next)]
+            if ecp5:
+                m.d.comb += acc_mem.write_en_next.eq(tail.wr_valid_next)
             acc_q = acc_mem.data
             for i in range(p):
-                fresh = fresh_q
+                fresh = (kept_register(m, tail.fresh_prev, f"fresh_s{s}_l{i}", en=advance)
+                         if ecp5 else fresh_q)
                 if self.mutation == "stream.clear_forgets_scale0" and s == 0:
                     fresh = 0  # the first frame after a clear reads scale 0's old state
                 acc = Mux(fresh, 0, acc_q[i * wa:(i + 1) * wa].as_signed())

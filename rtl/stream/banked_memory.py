@@ -28,6 +28,14 @@ array's beat advance), so stages count beats:
   next edge, registered again in every block RAM
   (:class:`~rvsm.rtl.fpga.ecp5_memory.Ecp5BlockRam`) as its own enable, so no control
   net runs from one register to all block RAMs; the generic build ignores it.
+  ``held_write=True`` adds ``write_en_next``: a write enable that may stay high through
+  cycles without ``advance`` (the caller's ``valid`` alone, where a held write repeats
+  the same word to the same address), given one edge ahead and registered per block
+  RAM; the ECP5 build writes where it holds (and the bank matches), the generic build
+  where ``write_en`` holds. The caller must keep the write address and data constant
+  while ``advance`` is low, and read nothing that a write outside ``advance`` edges
+  changes (the array: the write of a clear edge lands in a word the fresh frame
+  after the clear reads as zero and overwrites).
 * **Initial contents.** ``init_word``: every word's value at configuration (block-RAM
   initialisation; 0 by default). No reset reloads it.
 * **ECP5 block RAMs.** Elaborated for ``platform=ECP5_PLATFORM``
@@ -56,11 +64,11 @@ class BankedMemory(wiring.Component):
     docstring for the ports ``advance``, ``read_addr``, ``read_bank``, ``write_en``,
     ``write_addr``, ``write_data``, ``data`` and the optional ``forward_hit``,
     ``forward_data`` (``forward=True``), ``may_write`` (``guard_bits``) and the ECP5
-    build's ``advance_next``."""
+    build's ``advance_next`` and ``write_en_next`` (``held_write=True``)."""
 
     def __init__(self, width: int, depth: int, bank_words: int, forward: bool = False,
                  guard_bits: int | None = None, init_word: int = 0,
-                 read_stages: int = 2):
+                 read_stages: int = 2, held_write: bool = False):
         if read_stages not in (2, 3):
             raise ValueError(f"read_stages must be 2 or 3, got {read_stages}")
         self.read_stages = read_stages
@@ -71,6 +79,7 @@ class BankedMemory(wiring.Component):
         self.bank_sizes = [min(bank_words, depth - i) for i in range(0, depth, bank_words)]
         self.guard_bits = guard_bits
         self.forward = forward
+        self.held_write = held_write
         addr = Shape.cast(range(depth))
         #: Formal observation (driven only when elaborated for the ``"formal"``
         #: platform, never in a user's Verilog): ``probe_data`` is the word at
@@ -91,6 +100,8 @@ class BankedMemory(wiring.Component):
             members.update(forward_hit=In(1), forward_data=In(unsigned(width)))
         if guard_bits is not None:
             members["may_write"] = In(1)
+        if held_write:
+            members["write_en_next"] = In(1)
         super().__init__(members)
 
     def _offset(self, addr: Value) -> Value:
@@ -126,10 +137,16 @@ class BankedMemory(wiring.Component):
         for b, depth in enumerate(self.bank_sizes):
             wr_en = self.write_en & self._hit(self.write_addr, b)
             if ecp5:  # the bank register is the block RAM's output register
-                ram = Ecp5BlockRam(self.width, depth, self.init_word)
+                ram = Ecp5BlockRam(self.width, depth, self.init_word,
+                                   write_ahead=self.held_write)
                 m.submodules[f"b{b}"] = ram
                 wr_addr, rd_addr = ram.write_addr, ram.read_addr
-                m.d.comb += [ram.write_en.eq(wr_en), ram.write_data.eq(self.write_data),
+                if self.held_write:  # write_en_next registered per primitive, bank select
+                    m.d.comb += [ram.write_en.eq(self._hit(self.write_addr, b)),
+                                 ram.write_en_next.eq(self.write_en_next)]
+                else:
+                    m.d.comb += ram.write_en.eq(wr_en)
+                m.d.comb += [ram.write_data.eq(self.write_data),
                              ram.advance_next.eq(self.advance_next)]
                 outs.append(ram.data)
             else:

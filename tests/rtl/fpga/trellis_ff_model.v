@@ -1,10 +1,11 @@
 // A behavioural model of the ECP5 TRELLIS_FF in the one configuration the ECP5 build
 // instantiates (rvsm.rtl.fpga.ecp5_memory.kept_register): rising-edge clock, no clock
-// enable (CEMUX "1"), set/reset input tied low, GSR disabled: Q <= DI at every edge.
+// enable (CEMUX "1") or CE high (CEMUX "CE"), set/reset input tied low, GSR disabled
+// (0 at configuration, as REGSET "RESET" on the device): Q <= DI at every enabled edge.
 // yosys' share/ecp5/cells_sim.v has the full model; this one keeps the Icarus bench
 // self-contained. Any other configuration stops the simulation.
 `timescale 1ns / 1ps
-module TRELLIS_FF (input CLK, LSR, CE, DI, M, output reg Q);
+module TRELLIS_FF (input CLK, LSR, CE, DI, M, output reg Q = 1'b0);
   parameter GSR = "ENABLED";
   parameter [127:0] CEMUX = "1";
   parameter CLKMUX = "CLK";
@@ -13,7 +14,7 @@ module TRELLIS_FF (input CLK, LSR, CE, DI, M, output reg Q);
   parameter REGSET = "RESET";
   parameter [127:0] LSRMODE = "LSR";
   initial begin
-    if (GSR != "DISABLED" || CEMUX != "1" || CLKMUX != "CLK" || REGSET != "RESET") begin
+    if (GSR != "DISABLED" || (CEMUX != "1" && CEMUX != "CE") || CLKMUX != "CLK" || REGSET != "RESET") begin
       $display("TRELLIS_FF model: unsupported configuration");
       $finish;
     end
@@ -23,6 +24,7 @@ module TRELLIS_FF (input CLK, LSR, CE, DI, M, output reg Q);
       $display("TRELLIS_FF model: LSR must be tied low");
       $finish;
     end
-    Q <= DI;
+    if (CEMUX == "1" || CE === 1'b1) Q <= DI;
+    else if (CE !== 1'b0) Q <= 1'bx;
   end
 endmodule
