@@ -8,12 +8,13 @@ a write whose strobe is not 0xF, a write to a register without a writable field,
 field value above its ``max`` and a write the IP refuses (``refuse``, sampled in the
 write's commit cycle). A refused write changes nothing.
 
-Latency (for timing: every decode starts and ends at flip-flops): a read's ``rvalid``
-rises two cycles after its AR handshake (the handshake registers a one-hot register
-select decoded from ``araddr``, the next edge the multiplexed ``rdata``; ``arready`` is
-low from the handshake until the R handshake); a write's ``bvalid`` rises two cycles
-after the later of its AW and W handshakes (a decode cycle registers the one-hot
-register select and per register "accepted", the next edge commits).
+Latency, the handshake's cycle counted 0 (for timing: every decode starts and ends at
+flip-flops): a read's ``rvalid`` is high from cycle 2 (the handshake registers a one-hot
+register select decoded from ``araddr``, the next edge the multiplexed ``rdata``;
+``arready`` is low from the handshake until the R handshake); a write's ``bvalid``
+from cycle 3 after the later of its AW and W handshakes (the handshakes register
+address and data, the next edge per register "this address, strobe 0xF, fields within
+``max``", the next commits).
 
 What the IP sees, per field of the map: ``RW`` fields are registers here (``value``),
 except ``external`` ones whose value the IP holds and drives (``value`` is then an
