@@ -3,10 +3,18 @@
 :class:`AxiLiteSignature` is the bus (32-bit data, byte addresses, the master's view:
 a slave takes ``In(AxiLiteSignature(...))``). :class:`AxiLiteRegisters` decodes it
 against the map: one transaction of each kind outstanding (a write and a read may
-overlap), AW and W in either order or together, a response the cycle after the
-transaction is taken; OKAY, or SLVERR for an unmapped address, a write whose strobe is
-not 0xF, a write to a register without a writable field, a field value above its
-``max`` and a write the IP refuses (``refuse``). A refused write changes nothing.
+overlap), AW and W in either order or together; OKAY, or SLVERR for an unmapped address,
+a write whose strobe is not 0xF, a write to a register without a writable field, a
+field value above its ``max`` and a write the IP refuses (``refuse``, sampled in the
+write's commit cycle). A refused write changes nothing.
+
+Latency, the handshake's cycle counted 0 (for timing: every decode starts and ends at
+flip-flops): a read's ``rvalid`` is high from cycle 2 (the handshake registers a one-hot
+register select decoded from ``araddr``, the next edge the multiplexed ``rdata``;
+``arready`` is low from the handshake until the R handshake); a write's ``bvalid``
+from cycle 3 after the later of its AW and W handshakes (the handshakes register
+address and data, the next edge per register "this address, strobe 0xF, fields within
+``max``", the next commits).
 
 What the IP sees, per field of the map: ``RW`` fields are registers here (``value``),
 except ``external`` ones whose value the IP holds and drives (``value`` is then an
@@ -19,11 +27,11 @@ with that write's data in ``wdata``.
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, Const, Module, Signal, unsigned
+from amaranth.hdl import Cat, Const, Module, Mux, Signal, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from rvsm.rtl.ip.register_map import Field, RegisterMap
+from rvsm.rtl.ip.register_map import Field, Register, RegisterMap
 
 __all__ = ["AxiLiteRegisters", "AxiLiteSignature", "RESP_OKAY", "RESP_SLVERR"]
 
@@ -118,6 +126,13 @@ class AxiLiteRegisters(wiring.Component):
         self._read_channel(m)
         return m
 
+    @staticmethod
+    def _decode(m: Module, addr: Signal, name: str, regs: list[Register]) -> Signal:
+        """One-hot (one bit per register of ``regs``), combinational: ``addr`` selects it."""
+        hit = Signal(len(regs), name=name)
+        m.d.comb += hit.eq(Cat(addr[2:] == r.offset >> 2 for r in regs))
+        return hit
+
     def _write_channel(self, m: Module) -> None:
         bus, rm = self.bus, self.regmap
         aw_have, w_have = Signal(name="aw_have"), Signal(name="w_have")
@@ -133,7 +148,19 @@ class AxiLiteRegisters(wiring.Component):
             m.d.sync += [w_have.eq(1), w_data.eq(bus.wdata), w_strb.eq(bus.wstrb)]
         with m.If(bvalid & bus.bready):
             m.d.sync += bvalid.eq(0)
-        go = aw_have & w_have & ~bvalid
+        # decode cycle: per writable register, "this address, strobe 0xF, every field
+        # within its max" registered (ok_r); the commit cycle (commit) writes
+        writable = [r for r in rm.registers if r.writable]
+        hit = self._decode(m, aw_addr, "aw_hit", writable)
+        ok = Signal(len(writable), name="w_ok_r")
+        decoded = Signal(name="w_decoded")
+        m.d.sync += decoded.eq(aw_have & w_have & ~bvalid & ~decoded)
+        for n, r in enumerate(writable):
+            good = hit[n] & (w_strb == 0xF)
+            for f in r.fields:
+                if f.max is not None and f.max < (1 << f.width) - 1:
+                    good = good & (w_data[f.lsb:f.lsb + f.width] <= f.max)
+            m.d.sync += ok[n].eq(good)
         # sticky fields: the IP's set pulses always land; a write of 1 clears
         clears = {k: Signal(len(v), name=f"{v.name}_clr") for k, v in self.value.items()
                   if k in self.set}
@@ -142,38 +169,39 @@ class AxiLiteRegisters(wiring.Component):
                 m.d.sync += v.eq((v & ~clears[k]) | self.set[k])
         for s in (*self.pulse.values(), *self.written.values()):
             m.d.sync += s.eq(0)
-        with m.If(go):
+        with m.If(decoded):  # the commit cycle
             m.d.sync += [aw_have.eq(0), w_have.eq(0), bvalid.eq(1), bresp.eq(RESP_SLVERR),
                          self.wdata.eq(w_data)]
-            writable = [r for r in rm.registers if r.writable]
-            for n, r in enumerate(writable):  # if/elif, not a case: no incomplete case
-                with (m.If if n == 0 else m.Elif)(aw_addr[2:] == r.offset >> 2):
-                    bad = (w_strb != 0xF) | self.refuse[r.name]
+            for n, r in enumerate(writable):
+                with m.If(ok[n] & ~self.refuse[r.name]):
+                    m.d.sync += [bresp.eq(RESP_OKAY), self.written[r.name].eq(1)]
                     for f in r.fields:
-                        if f.max is not None and f.max < (1 << f.width) - 1:
-                            bad = bad | (w_data[f.lsb:f.lsb + f.width] > f.max)
-                    with m.If(~bad):
-                        m.d.sync += [bresp.eq(RESP_OKAY), self.written[r.name].eq(1)]
-                        for f in r.fields:
-                            k, bits = _key(r.name, f), w_data[f.lsb:f.lsb + f.width]
-                            if f.access == "RW" and not f.external:
-                                m.d.sync += self.value[k].eq(bits)
-                            elif f.access == "WO":
-                                m.d.sync += self.pulse[k].eq(bits)
-                            elif f.access == "W1C":
-                                m.d.comb += clears[k].eq(bits)
+                        k, bits = _key(r.name, f), w_data[f.lsb:f.lsb + f.width]
+                        if f.access == "RW" and not f.external:
+                            m.d.sync += self.value[k].eq(bits)
+                        elif f.access == "WO":
+                            m.d.sync += self.pulse[k].eq(bits)
+                        elif f.access == "W1C":
+                            m.d.comb += clears[k].eq(bits)
 
     def _read_channel(self, m: Module) -> None:
         bus, rm = self.bus, self.regmap
+        regs = list(rm.registers)
+        ar_have = Signal(name="ar_have")
+        sel = Signal(len(regs), name="ar_sel_r", reset_less=True)
         rvalid = Signal(name="rvalid_r")
         rdata = Signal(32, name="rdata_r", reset_less=True)
         rresp = Signal(2, name="rresp_r")
-        m.d.comb += [bus.arready.eq(~rvalid), bus.rvalid.eq(rvalid), bus.rdata.eq(rdata),
-                     bus.rresp.eq(rresp)]
+        m.d.comb += [bus.arready.eq(~ar_have & ~rvalid), bus.rvalid.eq(rvalid),
+                     bus.rdata.eq(rdata), bus.rresp.eq(rresp)]
         with m.If(rvalid & bus.rready):
             m.d.sync += rvalid.eq(0)
-        with m.If(bus.arvalid & ~rvalid):
-            m.d.sync += [rvalid.eq(1), rdata.eq(0), rresp.eq(RESP_SLVERR)]
-            for n, r in enumerate(rm.registers):
-                with (m.If if n == 0 else m.Elif)(bus.araddr[2:] == r.offset >> 2):
-                    m.d.sync += [rdata.eq(self.read_value(r.name)), rresp.eq(RESP_OKAY)]
+        # AR handshake: register the one-hot select; next edge: AND-OR multiplexer
+        with m.If(bus.arvalid & bus.arready):
+            m.d.sync += [ar_have.eq(1), sel.eq(self._decode(m, bus.araddr, "ar_hit", regs))]
+        with m.If(ar_have):
+            data = Const(0, 32)
+            for n, r in enumerate(regs):
+                data = data | (self.read_value(r.name) & sel[n].replicate(32))
+            m.d.sync += [ar_have.eq(0), rvalid.eq(1), rdata.eq(data),
+                         rresp.eq(Mux(sel.any(), RESP_OKAY, RESP_SLVERR))]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from rvsm.rtl.ip.axi_lite import RESP_OKAY, AxiLiteRegisters
+from rvsm.rtl.ip.axi_lite import RESP_OKAY, RESP_SLVERR, AxiLiteRegisters
 from rvsm.rtl.ip.register_map import ip_register_map
 from rvsm.rtl.simulation import run_simulation
 from tests.conftest import model_contract
@@ -72,3 +72,54 @@ def test_write_channels_in_either_order_and_a_read_meanwhile() -> None:
     assert seen["w_first"] == seen["aw_first"] == seen["late_w"] == RESP_OKAY
     assert seen["read"] == (0x4, RESP_OKAY)
     assert seen["data0"] == 0x2AA and seen["drop"] == 1
+
+
+def test_read_and_write_latencies_and_arready_while_in_flight() -> None:
+    """``rvalid`` from cycle 2 after the AR handshake (cycle 0), ``arready`` low until the
+    R handshake; ``bvalid`` from cycle 3 after AW and W together; unmapped: SLVERR."""
+    c = model_contract("fsm", 4, 8)
+    rm = ip_register_map(c, 2, 8, "0" * 16, "0" * 16, "0.1.0")
+    dut = AxiLiteRegisters(rm)
+    bus = dut.bus
+    seen: dict[str, object] = {}
+
+    async def read(ctx, addr: int) -> tuple[int, int, list[int]]:  # noqa: ANN001
+        ctx.set(bus.araddr, addr)
+        ctx.set(bus.arvalid, 1)
+        ctx.set(bus.rready, 0)
+        assert ctx.get(bus.arready)
+        await ctx.tick()
+        ctx.set(bus.arvalid, 0)
+        trace = []
+        for _ in range(4):  # cycles 1..4, rready low: rvalid holds
+            trace.append((ctx.get(bus.rvalid), ctx.get(bus.arready)))
+            await ctx.tick()
+        data, resp = ctx.get(bus.rdata), ctx.get(bus.rresp)
+        ctx.set(bus.rready, 1)
+        await ctx.tick()
+        ctx.set(bus.rready, 0)
+        return data, resp, trace
+
+    async def bench(ctx) -> None:  # noqa: ANN001
+        ctx.set(bus.awaddr, rm["THR_DATA0"].offset)
+        ctx.set(bus.wdata, 0x123)
+        ctx.set(bus.wstrb, 0xF)
+        ctx.set(bus.awvalid, 1)
+        ctx.set(bus.wvalid, 1)
+        ctx.set(bus.bready, 1)
+        await ctx.tick()
+        ctx.set(bus.awvalid, 0)
+        ctx.set(bus.wvalid, 0)
+        seen["b"] = []
+        for _ in range(4):
+            seen["b"].append(ctx.get(bus.bvalid))
+            await ctx.tick()
+        seen["read"] = await read(ctx, rm["THR_DATA0"].offset)
+        seen["unmapped"] = await read(ctx, 0xFFC)
+
+    run_simulation(dut, bench)
+    assert seen["b"] == [0, 0, 1, 0]
+    data, resp, trace = seen["read"]
+    assert (data, resp) == (0x123, RESP_OKAY)
+    assert trace == [(0, 0), (1, 0), (1, 0), (1, 0)]
+    assert seen["unmapped"][:2] == (0, RESP_SLVERR)
