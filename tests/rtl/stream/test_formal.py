@@ -14,6 +14,7 @@ from rvsm.rtl.architectures import get_architecture
 from rvsm.rtl.formal import property_at
 from rvsm.rtl.stream.formal import (
     PROPERTY_GROUPS,
+    SYNTHESISED_GROUPS,
     StreamEquivalence,
     StreamProperties,
     stream_check,
@@ -82,6 +83,20 @@ def test_depth_is_two_frames_plus_the_lag(formal_point):
     for harness in (StreamProperties(contract, 2), StreamEquivalence(contract, 2)):
         assert harness.depth == 2 * geo.beats_per_frame + geo.lag + 2 == 25
         harness.statements()
+
+
+def test_synthesis_is_chosen_per_group(formal_point):
+    """smtbmc ``--syn`` where it measured faster (``SYNTHESISED_GROUPS``), never for a
+    harness that states the ``state`` group, never in prove mode."""
+    contract = _contract(formal_point)
+    for group in PROPERTY_GROUPS:
+        harness = StreamProperties(contract, 2, groups=(group,))
+        expected = ("--syn",) if group in SYNTHESISED_GROUPS else ()
+        assert harness.smtbmc_options("bmc") == harness.smtbmc_options("cover") == expected
+        assert harness.smtbmc_options("prove") == ()
+    assert "state" not in SYNTHESISED_GROUPS
+    assert StreamProperties(contract, 2).smtbmc_options("bmc") == ()
+    assert StreamEquivalence(contract, 2).smtbmc_options("bmc") == ()
 
 
 @pytest.mark.parametrize("group", PROPERTY_GROUPS)

@@ -43,6 +43,19 @@ def test_false_property_gives_a_counterexample_trace(tmp_path):
     assert result.trace is not None and result.trace.read_text().startswith("$")
 
 
+def test_synthesised_model_gives_the_same_verdicts(tmp_path):
+    """``--syn`` (yosys synthesises the model first): the same pass, the same failing
+    line and a trace that still names the design's signals."""
+    assert run_sby(WrappingCounter(10), tmp_path / "true", mode="bmc", depth=12,
+                   engine_options=("--syn",)).passed
+    result = run_sby(WrappingCounter(15), tmp_path / "false", mode="bmc", depth=15,
+                     engine_options=("--syn",))
+    assert "smtbmc --syn yices" in (tmp_path / "false" / "formal.sby").read_text()
+    assert result.status == "FAIL"
+    assert result.failed[0].endswith(f"test_sby.py:{_assert_line()}")
+    assert result.trace is not None and "count" in result.trace.read_text()
+
+
 def test_cover_is_reached(tmp_path):
     result = run_sby(WrappingCounter(10), tmp_path, mode="cover", depth=12)
     assert result.status == "PASS" and result.trace is not None
