@@ -62,7 +62,10 @@ class FormalHarness(Elaboratable):
     * ``depth``: the bounded depth (clock cycles) the checks need (for the stream array:
       two frames plus the pipeline lag), used when ``--depth`` is not given;
     * ``provable``: whether k-induction is expected to close (small state), else BMC;
-    * :meth:`smtbmc_options`: the options given to sby's ``smtbmc`` engine in a mode.
+    * :meth:`smtbmc_options`: the options given to sby's ``smtbmc`` engine in a mode;
+    * ``power_up_memories``: submodules (yosys patterns below the top, e.g.
+      ``"dut.acc_s*"``) whose memories start with arbitrary contents, as a RAM does at
+      power-up: their initial values are dropped before the solver sees the model.
     """
 
     depth: int = 20
@@ -70,6 +73,7 @@ class FormalHarness(Elaboratable):
     #: Properties decided exactly in Python before the solver runs
     #: (:meth:`offline_failures`), e.g. the stream's ``sums.linear_forms``.
     offline_properties: tuple[str, ...] = ()
+    power_up_memories: tuple[str, ...] = ()
 
     def __init__(self) -> None:
         self.properties: list[Property] = []

@@ -9,8 +9,9 @@ clock cycles.
 
 :class:`StreamProperties` states the protocol and the tail's arithmetic from the
 harness's own bookkeeping (beats counted at the ports, shadows of one symbolic word of
-the memories: an ``AnyConst`` word and scale, so the checks hold for every word),
-observing the array's internal :class:`~rvsm.rtl.stream.array.StreamProbes`. Stalls,
+the memories: an ``AnyConst`` word and scale, so the checks hold for every word; the
+accumulator memories start with any contents, as RAM at power-up), observing the array's
+internal :class:`~rvsm.rtl.stream.array.StreamProbes`. Stalls,
 clears and threshold writes are free at every cycle. Its properties come in four groups
 (:data:`PROPERTY_GROUPS`), each its own check so that sby keeps only that group's cone of
 logic:
@@ -168,6 +169,11 @@ class StreamProperties(_StreamHarness):
         if unknown:
             raise ValueError(f"unknown property group {sorted(unknown)[0]!r}")
         self.groups = tuple(groups)
+
+    #: The accumulator memories start with any contents (RAM at power-up): every
+    #: property must hold from any RAM state, and a clear that misses a bank shows
+    #: within the bound (``state.fresh_after_clear`` in the first frame).
+    power_up_memories = ("dut.acc_s*",)
 
     def smtbmc_options(self, mode: str) -> tuple[str, ...]:
         """``--syn`` in bmc and cover mode when every chosen group is one of

