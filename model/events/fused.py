@@ -32,9 +32,13 @@ from rvsm.model.events.config import EventConfig
 from rvsm.model.events.event_rule import event_step
 from rvsm.model.events.ladder_kernels import (
     ladder_events_1,
+    ladder_events_1_2,
     ladder_events_2,
+    ladder_events_2_2,
     ladder_events_3,
+    ladder_events_3_2,
     ladder_events_4,
+    ladder_events_4_2,
 )
 from rvsm.model.events.log_intensity import log_intensity_value
 from rvsm.model.kernels.orbits import kernel_orbits
@@ -75,6 +79,21 @@ def ladder_events(pairs, pr, ring, w, width, thr, ref, ev, y):
         ladder_events_3(pairs, pr, ring, w, width, thr, ref, ev, y)
     else:
         ladder_events_4(pairs, pr, ring, w, width, thr, ref, ev, y)
+
+
+@njit(inline="always", cache=True)
+def ladder_events_two(pairs, pr, ring, w, width, thr, ref, ev, y):
+    """:func:`ladder_events` for rows ``y`` and ``y + 1`` (padded rows ``pr``, ``pr + 1``)
+    in one pass: :mod:`.ladder_kernels`' ``ladder_events_S_2``."""
+    num_scales = w.shape[0]
+    if num_scales == 1:
+        ladder_events_1_2(pairs, pr, ring, w, width, thr, ref, ev, y)
+    elif num_scales == 2:
+        ladder_events_2_2(pairs, pr, ring, w, width, thr, ref, ev, y)
+    elif num_scales == 3:
+        ladder_events_3_2(pairs, pr, ring, w, width, thr, ref, ev, y)
+    else:
+        ladder_events_4_2(pairs, pr, ring, w, width, thr, ref, ev, y)
 
 
 @njit(inline="always", cache=True)
@@ -132,11 +151,13 @@ def _ring_pairs(pad, lmax, width, ring, k, twice, pairs):
 
 @njit(parallel=True, cache=True, error_model="numpy")
 def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean, sd,
-                 zx, zr, weights, halves, ladder, lmax, tile_rows, out):
+                 zx, zr, weights, halves, ladder, lmax, tile_rows, two_rows, out):
     num_scales, height, width = thr.shape
     num_steps = fidx.shape[0]
     num_tiles = (height + tile_rows - 1) // tile_rows
-    ring = 2 * lmax + 1  # the rows one output row's sums read
+    two_rows = two_rows and ladder
+    # The rows one output row's sums read (two rows' for two rows a pass).
+    ring = 2 * lmax + 2 if two_rows else 2 * lmax + 1
     for ti in prange(num_tiles):
         y0 = ti * tile_rows
         rows = min(height, y0 + tile_rows) - y0
@@ -165,7 +186,13 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
                 yo = y - lmax  # the output row whose window ends at row y
                 pr = (r - 2 * lmax) % ring + lmax
                 if ladder and not capture:  # sums and event rule in one loop
-                    ladder_events(pairs, pr, ring, weights, width, thr, ref, out[b], yo)
+                    if not two_rows:
+                        ladder_events(pairs, pr, ring, weights, width, thr, ref, out[b], yo)
+                    elif (yo - y0) % 2 == 1:  # rows yo - 1 and yo in one pass
+                        ladder_events_two(pairs, (r - 1 - 2 * lmax) % ring + lmax, ring,
+                                          weights, width, thr, ref, out[b], yo - 1)
+                    elif yo - y0 == rows - 1:  # the last row of an odd tile alone
+                        ladder_events(pairs, pr, ring, weights, width, thr, ref, out[b], yo)
                     continue
                 if ladder:
                     ladder_sum(pairs, pr, ring, weights, width, resp)
@@ -183,7 +210,7 @@ class FusedEventSampler:
     ``(t1 - t0, S, H, W) int8`` events."""
 
     def __init__(self, scene: Scene, config: EventConfig, thresholds: np.ndarray,
-                 tile_rows: int = DEFAULT_TILE_ROWS):
+                 tile_rows: int = DEFAULT_TILE_ROWS, two_rows: bool = True):
         spec = config.spec
         self.scene = scene
         _, self.weights, self.halves, self.lmax = kernel_orbits(spec.kernels())
@@ -193,6 +220,7 @@ class FusedEventSampler:
         self.ref = np.zeros_like(self.thr)
         self.captured: np.ndarray | None = None
         self.tile_rows = max(1, int(tile_rows))
+        self.two_rows = bool(two_rows)
         self.noisy, self.key, self.mean, self.sd = dark_current_stream(
             config.noise, scene, spec.num_scales)
         self.next_step = 0
@@ -225,5 +253,4 @@ class FusedEventSampler:
         _event_chunk(np.ascontiguousarray(frames, dtype=np.float64), fidx, aw, self.thr,
                      self.ref, t0 == 0, self.noisy, self.key, int(t0), self.mean, self.sd,
                      ZIG_X, ZIG_RATIO, self.weights, self.halves, self.ladder, self.lmax,
-                     self.tile_rows,
-                     out)
+                     self.tile_rows, self.two_rows, out)

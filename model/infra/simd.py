@@ -21,7 +21,10 @@ one loop of the four-scale ladder sums reads 45 rows and writes 4) and
 :mod:`rvsm.model.events.ladder_kernels` (1024: sums and event rule, 53 rows read and 8
 written) raise it when imported, before any of their kernels compile.
 
-Results depend on neither: no kernel runs under ``fastmath``, so a vector loop does the
+A loop that needs no runtime alias checks at all: :mod:`.noalias` (numba's ``noalias``
+flag; it imports numba, so it is a module of its own).
+
+Results depend on none of these: no kernel runs under ``fastmath``, so a vector loop does the
 same float operations in the same order at any width (the event engines' oracle tests
 compare bit for bit). Numba's on-disk cache is keyed on the CPU name and feature string,
 so code compiled for one width is never loaded for the other. Speed: ``docs/events.md``
@@ -103,3 +106,4 @@ def allow_alias_checks(limit: int = ALIAS_CHECKS) -> int:
         llvm.set_option("", f"-vectorize-memory-check-threshold={int(limit)}")
         _alias_checks = int(limit)
     return _alias_checks
+
