@@ -41,6 +41,7 @@ from rvsm.model.events.ladder_kernels import (
     ladder_events_4_2,
 )
 from rvsm.model.events.log_intensity import log_intensity_value
+from rvsm.model.infra.noalias import NoAliasCompiler
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, normal_row
 from rvsm.model.sampling.fused import chunk_frames, dark_current_stream
@@ -96,57 +97,44 @@ def ladder_events_two(pairs, pr, ring, w, width, thr, ref, ev, y):
         ladder_events_4_2(pairs, pr, ring, w, width, thr, ref, ev, y)
 
 
-@njit(inline="always", cache=True)
-def _log_row(frames, f, a, y, noisy, key, t, mean, sd, zx, zr, dark, width, dst):
-    """``dst[x] = L`` of row ``y`` at one step: brightness interpolated between frames
-    ``f`` and ``f + 1`` with weight ``a`` (plus the dark current), then its log."""
-    f0 = frames[f, y]
-    f1 = frames[f + 1, y] if a != 0.0 else f0
+@njit(cache=True, error_model="numpy", pipeline_class=NoAliasCompiler)
+def _log_pairs(frames, f, a, y, noisy, dark, lmax, width, pad, pairs, k, k2):
+    """Row ``y`` of ``L`` at one step into ``pad (W + 2L,)`` (its middle ``W``; the
+    brightness interpolated between frames ``f`` and ``f + 1`` with weight ``a``, plus
+    the dark current ``dark (W,)`` if ``noisy``, then its log), then the row's pairs
+    (:func:`.row_sums.row_pairs`) into ring slot ``k`` of ``pairs (L + 1, R, W)``, and
+    slot ``k2`` too unless ``k2 < 0``. Indexes its arguments directly (no row views, no
+    reference counts) by unsigned indices (no negative-index wraparound), compiled
+    ``noalias``: the arrays must be distinct."""
+    n = np.uint64(width)
+    m = np.uint64(lmax)
     oma = 1.0 - a
+    g = f + 1 if a != 0.0 else f
     if noisy:
-        normal_row(key, t, y, width, mean, sd, zx, zr, dark, 0)
         if a == 0.0:
-            for x in range(width):
-                dst[x] = log_intensity_value(f0[x] + dark[x])
+            for x in range(n):
+                pad[x + m] = log_intensity_value(frames[f, y, x] + dark[x])
         else:
-            for x in range(width):
-                dst[x] = log_intensity_value((oma * f0[x] + a * f1[x]) + dark[x])
+            for x in range(n):
+                pad[x + m] = log_intensity_value((oma * frames[f, y, x]
+                                                  + a * frames[g, y, x]) + dark[x])
     elif a == 0.0:
-        for x in range(width):
-            dst[x] = log_intensity_value(f0[x])
+        for x in range(n):
+            pad[x + m] = log_intensity_value(frames[f, y, x])
     else:
-        for x in range(width):
-            dst[x] = log_intensity_value(oma * f0[x] + a * f1[x])
-
-
-@njit(inline="always", cache=True)
-def _ring_pairs(pad, lmax, width, ring, k, twice, pairs):
-    """Row pairs of the padded row ``pad (W + 2L,)`` (:func:`.row_sums.row_pairs`) into
-    ring slot ``k`` of ``pairs (L + 1, 2 ring, W)``, and slot ``k + ring`` if ``twice``."""
-    mid = pad[lmax:lmax + width]
-    d0 = pairs[0, k]
-    d1 = pairs[0, k + ring]
-    if twice:
-        for x in range(width):
-            v = mid[x]
-            d0[x] = v
-            d1[x] = v
-    else:
-        for x in range(width):
-            d0[x] = mid[x]
+        for x in range(n):
+            pad[x + m] = log_intensity_value(oma * frames[f, y, x] + a * frames[g, y, x])
+    for x in range(n):
+        pairs[0, k, x] = pad[x + m]
     for b in range(1, lmax + 1):
-        left = pad[lmax - b:lmax - b + width]
-        right = pad[lmax + b:lmax + b + width]
-        d0 = pairs[b, k]
-        d1 = pairs[b, k + ring]
-        if twice:
-            for x in range(width):
-                v = left[x] + right[x]
-                d0[x] = v
-                d1[x] = v
-        else:
-            for x in range(width):
-                d0[x] = left[x] + right[x]
+        lo = np.uint64(lmax - b)
+        hi = np.uint64(lmax + b)
+        for x in range(n):
+            pairs[b, k, x] = pad[x + lo] + pad[x + hi]
+    if k2 >= 0:
+        for b in range(lmax + 1):
+            for x in range(n):
+                pairs[b, k2, x] = pairs[b, k, x]
 
 
 @njit(parallel=True, cache=True, error_model="numpy")
@@ -178,9 +166,10 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
                     pairs[:, k] = 0.0
                     pairs[:, k + ring] = 0.0
                 else:
-                    _log_row(frames, fidx[b], aw[b], y, noisy, key, t0 + b, mean, sd, zx,
-                             zr, dark, width, pad[lmax:lmax + width])
-                    _ring_pairs(pad, lmax, width, ring, k, twice, pairs)
+                    if noisy:
+                        normal_row(key, t0 + b, y, width, mean, sd, zx, zr, dark, 0)
+                    _log_pairs(frames, fidx[b], aw[b], y, noisy, dark, lmax, width, pad,
+                               pairs, k, k + ring if twice else -1)
                 if r < 2 * lmax:
                     continue
                 yo = y - lmax  # the output row whose window ends at row y
