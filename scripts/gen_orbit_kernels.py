@@ -2,7 +2,7 @@
 """Write ``model/sampling/orbit_kernels.py``: the per-half-width orbit sums and the ladder
 sums (every scale of a ``1..S`` ladder in one pass), unrolled for numba; and
 ``model/events/ladder_kernels.py``: the ladder sums with the event rule of every scale in
-the same loop (the RVSM-DVS fused engine's step).
+the same loop, for one output row or two a pass (the RVSM-DVS fused engine's step).
 
 Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
 ``model/kernels/orbits.py``; ``tests/model/sampling/test_fused.py`` checks the file is up to date.

@@ -4,17 +4,22 @@ parallel, everything of a tile in cache.
 :func:`_event_chunk` processes tiles of ``tile_rows`` rows in parallel (``prange``); per
 tile and step it streams the tile's rows plus a halo of ``L`` rows, one at a time: the
 brightness (interpolated between the chunk's frames, plus the dark current drawn inside
-the tile from the counter-based streams of :mod:`rvsm.model.noise.streams`) and its log
-(:func:`.log_intensity.log_intensity_value`) in one vectorised loop, then the row's pairs
-into a ring of ``2L + 1`` rows (the ladder sums take their rows modulo the ring; for the
-per-scale sums each row is stored twice, so the window around any output row is
-consecutive). Once a row's window is complete it forms every scale's receptive sum of it
-and applies the event rule (:mod:`.event_rule`) to the row's accumulators and references:
-for the ``1..S`` ladders in one vectorised loop over all scales
-(:mod:`.ladder_kernels`, the sums of :func:`~rvsm.model.sampling.row_sums.ladder_sum`,
-the responses never stored), else :func:`~rvsm.model.sampling.row_sums.scale_sum` per
-scale into a row of responses, then the rule per scale (the orbit order either way; the
-first step's capture of the references goes the second way too).
+the tile from the counter-based streams of :mod:`rvsm.model.noise.streams`), its log
+(:func:`.log_intensity.log_intensity_value`) and the row's pairs into a ring of rows
+(:func:`_log_pairs`; the ladder sums take their rows modulo the ring; for the per-scale
+sums each row is stored twice, so the window around any output row is consecutive). Once
+a row's window is complete it forms every scale's receptive sum of it and applies the
+event rule (:mod:`.event_rule`) to the row's accumulators and references: for the
+``1..S`` ladders in one vectorised loop over all scales (:mod:`.ladder_kernels`, the sums
+of :func:`~rvsm.model.sampling.row_sums.ladder_sum`, the responses never stored), two
+output rows a pass (their windows share all but two rows of the ring: a ring of
+``2L + 2`` rows; the last row of an odd tile alone), else
+:func:`~rvsm.model.sampling.row_sums.scale_sum` per scale into a row of responses, then
+the rule per scale (the orbit order either way; the first step's capture of the
+references goes the second way too). :func:`_log_pairs` and the ladder loops index their
+arrays directly instead of taking row views (each view costs two reference-count calls)
+and are compiled ``noalias`` (:mod:`rvsm.model.infra.noalias`), so they vectorise without
+runtime alias checks.
 
 Every float operation is the one :mod:`.numpy_engine` does, in the same order, the log
 is the same inlined function, no loop runs under ``fastmath``, and every pixel's

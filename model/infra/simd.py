@@ -17,9 +17,8 @@ variable once) and is called from ``rvsm.model``'s ``__init__``. It changes noth
 :func:`allow_alias_checks` raises LLVM's limit on the runtime alias checks a loop may
 carry to be vectorised (``-vectorize-memory-check-threshold``, default 128 pointer
 comparisons), a process-wide LLVM option; :mod:`rvsm.model.sampling.row_sums` (256: the
-one loop of the four-scale ladder sums reads 45 rows and writes 4) and
-:mod:`rvsm.model.events.ladder_kernels` (1024: sums and event rule, 53 rows read and 8
-written) raise it when imported, before any of their kernels compile.
+one loop of the four-scale ladder sums reads 45 rows and writes 4) raises it when
+imported, before any of its kernels compile.
 
 A loop that needs no runtime alias checks at all: :mod:`.noalias` (numba's ``noalias``
 flag; it imports numba, so it is a module of its own).
