@@ -47,6 +47,7 @@ from rvsm.model.events.ladder_kernels import (
 )
 from rvsm.model.events.log_intensity import log_intensity_value
 from rvsm.model.infra.noalias import NoAliasCompiler
+from rvsm.model.infra.simd import aligned_copy
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, normal_row
 from rvsm.model.sampling.fused import chunk_frames, dark_current_stream
@@ -142,6 +143,18 @@ def _log_pairs(frames, f, a, y, noisy, dark, lmax, width, pad, pairs, k, k2):
                 pairs[b, k2, x] = pairs[b, k, x]
 
 
+@njit(inline="always", cache=True)
+def _aligned_ring(planes, slots, width):
+    """Zeros ``(planes, slots, W8)``, ``W8`` = ``width`` rounded up to 8, starting at a
+    64-byte boundary: every row starts on a cache line, so no 8-lane load or store of a
+    row straddles two (numba's own arrays start at 32 bytes past one)."""
+    w8 = (width + 7) // 8 * 8
+    n = planes * slots * w8
+    buf = np.zeros(n + 8)
+    off = (64 - buf.ctypes.data % 64) % 64 // 8
+    return buf[off:off + n].reshape((planes, slots, w8))
+
+
 @njit(parallel=True, cache=True, error_model="numpy")
 def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean, sd,
                  zx, zr, weights, halves, ladder, lmax, tile_rows, two_rows, out):
@@ -158,7 +171,7 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
         # Each padded row's pairs go to ring slot k; for the per-scale sums also to slot
         # k + ring, so the 2L + 1 rows around any output row are consecutive slots (what
         # scale_sum indexes; ladder_sum takes its rows modulo the ring).
-        pairs = np.zeros((lmax + 1, 2 * ring, width))
+        pairs = _aligned_ring(lmax + 1, 2 * ring, width)  # rows on cache lines
         twice = not ladder
         dark = np.empty(width)
         resp = np.empty((num_scales, width))
@@ -210,8 +223,8 @@ class FusedEventSampler:
         _, self.weights, self.halves, self.lmax = kernel_orbits(spec.kernels())
         self.weights = np.ascontiguousarray(self.weights, dtype=np.float64)
         self.ladder = is_ladder(self.halves)
-        self.thr = np.ascontiguousarray(thresholds, dtype=np.float64)
-        self.ref = np.zeros_like(self.thr)
+        self.thr = aligned_copy(np.asarray(thresholds, dtype=np.float64))
+        self.ref = aligned_copy(np.zeros_like(self.thr))
         self.captured: np.ndarray | None = None
         self.tile_rows = max(1, int(tile_rows))
         self.two_rows = bool(two_rows)
