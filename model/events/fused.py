@@ -241,6 +241,8 @@ class FusedEventSampler:
         """Events ``(t1 - t0, S, H, W) int8`` of steps ``t0 .. t1 - 1``."""
         if t0 != self.next_step:
             raise ValueError(f"chunks must be consecutive: expected step {self.next_step}")
+        if t1 > self.scene.num_steps:  # the kernel indexes frames unchecked
+            raise ValueError(f"step {t1 - 1} is past the scene's {self.scene.num_steps} steps")
         s, h, w = self.thr.shape
         if out is None:
             out = np.empty((t1 - t0, s, h, w), dtype=np.int8)

@@ -117,3 +117,13 @@ def test_bad_configs_are_refused() -> None:
         EventConfig("dog2", scale_contrast=(0.1,))
     with pytest.raises(RvsmError, match="per-scale contrast"):
         EventConfig("dog2", scale_contrast=(0.1, float("nan")))
+
+
+def test_fused_refuses_steps_past_the_scene() -> None:
+    """The kernel reads frames unchecked: a range past the scene's steps is refused."""
+    scene = load_scene("flyball", size=(8, 12), num_frames=2)
+    cfg = EventConfig("dog2")
+    fused = FusedEventSampler(scene, cfg, contrast_thresholds(cfg, scene.shape))
+    with pytest.raises(ValueError, match="past the scene"):
+        fused.run(0, scene.num_steps + 1)
+    assert fused.run(0, scene.num_steps).shape[0] == scene.num_steps
