@@ -108,7 +108,7 @@ def _log_pairs(frames, f, a, y, noisy, dark, lmax, width, pad, pairs, k, k2):
     """Row ``y`` of ``L`` at one step into ``pad (W + 2L,)`` (its middle ``W``; the
     brightness interpolated between frames ``f`` and ``f + 1`` with weight ``a``, plus
     the dark current ``dark (W,)`` if ``noisy``, then its log), then the row's pairs
-    (:func:`.row_sums.row_pairs`) into ring slot ``k`` of ``pairs (L + 1, R, W)``, and
+    (:func:`.row_sums.row_pairs`) into ring slot ``k`` of ``pairs (L + 1, R, >= W)``, and
     slot ``k2`` too unless ``k2 < 0``. Indexes its arguments directly (no row views, no
     reference counts) by unsigned indices (no negative-index wraparound), compiled
     ``noalias``: the arrays must be distinct."""

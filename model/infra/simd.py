@@ -114,7 +114,6 @@ def allow_alias_checks(limit: int = ALIAS_CHECKS) -> int:
     return _alias_checks
 
 
-
 def aligned_copy(a, align: int = CACHE_LINE):
     """A C-contiguous copy of the numpy array ``a`` whose data starts at a multiple of
     ``align`` bytes (numpy's large arrays start 16 bytes past a page boundary, so every
