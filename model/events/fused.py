@@ -214,7 +214,8 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
 class FusedEventSampler:
     """The fused event sampler's state for one scene and configuration; :meth:`run`
     covers steps ``t0 .. t1 - 1`` (consecutive calls, consecutive ranges) and returns
-    ``(t1 - t0, S, H, W) int8`` events."""
+    ``(t1 - t0, S, H, W) int8`` events. ``tile_rows`` and ``two_rows`` (the ladders' two
+    output rows a pass; False: one) change the speed, never the events."""
 
     def __init__(self, scene: Scene, config: EventConfig, thresholds: np.ndarray,
                  tile_rows: int = DEFAULT_TILE_ROWS, two_rows: bool = True):
