@@ -26,8 +26,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numba
-
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.twin import stream_fixed
 from rvsm.model.noise.sensor import NoiseParams
@@ -71,6 +69,12 @@ class NullSink:
 def load() -> str:
     """The 1-minute load average, as `uptime` prints it."""
     return f"{os.getloadavg()[0]:.2f}"
+
+
+def vector_bits() -> str:
+    """``512`` when :mod:`rvsm.model` chose 512-bit vectors for numba, else ``default``."""
+    wide = os.environ.get("NUMBA_CPU_FEATURES", "").endswith("-prefer-256-bit")
+    return "512" if wide else "default"
 
 
 def best_time(fn, repeat: int) -> tuple[float, float]:
@@ -137,13 +141,16 @@ def main() -> None:
     parser.add_argument("--only", default="", metavar="TEXT",
                         help="run only the cases whose label contains TEXT (e.g. dvs)")
     args = parser.parse_args()
+    import numba  # after rvsm.model, which chooses the vector width before numba loads
+
     m = 10
     scene = builtin_scene("flyball", num_frames=args.steps // m + 1, steps_per_frame=m)
     short = builtin_scene("flyball", num_frames=args.numpy_steps // m + 1, steps_per_frame=m)
     h, w = scene.shape
     print(f"flyball {h}x{w}; fused: {scene.num_steps} steps, numba threads "
           f"{numba.get_num_threads()}; numpy: {short.num_steps} steps; best of {args.repeat}; "
-          f"{os.cpu_count()} CPUs; load = 1-min load average at the start of each row")
+          f"{os.cpu_count()} CPUs; {vector_bits()}-bit vectors; "
+          "load = 1-min load average at the start of each row")
     head = (f"{'twin':13s} {'noise':5s} {'fused/s':>10s} {'numpy/s':>10s} {'speed-up':>8s} "
             f"{'target':>8s} {'met':>6s} {'load':>5s} {'fused/cpu-s':>11s}")
     print(head)

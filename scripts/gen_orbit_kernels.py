@@ -2,7 +2,7 @@
 """Write ``model/sampling/orbit_kernels.py``: the per-half-width orbit sums and the ladder
 sums (every scale of a ``1..S`` ladder in one pass), unrolled for numba; and
 ``model/events/ladder_kernels.py``: the ladder sums with the event rule of every scale in
-the same loop (the RVSM-DVS fused engine's step).
+the same loop, for one output row or two a pass (the RVSM-DVS fused engine's step).
 
 Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
 ``model/kernels/orbits.py``; ``tests/model/sampling/test_fused.py`` checks the file is up to date.
@@ -125,47 +125,76 @@ EVENTS_HEADER = '''"""Ladder sums and event rule, one loop (scripts/gen_orbit_ke
 
 ``ladder_events_S(pairs, pr, ring, w, width, thr, ref, ev, y)``: every scale's receptive
 sum of padded row ``pr`` exactly as
-:func:`rvsm.model.sampling.orbit_kernels.ladder_sum_S` forms it (rows modulo ``ring``,
-the same operations in the same order), then, in the same loop, the event rule
-(:func:`.event_rule.event_step`) on row ``y`` of every scale: thresholds and references
-``thr, ref (S, H, W)``, events ``ev (S, H, W) int8``. The responses stay in registers (no
-row of responses is stored and read back); the loop reads 45 + 8 rows and writes 8 for
-four scales, so it vectorises only with the vectoriser's runtime alias-check limit raised
-(:func:`rvsm.model.infra.simd.allow_alias_checks`, raised here). They are compiled as
-functions of their own, not inlined: four inlined loops made the fused kernel 10 %
-slower.
+:func:`rvsm.model.sampling.orbit_kernels.ladder_sum_S` forms it (rows of ``pairs (L + 1,
+R, W)`` taken modulo ``ring``, the same operations in the same order), then, in the same
+loop, the event rule (:func:`.event_rule.event_step_at`) on row ``y`` of every scale:
+thresholds and references ``thr, ref (S, H, W)``, events ``ev (S, H, W) int8``. The
+responses stay in registers (no row of responses is stored and read back).
+``ladder_events_S_2``: the same for rows ``y`` and ``y + 1`` (padded rows ``pr`` and
+``pr + 1``) in one pass; the two windows share ``2S`` of their ``2S + 2`` rows, so each
+loaded vector serves both rows' sums; each pixel's sums are formed exactly as by
+``ladder_events_S``.
+
+The loops index their arguments directly (no row views: a view costs numba two reference
+count calls, about 100 a call for 45 rows) and are compiled with numba's ``noalias`` flag
+(:class:`rvsm.model.infra.noalias.NoAliasCompiler`): LLVM vectorises them without runtime
+alias checks, so the arguments must be distinct arrays. Compiled as functions of their
+own, not inlined into the fused kernel (``noalias`` holds at a function's boundary).
 """
 
 from numba import njit
 
-from rvsm.model.events.event_rule import event_step
-from rvsm.model.infra.simd import allow_alias_checks
-
-# The four-scale loop reads 53 rows and writes 8: up to 424 runtime alias checks.
-allow_alias_checks(1024)
+from rvsm.model.events.event_rule import event_step_at
+from rvsm.model.infra.noalias import NoAliasCompiler
 '''
 
 
-def ladder_events(scales: int) -> list[str]:
-    """The lines of ``ladder_events_S``: ``ladder_sum_S`` whose stores of the responses
-    are the event rule of each scale."""
-    lines = ladder_sum(scales)
-    lines[0] = "@njit(cache=True)"  # not inlined: four inlined loops slow the kernel 10 %
-    lines[1] = f"def ladder_events_{scales}(pairs, pr, ring, w, width, thr, ref, ev, y):"
-    out = []
-    for line in lines:
-        row = re.fullmatch(r"    out(\d) = out\[(\d)\]", line)
-        store = re.fullmatch(r"        out(\d)\[x\] = t(\d)", line)
-        if row:
-            s = row[1]
-            out += [f"    th{s} = thr[{s}, y]", f"    rf{s} = ref[{s}, y]",
-                    f"    ev{s} = ev[{s}, y]"]
-        elif store:
-            s = store[1]
-            out.append(f"        event_step(t{s}, th{s}, rf{s}, ev{s}, x)")
-        else:
-            out.append(line)
-    return out
+def ladder_events(scales: int, nrows: int = 1) -> list[str]:
+    """The lines of ``ladder_events_S`` (``nrows = 1``) or ``ladder_events_S_n``: the
+    loop of ``ladder_sum_S`` for output rows ``y .. y + nrows - 1`` whose stores of the
+    responses are the event rule of each scale; the ``pairs`` rows indexed directly. Row
+    ``k``'s sums read the rows of row 0's shifted by ``k``; every row's sums are formed
+    in ``ladder_sum_S``'s order (row by row within each orbit)."""
+    orbits = [(a, b) for a in range(scales + 1) for b in range(a + 1)]
+    used = [(s + 2) * (s + 3) // 2 for s in range(scales)]  # orbits of half-width s + 1
+    name = f"ladder_events_{scales}" + (f"_{nrows}" if nrows > 1 else "")
+    lines = ["@njit(cache=True, pipeline_class=NoAliasCompiler)",
+             f"def {name}(pairs, pr, ring, w, width, thr, ref, ev, y):"]
+    exprs, rows = [], set()
+    for a, b in orbits[:max(used)]:
+        expr, r = orbit_expr(a, b)
+        exprs.append(expr)
+        rows |= r
+    rows = {(pb, d + k) for pb, d in rows for k in range(nrows)}
+    offsets = sorted({d for _, d in rows})
+    lines += [f"    {_slot(d)} = (pr {'-' if d < 0 else '+'} {abs(d)}) % ring" for d in offsets]
+    for s, n_s in enumerate(used):
+        lines += [f"    w{s}_{n} = w[{s}, {n}]" for n in range(n_s)]
+    lines.append("    for x in range(width):")
+    lines += [f"        t{k}_{s} = w{s}_0 - w{s}_0" for k in range(nrows) for s in range(scales)]
+    for n, expr in enumerate(exprs):
+        for k in range(nrows):
+            lines.append(f"        o = {_indexed(expr, k)}")
+            lines += [f"        t{k}_{s} = t{k}_{s} + w{s}_{n} * o"
+                      for s, n_s in enumerate(used) if n < n_s]
+    yk = ["y"] + [f"y + {k}" for k in range(1, nrows)]
+    lines += [f"        event_step_at(t{k}_{s}, thr, ref, ev, {s}, {yk[k]}, x)"
+              for k in range(nrows) for s in range(scales)]
+    return lines
+
+
+def _slot(d: int) -> str:
+    """The name of the ring slot of padded row ``pr + d``."""
+    return f"k{'m' if d < 0 else 'p'}{abs(d)}"
+
+
+def _indexed(expr: str, shift: int) -> str:
+    """``orbit_expr``'s expression with row ``r{b}_{d}[x]`` read as ``pairs[b, slot of
+    d + shift, x]``."""
+    def sub(m: re.Match) -> str:
+        d = (-1 if m[2] == "m" else 1) * int(m[3]) + shift
+        return f"pairs[{m[1]}, {_slot(d)}, x]"
+    return re.sub(r"r(\d)_([mp])(\d)\[x\]", sub, expr)
 
 
 def generate_events() -> str:
@@ -173,6 +202,8 @@ def generate_events() -> str:
     out = [EVENTS_HEADER.rstrip("\n")]
     for scales in range(1, MAX_HALF + 1):
         out += ["", ""] + ladder_events(scales)
+    for scales in range(1, MAX_HALF + 1):
+        out += ["", ""] + ladder_events(scales, 2)
     return "\n".join(out).rstrip("\n") + "\n"
 
 

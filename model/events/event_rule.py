@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["event_step"]
+__all__ = ["event_step", "event_step_at"]
 
 
 @njit(inline="always", cache=True)
@@ -27,3 +27,17 @@ def event_step(resp, thr, ref, out, x):
     off = (d <= -c) & (not on)
     out[x] = np.int8(on) - np.int8(off)
     ref[x] = r + c if on else (r - c if off else r)
+
+
+@njit(inline="always", cache=True)
+def event_step_at(resp, thr, ref, out, s, y, x):
+    """:func:`event_step` on accumulator ``(s, y, x)`` of whole arrays ``thr, ref
+    (S, H, W)`` and ``out (S, H, W) int8`` (no row views: the generated ladder loops index
+    their arguments directly)."""
+    r = ref[s, y, x]
+    d = resp - r
+    c = thr[s, y, x]
+    on = d >= c
+    off = (d <= -c) & (not on)
+    out[s, y, x] = np.int8(on) - np.int8(off)
+    ref[s, y, x] = r + c if on else (r - c if off else r)

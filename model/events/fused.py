@@ -4,17 +4,22 @@ parallel, everything of a tile in cache.
 :func:`_event_chunk` processes tiles of ``tile_rows`` rows in parallel (``prange``); per
 tile and step it streams the tile's rows plus a halo of ``L`` rows, one at a time: the
 brightness (interpolated between the chunk's frames, plus the dark current drawn inside
-the tile from the counter-based streams of :mod:`rvsm.model.noise.streams`) and its log
-(:func:`.log_intensity.log_intensity_value`) in one vectorised loop, then the row's pairs
-into a ring of ``2L + 1`` rows (the ladder sums take their rows modulo the ring; for the
-per-scale sums each row is stored twice, so the window around any output row is
-consecutive). Once a row's window is complete it forms every scale's receptive sum of it
-and applies the event rule (:mod:`.event_rule`) to the row's accumulators and references:
-for the ``1..S`` ladders in one vectorised loop over all scales
-(:mod:`.ladder_kernels`, the sums of :func:`~rvsm.model.sampling.row_sums.ladder_sum`,
-the responses never stored), else :func:`~rvsm.model.sampling.row_sums.scale_sum` per
-scale into a row of responses, then the rule per scale (the orbit order either way; the
-first step's capture of the references goes the second way too).
+the tile from the counter-based streams of :mod:`rvsm.model.noise.streams`), its log
+(:func:`.log_intensity.log_intensity_value`) and the row's pairs into a ring of rows
+(:func:`_log_pairs`; the ladder sums take their rows modulo the ring; for the per-scale
+sums each row is stored twice, so the window around any output row is consecutive). Once
+a row's window is complete it forms every scale's receptive sum of it and applies the
+event rule (:mod:`.event_rule`) to the row's accumulators and references: for the
+``1..S`` ladders in one vectorised loop over all scales (:mod:`.ladder_kernels`, the sums
+of :func:`~rvsm.model.sampling.row_sums.ladder_sum`, the responses never stored), two
+output rows a pass (their windows share all but two rows of the ring: a ring of
+``2L + 2`` rows; the last row of an odd tile alone), else
+:func:`~rvsm.model.sampling.row_sums.scale_sum` per scale into a row of responses, then
+the rule per scale (the orbit order either way; the first step's capture of the
+references goes the second way too). :func:`_log_pairs` and the ladder loops index their
+arrays directly instead of taking row views (each view costs two reference-count calls)
+and are compiled ``noalias`` (:mod:`rvsm.model.infra.noalias`), so they vectorise without
+runtime alias checks.
 
 Every float operation is the one :mod:`.numpy_engine` does, in the same order, the log
 is the same inlined function, no loop runs under ``fastmath``, and every pixel's
@@ -32,11 +37,17 @@ from rvsm.model.events.config import EventConfig
 from rvsm.model.events.event_rule import event_step
 from rvsm.model.events.ladder_kernels import (
     ladder_events_1,
+    ladder_events_1_2,
     ladder_events_2,
+    ladder_events_2_2,
     ladder_events_3,
+    ladder_events_3_2,
     ladder_events_4,
+    ladder_events_4_2,
 )
 from rvsm.model.events.log_intensity import log_intensity_value
+from rvsm.model.infra.noalias import NoAliasCompiler
+from rvsm.model.infra.simd import aligned_copy
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, normal_row
 from rvsm.model.sampling.fused import chunk_frames, dark_current_stream
@@ -78,65 +89,81 @@ def ladder_events(pairs, pr, ring, w, width, thr, ref, ev, y):
 
 
 @njit(inline="always", cache=True)
-def _log_row(frames, f, a, y, noisy, key, t, mean, sd, zx, zr, dark, width, dst):
-    """``dst[x] = L`` of row ``y`` at one step: brightness interpolated between frames
-    ``f`` and ``f + 1`` with weight ``a`` (plus the dark current), then its log."""
-    f0 = frames[f, y]
-    f1 = frames[f + 1, y] if a != 0.0 else f0
-    oma = 1.0 - a
-    if noisy:
-        normal_row(key, t, y, width, mean, sd, zx, zr, dark, 0)
-        if a == 0.0:
-            for x in range(width):
-                dst[x] = log_intensity_value(f0[x] + dark[x])
-        else:
-            for x in range(width):
-                dst[x] = log_intensity_value((oma * f0[x] + a * f1[x]) + dark[x])
-    elif a == 0.0:
-        for x in range(width):
-            dst[x] = log_intensity_value(f0[x])
+def ladder_events_two(pairs, pr, ring, w, width, thr, ref, ev, y):
+    """:func:`ladder_events` for rows ``y`` and ``y + 1`` (padded rows ``pr``, ``pr + 1``)
+    in one pass: :mod:`.ladder_kernels`' ``ladder_events_S_2``."""
+    num_scales = w.shape[0]
+    if num_scales == 1:
+        ladder_events_1_2(pairs, pr, ring, w, width, thr, ref, ev, y)
+    elif num_scales == 2:
+        ladder_events_2_2(pairs, pr, ring, w, width, thr, ref, ev, y)
+    elif num_scales == 3:
+        ladder_events_3_2(pairs, pr, ring, w, width, thr, ref, ev, y)
     else:
-        for x in range(width):
-            dst[x] = log_intensity_value(oma * f0[x] + a * f1[x])
+        ladder_events_4_2(pairs, pr, ring, w, width, thr, ref, ev, y)
+
+
+@njit(cache=True, error_model="numpy", pipeline_class=NoAliasCompiler)
+def _log_pairs(frames, f, a, y, noisy, dark, lmax, width, pad, pairs, k, k2):
+    """Row ``y`` of ``L`` at one step into ``pad (W + 2L,)`` (its middle ``W``; the
+    brightness interpolated between frames ``f`` and ``f + 1`` with weight ``a``, plus
+    the dark current ``dark (W,)`` if ``noisy``, then its log), then the row's pairs
+    (:func:`.row_sums.row_pairs`) into ring slot ``k`` of ``pairs (L + 1, R, >= W)``, and
+    slot ``k2`` too unless ``k2 < 0``. Indexes its arguments directly (no row views, no
+    reference counts) by unsigned indices (no negative-index wraparound), compiled
+    ``noalias``: the arrays must be distinct."""
+    n = np.uint64(width)
+    m = np.uint64(lmax)
+    oma = 1.0 - a
+    g = f + 1 if a != 0.0 else f
+    if noisy:
+        if a == 0.0:
+            for x in range(n):
+                pad[x + m] = log_intensity_value(frames[f, y, x] + dark[x])
+        else:
+            for x in range(n):
+                pad[x + m] = log_intensity_value((oma * frames[f, y, x]
+                                                  + a * frames[g, y, x]) + dark[x])
+    elif a == 0.0:
+        for x in range(n):
+            pad[x + m] = log_intensity_value(frames[f, y, x])
+    else:
+        for x in range(n):
+            pad[x + m] = log_intensity_value(oma * frames[f, y, x] + a * frames[g, y, x])
+    for x in range(n):
+        pairs[0, k, x] = pad[x + m]
+    for b in range(1, lmax + 1):
+        lo = np.uint64(lmax - b)
+        hi = np.uint64(lmax + b)
+        for x in range(n):
+            pairs[b, k, x] = pad[x + lo] + pad[x + hi]
+    if k2 >= 0:
+        for b in range(lmax + 1):
+            for x in range(n):
+                pairs[b, k2, x] = pairs[b, k, x]
 
 
 @njit(inline="always", cache=True)
-def _ring_pairs(pad, lmax, width, ring, k, twice, pairs):
-    """Row pairs of the padded row ``pad (W + 2L,)`` (:func:`.row_sums.row_pairs`) into
-    ring slot ``k`` of ``pairs (L + 1, 2 ring, W)``, and slot ``k + ring`` if ``twice``."""
-    mid = pad[lmax:lmax + width]
-    d0 = pairs[0, k]
-    d1 = pairs[0, k + ring]
-    if twice:
-        for x in range(width):
-            v = mid[x]
-            d0[x] = v
-            d1[x] = v
-    else:
-        for x in range(width):
-            d0[x] = mid[x]
-    for b in range(1, lmax + 1):
-        left = pad[lmax - b:lmax - b + width]
-        right = pad[lmax + b:lmax + b + width]
-        d0 = pairs[b, k]
-        d1 = pairs[b, k + ring]
-        if twice:
-            for x in range(width):
-                v = left[x] + right[x]
-                d0[x] = v
-                d1[x] = v
-        else:
-            for x in range(width):
-                d0[x] = left[x] + right[x]
+def _aligned_ring(planes, slots, width):
+    """Zeros ``(planes, slots, W8)``, ``W8`` = ``width`` rounded up to 8, starting at a
+    64-byte boundary: every row starts on a cache line, so no 8-lane load or store of a
+    row straddles two (numba's own arrays start at 32 bytes past one)."""
+    w8 = (width + 7) // 8 * 8
+    n = planes * slots * w8
+    buf = np.zeros(n + 8)
+    off = (64 - buf.ctypes.data % 64) % 64 // 8
+    return buf[off:off + n].reshape((planes, slots, w8))
 
 
 @njit(parallel=True, cache=True, error_model="numpy")
 def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean, sd,
-                 zx, zr, weights, halves, ladder, lmax, tile_rows, out):
+                 zx, zr, weights, halves, ladder, lmax, tile_rows, two_rows, out):
     num_scales, height, width = thr.shape
     num_steps = fidx.shape[0]
     num_tiles = (height + tile_rows - 1) // tile_rows
-    ring = 2 * lmax + 1  # the rows one output row's sums read
+    two_rows = two_rows and ladder
+    # The rows one output row's sums read (two rows' for two rows a pass).
+    ring = 2 * lmax + 2 if two_rows else 2 * lmax + 1
     for ti in prange(num_tiles):
         y0 = ti * tile_rows
         rows = min(height, y0 + tile_rows) - y0
@@ -144,7 +171,7 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
         # Each padded row's pairs go to ring slot k; for the per-scale sums also to slot
         # k + ring, so the 2L + 1 rows around any output row are consecutive slots (what
         # scale_sum indexes; ladder_sum takes its rows modulo the ring).
-        pairs = np.zeros((lmax + 1, 2 * ring, width))
+        pairs = _aligned_ring(lmax + 1, 2 * ring, width)  # rows on cache lines
         twice = not ladder
         dark = np.empty(width)
         resp = np.empty((num_scales, width))
@@ -157,15 +184,22 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
                     pairs[:, k] = 0.0
                     pairs[:, k + ring] = 0.0
                 else:
-                    _log_row(frames, fidx[b], aw[b], y, noisy, key, t0 + b, mean, sd, zx,
-                             zr, dark, width, pad[lmax:lmax + width])
-                    _ring_pairs(pad, lmax, width, ring, k, twice, pairs)
+                    if noisy:
+                        normal_row(key, t0 + b, y, width, mean, sd, zx, zr, dark, 0)
+                    _log_pairs(frames, fidx[b], aw[b], y, noisy, dark, lmax, width, pad,
+                               pairs, k, k + ring if twice else -1)
                 if r < 2 * lmax:
                     continue
                 yo = y - lmax  # the output row whose window ends at row y
                 pr = (r - 2 * lmax) % ring + lmax
                 if ladder and not capture:  # sums and event rule in one loop
-                    ladder_events(pairs, pr, ring, weights, width, thr, ref, out[b], yo)
+                    if not two_rows:
+                        ladder_events(pairs, pr, ring, weights, width, thr, ref, out[b], yo)
+                    elif (yo - y0) % 2 == 1:  # rows yo - 1 and yo in one pass
+                        ladder_events_two(pairs, (r - 1 - 2 * lmax) % ring + lmax, ring,
+                                          weights, width, thr, ref, out[b], yo - 1)
+                    elif yo - y0 == rows - 1:  # the last row of an odd tile alone
+                        ladder_events(pairs, pr, ring, weights, width, thr, ref, out[b], yo)
                     continue
                 if ladder:
                     ladder_sum(pairs, pr, ring, weights, width, resp)
@@ -180,19 +214,21 @@ def _event_chunk(frames, fidx, aw, thr, ref, capture_first, noisy, key, t0, mean
 class FusedEventSampler:
     """The fused event sampler's state for one scene and configuration; :meth:`run`
     covers steps ``t0 .. t1 - 1`` (consecutive calls, consecutive ranges) and returns
-    ``(t1 - t0, S, H, W) int8`` events."""
+    ``(t1 - t0, S, H, W) int8`` events. ``tile_rows`` and ``two_rows`` (the ladders' two
+    output rows a pass; False: one) change the speed, never the events."""
 
     def __init__(self, scene: Scene, config: EventConfig, thresholds: np.ndarray,
-                 tile_rows: int = DEFAULT_TILE_ROWS):
+                 tile_rows: int = DEFAULT_TILE_ROWS, two_rows: bool = True):
         spec = config.spec
         self.scene = scene
         _, self.weights, self.halves, self.lmax = kernel_orbits(spec.kernels())
         self.weights = np.ascontiguousarray(self.weights, dtype=np.float64)
         self.ladder = is_ladder(self.halves)
-        self.thr = np.ascontiguousarray(thresholds, dtype=np.float64)
-        self.ref = np.zeros_like(self.thr)
+        self.thr = aligned_copy(np.asarray(thresholds, dtype=np.float64))
+        self.ref = aligned_copy(np.zeros_like(self.thr))
         self.captured: np.ndarray | None = None
         self.tile_rows = max(1, int(tile_rows))
+        self.two_rows = bool(two_rows)
         self.noisy, self.key, self.mean, self.sd = dark_current_stream(
             config.noise, scene, spec.num_scales)
         self.next_step = 0
@@ -206,6 +242,8 @@ class FusedEventSampler:
         """Events ``(t1 - t0, S, H, W) int8`` of steps ``t0 .. t1 - 1``."""
         if t0 != self.next_step:
             raise ValueError(f"chunks must be consecutive: expected step {self.next_step}")
+        if t1 > self.scene.num_steps:  # the kernel indexes frames unchecked
+            raise ValueError(f"step {t1 - 1} is past the scene's {self.scene.num_steps} steps")
         s, h, w = self.thr.shape
         if out is None:
             out = np.empty((t1 - t0, s, h, w), dtype=np.int8)
@@ -225,5 +263,4 @@ class FusedEventSampler:
         _event_chunk(np.ascontiguousarray(frames, dtype=np.float64), fidx, aw, self.thr,
                      self.ref, t0 == 0, self.noisy, self.key, int(t0), self.mean, self.sd,
                      ZIG_X, ZIG_RATIO, self.weights, self.halves, self.ladder, self.lmax,
-                     self.tile_rows,
-                     out)
+                     self.tile_rows, self.two_rows, out)

@@ -76,7 +76,8 @@ def test_fused_equals_numpy(model: str, noisy: bool) -> None:
 @pytest.mark.parametrize("noisy", [False, True])
 def test_fused_any_tile_height_and_thread_count(noisy: bool) -> None:
     """dog4 (L = 4) on 5 rows (fewer than the 2L + 1 rows a sum reads: zero rows in the
-    fused kernel's ring) and on 20 rows, tiles of 1, 3 and 64 rows, 1 and 2 threads."""
+    fused kernel's ring) and on 20 rows, tiles of 1, 3 and 64 rows (odd tiles end with
+    a row alone), 1 and 2 threads, two output rows a pass and one."""
     cfg = EventConfig("dog4", noise=NoiseParams(k=4, seed=5) if noisy else None)
     threads = numba.get_num_threads()
     try:
@@ -87,9 +88,11 @@ def test_fused_any_tile_height_and_thread_count(noisy: bool) -> None:
             for tile in (1, 3, 64):
                 for n in range(1, min(2, numba.config.NUMBA_NUM_THREADS) + 1):
                     numba.set_num_threads(n)
-                    fused = FusedEventSampler(scene, cfg, thr, tile_rows=tile)
-                    assert np.array_equal(fused.run(0, scene.num_steps), ref.events)
-                    assert np.array_equal(fused.references, ref.references)
+                    for two_rows in (True, False):
+                        fused = FusedEventSampler(scene, cfg, thr, tile_rows=tile,
+                                                  two_rows=two_rows)
+                        assert np.array_equal(fused.run(0, scene.num_steps), ref.events)
+                        assert np.array_equal(fused.references, ref.references)
             assert np.count_nonzero(ref.events) > 0
     finally:
         numba.set_num_threads(threads)
@@ -114,3 +117,13 @@ def test_bad_configs_are_refused() -> None:
         EventConfig("dog2", scale_contrast=(0.1,))
     with pytest.raises(RvsmError, match="per-scale contrast"):
         EventConfig("dog2", scale_contrast=(0.1, float("nan")))
+
+
+def test_fused_refuses_steps_past_the_scene() -> None:
+    """The kernel reads frames unchecked: a range past the scene's steps is refused."""
+    scene = load_scene("flyball", size=(8, 12), num_frames=2)
+    cfg = EventConfig("dog2")
+    fused = FusedEventSampler(scene, cfg, contrast_thresholds(cfg, scene.shape))
+    with pytest.raises(ValueError, match="past the scene"):
+        fused.run(0, scene.num_steps + 1)
+    assert fused.run(0, scene.num_steps).shape[0] == scene.num_steps

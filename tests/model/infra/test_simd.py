@@ -1,5 +1,6 @@
 """The vector-width choice (:mod:`rvsm.model.infra.simd`): 512-bit vectors only on an
-AVX-512 host, never over the user's settings, and the opt-out."""
+AVX-512 host, never over the user's settings, and the opt-out; cache-line aligned
+copies."""
 
 from __future__ import annotations
 
@@ -70,3 +71,13 @@ def test_a_fresh_process_compiles_for_the_host() -> None:
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                          text=True, check=True).stdout.strip()
     assert out == "False"
+
+
+@pytest.mark.parametrize("shape", [(3, 5, 7), (1000,), (4, 32, 400)])
+def test_aligned_copy_starts_on_a_cache_line(shape) -> None:
+    import numpy as np
+
+    a = np.random.default_rng(0).random(shape)
+    b = simd.aligned_copy(a)
+    assert b.ctypes.data % simd.CACHE_LINE == 0 and b.flags.c_contiguous
+    assert b.dtype == a.dtype and np.array_equal(a, b) and not np.shares_memory(a, b)
