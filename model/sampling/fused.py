@@ -19,6 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from rvsm.model.infra.noalias import NoAliasCompiler
+from rvsm.model.infra.simd import aligned_copy
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.sensor import NoiseParams, NoiseSource
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, check_coordinates, normal_row
@@ -85,35 +87,61 @@ def filter_frames(frames: np.ndarray, weights, halves, lmax: int, tile_rows: int
 
 
 @njit(inline="always", cache=True)
-def _integrate_row(acc, thr, drive, spikes, width, signed, zero_reset):
-    """Integrate one row of one scale, compare, fire, reset (the numpy Integrator's rules)."""
+def _drive(kf, f, a, oma, dark, noisy, s, y, r, x):
+    """The drive of pixel ``(y, x)`` of scale ``s``: the filtered frames ``kf[f]`` and
+    ``kf[f + 1]`` interpolated with weight ``a`` (``kf[f]`` alone when ``a`` is 0), plus
+    the dark current ``dark[s, r, x]`` if ``noisy`` (the numpy engine's operations)."""
+    d = kf[f, s, y, x] if a == 0.0 else kf[f, s, y, x] * oma + kf[f + 1, s, y, x] * a
+    return d + dark[s, r, x] if noisy else d
+
+
+@njit(inline="always", cache=True)
+def _integrate_row(kf, f, a, oma, dark, noisy, acc, thr, out, s, y, r, b, width, signed,
+                   zero_reset):
+    """Integrate row ``y`` of scale ``s`` by its drive (:func:`_drive`), compare, fire,
+    reset (the numpy Integrator's rules); spikes into ``out[b, s, y]``. Indexes the arrays
+    directly (a row view costs numba two reference-count calls)."""
     if zero_reset:
         if signed:
             for x in range(width):
-                v = acc[x] + drive[x]
-                th = thr[x]
+                v = acc[s, y, x] + _drive(kf, f, a, oma, dark, noisy, s, y, r, x)
+                th = thr[s, y, x]
                 sp = np.int8(1) if v >= th else (np.int8(-1) if v <= -th else np.int8(0))
-                spikes[x] = sp
-                acc[x] = v if sp == 0 else 0.0
+                out[b, s, y, x] = sp
+                acc[s, y, x] = v if sp == 0 else 0.0
         else:
             for x in range(width):
-                v = acc[x] + drive[x]
-                fired = v >= thr[x]
-                spikes[x] = np.int8(1) if fired else np.int8(0)
-                acc[x] = 0.0 if fired else v
+                v = acc[s, y, x] + _drive(kf, f, a, oma, dark, noisy, s, y, r, x)
+                fired = v >= thr[s, y, x]
+                out[b, s, y, x] = np.int8(1) if fired else np.int8(0)
+                acc[s, y, x] = 0.0 if fired else v
     else:
         for x in range(width):
-            v = acc[x] + drive[x]
-            th = thr[x]
+            v = acc[s, y, x] + _drive(kf, f, a, oma, dark, noisy, s, y, r, x)
+            th = thr[s, y, x]
             if v >= th:
-                spikes[x] = 1
+                out[b, s, y, x] = 1
                 v = v - th
             elif signed and v <= -th:
-                spikes[x] = -1
+                out[b, s, y, x] = -1
                 v = v + th
             else:
-                spikes[x] = 0
-            acc[x] = v
+                out[b, s, y, x] = 0
+            acc[s, y, x] = v
+
+
+@njit(cache=True, error_model="numpy", pipeline_class=NoAliasCompiler)
+def _step_rows(kf, f, a, thr, acc, noisy, dark, y0, y1, signed, zero_reset, out, b):
+    """One step of rows ``y0 .. y1 - 1``, every scale (:func:`_integrate_row`; the tile's
+    dark current ``dark[s, y - y0]``). Compiled ``noalias``: every array argument is a
+    distinct allocation."""
+    num_scales = acc.shape[0]
+    width = acc.shape[2]
+    oma = 1.0 - a
+    for y in range(y0, y1):
+        for s in range(num_scales):
+            _integrate_row(kf, f, a, oma, dark, noisy, acc, thr, out, s, y, y - y0, b, width,
+                           signed, zero_reset)
 
 
 @njit(parallel=True, cache=True)
@@ -130,11 +158,7 @@ def _float_chunk(kf, fidx, aw, thr, acc, signed, zero_reset, noisy, key, t0, mea
         pad = np.zeros((rows + 2 * halo, width + 2 * halo))
         pairs = np.empty((halo + 1, rows + 2 * halo, width)) if noisy else np.empty((1, 1, 1))
         dark = np.empty((num_scales, rows, width)) if noisy else np.empty((1, 1, 1))
-        drive = np.empty(width)
         for b in range(num_steps):
-            f = fidx[b]
-            a = aw[b]
-            oma = 1.0 - a
             if noisy:
                 for r in range(rows + 2 * halo):
                     y = y0 - halo + r
@@ -142,22 +166,8 @@ def _float_chunk(kf, fidx, aw, thr, acc, signed, zero_reset, noisy, key, t0, mea
                         normal_row(key, t0 + b, y, width, mean, sd, zx, zr, pad[r], halo)
                 row_pairs(pad, rows + 2 * halo, halo, width, pairs)
                 _filter_rows(pairs, halo, rows, weights, halves, width, dark)
-            for r in range(rows):
-                y = y0 + r
-                for s in range(num_scales):
-                    k0 = kf[f, s, y]
-                    if a == 0.0:
-                        for x in range(width):
-                            drive[x] = k0[x]
-                    else:
-                        k1 = kf[f + 1, s, y]
-                        for x in range(width):
-                            drive[x] = k0[x] * oma + k1[x] * a
-                    if noisy:
-                        for x in range(width):
-                            drive[x] = drive[x] + dark[s, r, x]
-                    _integrate_row(acc[s, y], thr[s, y], drive, out[b, s, y], width,
-                                   signed, zero_reset)
+            _step_rows(kf, fidx[b], aw[b], thr, acc, noisy, dark, y0, y1, signed, zero_reset,
+                       out, b)
 
 
 def dark_current_stream(noise: NoiseParams | None, scene: Scene, num_scales: int
@@ -187,8 +197,9 @@ class FusedFloatSampler:
         self.scene = scene
         _, self.weights, self.halves, self.lmax = kernel_orbits(spec.kernels())
         self.weights = np.ascontiguousarray(self.weights, dtype=np.float64)
-        self.thr = np.ascontiguousarray(thresholds, dtype=np.float64)
-        self.acc = np.zeros_like(self.thr)
+        # on cache lines: no 8-lane load or store straddles two
+        self.thr = aligned_copy(np.asarray(thresholds, dtype=np.float64))
+        self.acc = aligned_copy(np.zeros_like(self.thr))
         self.signed = bool(spec.signed)
         self.zero_reset = config.reset == "zero"
         self.tile_rows = max(1, int(tile_rows))
