@@ -450,10 +450,10 @@ class RenderedFrames:
         b0 = f0 // RENDER_BATCH * RENDER_BATCH
         parts = [
             _render_batch(self.name, self.size, b, min(RENDER_BATCH, self.num_frames - b))
+            [max(f0 - b, 0):f1 - b]
             for b in range(b0, f1, RENDER_BATCH)
         ]
-        stack = parts[0] if len(parts) == 1 else np.concatenate(parts)
-        return stack[f0 - b0:f1 - b0]
+        return parts[0] if len(parts) == 1 else np.concatenate(parts)  # only frames asked for
 
 
 def render_frames(
