@@ -31,6 +31,24 @@ from rvsm.model.scene.scene import Scene
 DEFAULT_TILE_ROWS = 16
 
 
+def view_spans(scene: Scene, t0: int, t1: int) -> list[tuple[int, int]]:
+    """Steps ``t0 .. t1 - 1`` as consecutive ranges whose frames (:meth:`Scene.frame_span`)
+    the scene's source hands out without a copy: for a source with ``block_frames = B``
+    (:class:`rvsm.model.scene.library.RenderedFrames`), the steps between frames ``k B``
+    and ``(k + 1) B - 1`` in one range, those between frames ``(k + 1) B - 1`` and
+    ``(k + 1) B`` (two frames copied) in another; ``[(t0, t1)]`` for any other source."""
+    block = getattr(scene.frame_source, "block_frames", 0)
+    if block < 2 or t1 <= t0:
+        return [(t0, t1)]
+    m = scene.steps_per_frame
+    cuts = {t0, t1}
+    for f in range(t0 // m, (t1 - 1) // m + 1):
+        if f % block == block - 1:  # steps of frame f read frames f and f + 1
+            cuts.update(t for t in (f * m, (f + 1) * m) if t0 < t < t1)
+    edges = sorted(cuts)
+    return list(zip(edges[:-1], edges[1:], strict=True))
+
+
 def chunk_frames(scene: Scene, t0: int, t1: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """What a fused kernel needs for steps ``t0 .. t1 - 1``: the scene's frames the chunk
     touches ``(F, H, W)`` (read on demand, :meth:`Scene.frame_range`), each step's first
@@ -213,6 +231,18 @@ class FusedFloatSampler:
         """Spikes ``(t1 - t0, S, H, W) int8`` of steps ``t0 .. t1 - 1``."""
         if t0 != self.next_step:
             raise ValueError(f"chunks must be consecutive: expected step {self.next_step}")
+        s, h, w = self.acc.shape
+        if out is None:
+            out = np.empty((t1 - t0, s, h, w), dtype=np.int8)
+        # FSM reads the frames themselves: in ranges of steps whose frames are views (no
+        # copy of the chunk's frames); a filtering model copies them anyway
+        spans = view_spans(self.scene, t0, t1) if self.lmax == 0 else [(t0, t1)]
+        for u0, u1 in spans:
+            self._run(u0, u1, out[u0 - t0:u1 - t0])
+        self.next_step = t1
+        return out
+
+    def _run(self, t0: int, t1: int, out: np.ndarray) -> None:
         scene = self.scene
         frames, fidx, aw = chunk_frames(scene, t0, t1)
         if self.lmax == 0:  # FSM: 0 + 1.0 * v is v
@@ -225,14 +255,9 @@ class FusedFloatSampler:
                 self._padded = np.zeros((nf, h + 2 * self.lmax, w + 2 * self.lmax))
             kf = filter_frames(frames, self.weights, self.halves, self.lmax,
                                out=self._kf, padded=self._padded)
-        s, h, w = self.acc.shape
-        if out is None:
-            out = np.empty((t1 - t0, s, h, w), dtype=np.int8)
         _float_chunk(
             kf, fidx, aw,
             self.thr, self.acc, self.signed, self.zero_reset, self.noisy, self.key,
             int(t0), self.mean, self.sd, ZIG_X, ZIG_RATIO, self.weights, self.halves,
             self.lmax, self.tile_rows, out,
         )
-        self.next_step = t1
-        return out

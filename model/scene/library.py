@@ -437,6 +437,11 @@ class RenderedFrames:
     size: tuple[int, int]
     num_frames: int
 
+    #: A range within ``[k B, (k + 1) B)`` is a view of one cached batch (no copy); a
+    #: range crossing a multiple of ``B`` is copied. Read by
+    #: :meth:`rvsm.model.sampling.fused.FusedFloatSampler.run`.
+    block_frames = RENDER_BATCH
+
     @property
     def shape(self) -> tuple[int, int, int]:
         """``(F, H, W)``."""
