@@ -25,7 +25,7 @@ from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.sensor import NoiseParams, NoiseSource
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, check_coordinates, normal_row
 from rvsm.model.sampling.config import SamplerConfig
-from rvsm.model.sampling.row_sums import row_pairs, scale_sum
+from rvsm.model.sampling.row_sums import is_ladder, ladder_sum, row_pairs, scale_sum
 from rvsm.model.scene.scene import Scene
 
 DEFAULT_TILE_ROWS = 16
@@ -61,16 +61,24 @@ def chunk_frames(scene: Scene, t0: int, t1: int) -> tuple[np.ndarray, np.ndarray
 
 
 @njit(inline="always", cache=True)
-def _filter_rows(pairs, r0, nrows, weights, halves, width, out):
+def _filter_rows(pairs, r0, nrows, weights, halves, ladder, width, row, out):
     """``out[s, r, x]``: receptive sums of rows ``r0 .. r0 + nrows - 1`` of the padded
-    image whose row pairs are ``pairs`` (:func:`.row_sums.scale_sum`)."""
+    image whose row pairs are ``pairs``: :func:`.row_sums.ladder_sum` (every scale in one
+    pass, through ``row (S, W)``) if ``ladder``, else :func:`.row_sums.scale_sum` per
+    scale; the same sums bit for bit."""
     for r in range(nrows):
-        for s in range(weights.shape[0]):
-            scale_sum(pairs, r0 + r, weights[s], halves[s], width, out[s, r])
+        if ladder:
+            ladder_sum(pairs, r0 + r, pairs.shape[1], weights, width, row)
+            for s in range(weights.shape[0]):
+                for x in range(width):
+                    out[s, r, x] = row[s, x]
+        else:
+            for s in range(weights.shape[0]):
+                scale_sum(pairs, r0 + r, weights[s], halves[s], width, out[s, r])
 
 
 @njit(parallel=True, cache=True)
-def _filter_frames(padded, weights, halves, lmax, height, width, tile_rows, out):
+def _filter_frames(padded, weights, halves, ladder, lmax, height, width, tile_rows, out):
     num_frames = padded.shape[0]
     num_scales = weights.shape[0]
     num_tiles = (height + tile_rows - 1) // tile_rows
@@ -80,8 +88,9 @@ def _filter_frames(padded, weights, halves, lmax, height, width, tile_rows, out)
         rows = min(height, y0 + tile_rows) - y0
         pairs = np.empty((lmax + 1, rows + 2 * lmax, width))
         local = np.empty((num_scales, rows, width))
+        row = np.empty((num_scales, width))
         row_pairs(padded[f, y0:y0 + rows + 2 * lmax], rows + 2 * lmax, lmax, width, pairs)
-        _filter_rows(pairs, lmax, rows, weights, halves, width, local)
+        _filter_rows(pairs, lmax, rows, weights, halves, ladder, width, row, local)
         out[f, :, y0:y0 + rows] = local
 
 
@@ -100,7 +109,7 @@ def filter_frames(frames: np.ndarray, weights, halves, lmax: int, tile_rows: int
     if out is None or out.shape[0] < f:
         out = np.empty((f, weights.shape[0], h, w))
     out = out[:f]
-    _filter_frames(padded, weights, halves, lmax, h, w, tile_rows, out)
+    _filter_frames(padded, weights, halves, is_ladder(halves), lmax, h, w, tile_rows, out)
     return out
 
 
@@ -164,7 +173,7 @@ def _step_rows(kf, f, a, thr, acc, noisy, dark, y0, y1, signed, zero_reset, out,
 
 @njit(parallel=True, cache=True)
 def _float_chunk(kf, fidx, aw, thr, acc, signed, zero_reset, noisy, key, t0, mean, sd,
-                 zx, zr, weights, halves, lmax, tile_rows, out):
+                 zx, zr, weights, halves, ladder, lmax, tile_rows, out):
     num_scales, height, width = acc.shape
     num_steps = fidx.shape[0]
     num_tiles = (height + tile_rows - 1) // tile_rows
@@ -176,6 +185,7 @@ def _float_chunk(kf, fidx, aw, thr, acc, signed, zero_reset, noisy, key, t0, mea
         pad = np.zeros((rows + 2 * halo, width + 2 * halo))
         pairs = np.empty((halo + 1, rows + 2 * halo, width)) if noisy else np.empty((1, 1, 1))
         dark = np.empty((num_scales, rows, width)) if noisy else np.empty((1, 1, 1))
+        row = np.empty((num_scales, width))
         for b in range(num_steps):
             if noisy:
                 for r in range(rows + 2 * halo):
@@ -183,7 +193,7 @@ def _float_chunk(kf, fidx, aw, thr, acc, signed, zero_reset, noisy, key, t0, mea
                     if y >= 0 and y < height:
                         normal_row(key, t0 + b, y, width, mean, sd, zx, zr, pad[r], halo)
                 row_pairs(pad, rows + 2 * halo, halo, width, pairs)
-                _filter_rows(pairs, halo, rows, weights, halves, width, dark)
+                _filter_rows(pairs, halo, rows, weights, halves, ladder, width, row, dark)
             _step_rows(kf, fidx[b], aw[b], thr, acc, noisy, dark, y0, y1, signed, zero_reset,
                        out, b)
 
@@ -215,6 +225,7 @@ class FusedFloatSampler:
         self.scene = scene
         _, self.weights, self.halves, self.lmax = kernel_orbits(spec.kernels())
         self.weights = np.ascontiguousarray(self.weights, dtype=np.float64)
+        self.ladder = is_ladder(self.halves)
         # on cache lines: no 8-lane load or store straddles two
         self.thr = aligned_copy(np.asarray(thresholds, dtype=np.float64))
         self.acc = aligned_copy(np.zeros_like(self.thr))
@@ -259,5 +270,5 @@ class FusedFloatSampler:
             kf, fidx, aw,
             self.thr, self.acc, self.signed, self.zero_reset, self.noisy, self.key,
             int(t0), self.mean, self.sd, ZIG_X, ZIG_RATIO, self.weights, self.halves,
-            self.lmax, self.tile_rows, out,
+            self.ladder, self.lmax, self.tile_rows, out,
         )
