@@ -6,7 +6,11 @@ chunk touches are filtered once (:func:`filter_frames`, parallel over rows); the
 inside each tile loops over the chunk's steps with the tile's accumulators in cache:
 interpolate between filtered frames, add the filtered dark current (drawn inside the tile
 from the counter-based streams of :mod:`rvsm.model.noise.streams`, with a halo of ``L``
-rows), integrate, compare, fire, reset. Row sums are the shared kernels of :mod:`.row_sums`.
+rows), integrate, compare, fire, reset. Row sums are the shared kernels of :mod:`.row_sums`
+(:func:`.row_sums.ladder_sum` for ladder models). Each step of a tile is one call of
+:func:`_step_rows`, compiled ``noalias`` and indexing its arrays directly (no row views);
+accumulators and thresholds start on cache lines. FSM reads the frames themselves, so a
+chunk runs in :func:`view_spans`, ranges whose rendered frames are views (no copy).
 
 Every float operation is the one :mod:`.numpy_engine` does, in the same order (filtering
 in the orbit order of :mod:`rvsm.model.kernels.orbits`), and every pixel's arithmetic
