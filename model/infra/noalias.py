@@ -7,7 +7,8 @@ argument and stores through another never touch the same memory, and vectorises 
 over them without runtime alias checks (a loop reading 45 rows and writing 8 otherwise
 carries hundreds of pointer comparisons; with them, rows of 128 columns or fewer ran 2-5x
 slower per pixel). Only for functions whose array arguments are distinct allocations, never
-overlapping views of one array: :mod:`rvsm.model.events.ladder_kernels`. Results do not
+overlapping views of one array: :mod:`rvsm.model.events.ladder_kernels`,
+:func:`rvsm.model.sampling.fused._step_rows`. Results do not
 change (no reassociation: ``noalias`` only removes the checks). Imports numba: import it
 after :mod:`rvsm.model` (:mod:`.simd` chooses the vector width before numba loads).
 """

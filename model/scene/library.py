@@ -437,6 +437,11 @@ class RenderedFrames:
     size: tuple[int, int]
     num_frames: int
 
+    #: A range within ``[k B, (k + 1) B)`` is a view of one cached batch (no copy); a
+    #: range crossing a multiple of ``B`` is copied. Read by
+    #: :meth:`rvsm.model.sampling.fused.FusedFloatSampler.run`.
+    block_frames = RENDER_BATCH
+
     @property
     def shape(self) -> tuple[int, int, int]:
         """``(F, H, W)``."""
@@ -450,10 +455,10 @@ class RenderedFrames:
         b0 = f0 // RENDER_BATCH * RENDER_BATCH
         parts = [
             _render_batch(self.name, self.size, b, min(RENDER_BATCH, self.num_frames - b))
+            [max(f0 - b, 0):f1 - b]
             for b in range(b0, f1, RENDER_BATCH)
         ]
-        stack = parts[0] if len(parts) == 1 else np.concatenate(parts)
-        return stack[f0 - b0:f1 - b0]
+        return parts[0] if len(parts) == 1 else np.concatenate(parts)  # only frames asked for
 
 
 def render_frames(

@@ -12,8 +12,9 @@ from rvsm.model.kernels.orbits import kernel_orbits, orbit_receptive_sums
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES, model_spec
 from rvsm.model.noise.sensor import NoiseParams
 from rvsm.model.sampling.config import SamplerConfig
-from rvsm.model.sampling.fused import filter_frames
+from rvsm.model.sampling.fused import filter_frames, view_spans
 from rvsm.model.sampling.twin import sample, stream_float
+from rvsm.model.scene.library import RENDER_BATCH, builtin_scene
 from rvsm.model.scene.scene import Scene
 from rvsm.model.spikes.sinks import ArraySink, CountSink
 
@@ -38,6 +39,26 @@ def test_fused_equals_numpy_engine(model, noisy, reset):
     assert np.count_nonzero(ref) > 0
     if model in ("dog3", "dog4"):
         assert (ref < 0).any()  # the signed path is exercised
+
+
+def test_fsm_on_a_rendered_scene_runs_in_view_spans_and_equals_numpy_engine():
+    # 2.5 batches of frames, chunks of 40 steps: spans cut at every batch's last frame
+    scene = builtin_scene("flyball", size=(6, 9), num_frames=5 * RENDER_BATCH // 2,
+                          steps_per_frame=3)
+    spans = view_spans(scene, 40, 80)
+    assert spans[0][0] == 40 and spans[-1][1] == 80 and len(spans) > 1
+    assert all(a[1] == b[0] for a, b in zip(spans[:-1], spans[1:], strict=True))
+    for u0, u1 in view_spans(scene, 0, scene.num_steps):
+        f0, f1 = scene.frame_span(u0, u1)
+        assert f0 // RENDER_BATCH == (f1 - 1) // RENDER_BATCH or f1 - f0 == 2
+    assert view_spans(_scene(), 0, 15) == [(0, 15)]  # in-memory frames: one range
+    for reset in ("zero", "subtract"):
+        config = SamplerConfig(model="fsm", phi=40.0, reset=reset)
+        ref = sample(scene, config, engine="numpy").spikes
+        sink = ArraySink()
+        stream_float(scene, config, sink, chunk_steps=40)
+        np.testing.assert_array_equal(sink.spikes, ref)
+        assert np.count_nonzero(ref) > 0
 
 
 def test_hold_mode_per_scale_thresholds_and_zero_thresholds():
