@@ -50,7 +50,7 @@ from rvsm.model.infra.noalias import NoAliasCompiler
 from rvsm.model.infra.simd import aligned_copy
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, normal_row
-from rvsm.model.sampling.fused import chunk_frames, dark_current_stream
+from rvsm.model.sampling.fused import check_chunk, chunk_frames, dark_current_stream
 from rvsm.model.sampling.row_sums import is_ladder, ladder_sum, scale_sum
 from rvsm.model.scene.scene import Scene
 
@@ -240,10 +240,7 @@ class FusedEventSampler:
 
     def run(self, t0: int, t1: int, out: np.ndarray | None = None) -> np.ndarray:
         """Events ``(t1 - t0, S, H, W) int8`` of steps ``t0 .. t1 - 1``."""
-        if t0 != self.next_step:
-            raise ValueError(f"chunks must be consecutive: expected step {self.next_step}")
-        if t1 > self.scene.num_steps:  # the kernel indexes frames unchecked
-            raise ValueError(f"step {t1 - 1} is past the scene's {self.scene.num_steps} steps")
+        check_chunk(self.scene, t0, t1, self.next_step)
         s, h, w = self.thr.shape
         if out is None:
             out = np.empty((t1 - t0, s, h, w), dtype=np.int8)

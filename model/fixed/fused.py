@@ -33,7 +33,7 @@ from rvsm.model.fixed.widths import signed_range
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.orbits import kernel_orbits
 from rvsm.model.noise.streams import ZIG_RATIO, ZIG_X, check_coordinates, pixel_normal
-from rvsm.model.sampling.fused import DEFAULT_TILE_ROWS, chunk_frames
+from rvsm.model.sampling.fused import DEFAULT_TILE_ROWS, check_chunk, chunk_frames
 from rvsm.model.sampling.row_sums import row_pairs, scale_sum
 from rvsm.model.scene.scene import Scene
 
@@ -297,8 +297,7 @@ class FusedFixedTwin:
 
     def run(self, t0: int, t1: int, out: np.ndarray | None = None) -> np.ndarray:
         """Spikes ``(t1 - t0, S, H, W) int8`` of steps ``t0 .. t1 - 1``."""
-        if t0 != self.next_step:
-            raise ValueError(f"chunks must be consecutive: expected step {self.next_step}")
+        check_chunk(self.scene, t0, t1, self.next_step)
         frames, fidx, aw = chunk_frames(self.scene, t0, t1)
         s, h, w = self.acc.shape
         if out is None:

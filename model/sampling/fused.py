@@ -53,6 +53,16 @@ def view_spans(scene: Scene, t0: int, t1: int) -> list[tuple[int, int]]:
     return list(zip(edges[:-1], edges[1:], strict=True))
 
 
+def check_chunk(scene: Scene, t0: int, t1: int, next_step: int) -> None:
+    """``ValueError`` unless steps ``t0 .. t1 - 1`` continue at ``next_step`` and lie in
+    the scene: the fused kernels index frames unchecked (a step past the scene would read
+    past its frames)."""
+    if t0 != next_step:
+        raise ValueError(f"chunks must be consecutive: expected step {next_step}")
+    if t1 > scene.num_steps:
+        raise ValueError(f"step {t1 - 1} is past the scene's {scene.num_steps} steps")
+
+
 def chunk_frames(scene: Scene, t0: int, t1: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """What a fused kernel needs for steps ``t0 .. t1 - 1``: the scene's frames the chunk
     touches ``(F, H, W)`` (read on demand, :meth:`Scene.frame_range`), each step's first
@@ -244,8 +254,7 @@ class FusedFloatSampler:
 
     def run(self, t0: int, t1: int, out: np.ndarray | None = None) -> np.ndarray:
         """Spikes ``(t1 - t0, S, H, W) int8`` of steps ``t0 .. t1 - 1``."""
-        if t0 != self.next_step:
-            raise ValueError(f"chunks must be consecutive: expected step {self.next_step}")
+        check_chunk(self.scene, t0, t1, self.next_step)
         s, h, w = self.acc.shape
         if out is None:
             out = np.empty((t1 - t0, s, h, w), dtype=np.int8)

@@ -135,3 +135,25 @@ def test_bad_engine_and_chunking_are_refused():
         sample(scene, SamplerConfig(model="fsm"), engine="gpu")
     with pytest.raises(RvsmError, match="chunk_steps"):
         stream_float(scene, SamplerConfig(model="fsm"), ArraySink(), chunk_steps=0)
+
+
+@pytest.mark.parametrize("model", ["fsm", "dog2"])
+def test_fused_engines_refuse_steps_past_the_scene(model) -> None:
+    """The fused kernels (float and fixed) index frames unchecked: a range past the
+    scene's steps, or one that does not continue the last, is refused."""
+    from rvsm.model.fixed.design_point import default_design_point
+    from rvsm.model.fixed.fused import FusedFixedTwin
+    from rvsm.model.sampling.config import accumulator_thresholds
+    from rvsm.model.sampling.fused import FusedFloatSampler
+
+    scene = builtin_scene("flyball", size=(8, 12), num_frames=2)
+    config = SamplerConfig(model)
+    point = default_design_point().with_size(8, 12)
+    engines = [FusedFloatSampler(scene, config, accumulator_thresholds(config, scene.shape)),
+               FusedFixedTwin(scene, point, point.integer_thresholds())]
+    for engine in engines:
+        with pytest.raises(ValueError, match="past the scene"):
+            engine.run(0, scene.num_steps + 1)
+        with pytest.raises(ValueError, match="consecutive"):
+            engine.run(1, 2)
+        assert engine.run(0, scene.num_steps).shape[0] == scene.num_steps
