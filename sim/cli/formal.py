@@ -13,6 +13,11 @@ from rvsm.sim.cli.args import sized_contract
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 from rvsm.sim.cli.rtl import add_arch_arguments, arch_options
 
+#: The most pixels ``rvsm formal`` takes: solvers handle tiny arrays only (a 3x3
+#: parallel array needs about 2 minutes to prove; docs/formal.md), so a full-size point
+#: without ``--size`` is refused instead of starting a run that cannot finish.
+MAX_FORMAL_PIXELS = 64
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``formal`` sub-command."""
@@ -66,6 +71,10 @@ def _formal(args: argparse.Namespace) -> int:
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be positive, got {args.timeout}")
     point, contract = sized_contract(args.point, args.size, arch, options)
+    if contract.height * contract.width > MAX_FORMAL_PIXELS:
+        raise RvsmError(f"rvsm formal checks tiny arrays (at most {MAX_FORMAL_PIXELS} "
+                        f"pixels); this one is {contract.height}x{contract.width}: pass "
+                        "--size, for example --size 3x4 --lanes 2")
     if args.model is not None and args.model != point.model:
         if point.scale_phi is not None:
             raise RvsmError(f"--model {args.model}: the point sets per-scale thresholds "

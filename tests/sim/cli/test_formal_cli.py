@@ -71,6 +71,7 @@ def test_unreached_cover_is_exit_1(formal, capsys: pytest.CaptureFixture) -> Non
     (("--depth", "0"), "--depth"),
     (("--check", "nope"), "unknown formal check"),
     (("--lanes", "2"), "lanes"),
+    (("--size", "8x10"), "tiny arrays"),
 ])
 def test_bad_input_is_exit_2(formal, tmp_path: Path, capsys: pytest.CaptureFixture,
                              extra: tuple[str, ...], message: str) -> None:
@@ -137,3 +138,16 @@ def test_stream_bad_input_is_exit_2(formal_point_toml: Path, tmp_path: Path,
         status = exc.code
     assert status == 2
     assert message in capsys.readouterr().err
+
+
+def test_full_size_point_is_refused_at_once(tmp_path: Path,
+                                            capsys: pytest.CaptureFixture) -> None:
+    """A point without a tiny size (here: a file of only a comment, the default 250x400)
+    is refused with one line before any solver starts; no output folder is made."""
+    point = tmp_path / "point.toml"
+    point.write_text("# rvsm fixed-point design point\n")
+    out = tmp_path / "out"
+    assert main(["formal", str(point), "--arch", "stream", "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "tiny arrays" in err and "250x400" in err and len(err.splitlines()) == 1
+    assert not out.exists()
