@@ -18,14 +18,14 @@ from __future__ import annotations
 import hashlib
 from collections.abc import Mapping, Sequence
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.versions import rvsm_version
 
 __all__ = ["DEFAULT_CLOCK_MHZ", "LINT_WAIVER_RULES", "TIMESCALE", "design_point_digest",
            "fusesoc_core", "header", "provenance", "sdc_constraints", "verilator_waivers"]
 
 #: The time unit and precision written at the top of every generated Verilog file (the
-#: co-simulation's cocotb builds use the same, ``sim/cosim/cocotb_adapter.py``).
+#: co-simulation's cocotb builds use the same, ``sim/cosim/builds/cocotb_adapter.py``).
 TIMESCALE = "`timescale 1ns/1ps"
 
 #: The clock of the constraints template when none is given: the target of issue 21.
@@ -63,7 +63,7 @@ def provenance(contract: ArrayContract, arch: str, options: Mapping[str, int], t
                command: str | None = None) -> dict:
     """What made the files: ``rvsm`` version, ``design_point_digest``, ``rtl_digest``,
     ``arch``, ``options``, ``top``, ``command`` (``None``: a library call). No date."""
-    from rvsm.rtl.digest import rtl_digest
+    from rvsm.rtl.rtl_digest import rtl_digest
 
     return {"generator": "rvsm", "rvsm_version": rvsm_version(),
             "design_point_digest": design_point_digest(contract),

@@ -1,5 +1,5 @@
 """Verilog generation, port map, Verilator lint and yosys synthesis statistics, for every
-registered architecture (:mod:`rvsm.rtl.architectures`).
+registered architecture (:mod:`rvsm.rtl.registry`).
 
 * :func:`generate_verilog` converts an architecture's component with Amaranth's bundled
   (WebAssembly) yosys, ``emit_src=False`` (no source-location attributes), and leaves
@@ -35,12 +35,10 @@ from pathlib import Path
 from amaranth.back import verilog as amaranth_verilog
 from amaranth.lib import wiring
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError, ToolError
-from rvsm.model.infra.tools import ToolFailure, run_tool
-from rvsm.rtl.architecture import Architecture
-from rvsm.rtl.architectures import get_architecture
+from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.flow_files import (
     DEFAULT_CLOCK_MHZ,
     TIMESCALE,
@@ -51,6 +49,8 @@ from rvsm.rtl.flow_files import (
     verilator_waivers,
 )
 from rvsm.rtl.ports import verilog_ports
+from rvsm.rtl.registry import get_architecture
+from rvsm.rtl.toolchain import ToolFailure, run_tool
 
 __all__ = [
     "OUTPUT_SUFFIXES",
@@ -227,7 +227,7 @@ def verilator_lint(verilog_path: str | os.PathLike, top: str | None = None) -> s
     ``top`` defaults to the file's name without ``.v`` (as :func:`write_outputs` names it).
 
     Raises :class:`RvsmError` (with the output) if Verilator reports anything, a
-    :class:`~rvsm.model.infra.tools.ToolFailure` if it crashes or is killed.
+    :class:`~rvsm.rtl.toolchain.ToolFailure` if it crashes or is killed.
     """
     env = verilator_env()
     path = Path(verilog_path).resolve()
@@ -292,7 +292,7 @@ def yosys_stats(verilog_path: str | os.PathLike, top: str | None = None) -> dict
     "memories", "memory_bits", "memory_list", "cell_types", "seconds"}`` (``cells``
     counts each memory as one cell; ``memory_list``: name, words, width). Raises
     :class:`RvsmError` if ``yosys`` is missing, a
-    :class:`~rvsm.model.infra.tools.ToolFailure` (exit 3) if it fails or is killed.
+    :class:`~rvsm.rtl.toolchain.ToolFailure` (exit 3) if it fails or is killed.
     """
     exe = shutil.which("yosys")
     if exe is None:

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint, default_design_point
 from rvsm.model.fixed.weights import model_contract as weights_model_contract
 
@@ -53,7 +53,7 @@ def small_contract() -> Callable[..., ArrayContract]:
 
 
 class AmaranthSim:
-    """Runs test benches through :func:`rvsm.rtl.simulation.run_simulation`."""
+    """Runs test benches through :func:`rvsm.rtl.amaranth_sim.run_simulation`."""
 
     def __init__(self, waves_dir: Path | None, test_name: str) -> None:
         self.waves_dir = waves_dir
@@ -70,7 +70,7 @@ class AmaranthSim:
 
     def run(self, dut: object, bench: Callable[[object], Awaitable[None]]) -> None:
         """Simulate ``dut`` with ``bench(ctx)`` as its test bench until the bench returns."""
-        from rvsm.rtl.simulation import run_simulation
+        from rvsm.rtl.amaranth_sim import run_simulation
 
         run_simulation(dut, bench, self.vcd_path())
 

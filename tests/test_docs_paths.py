@@ -53,9 +53,9 @@ def test_quoted_paths_and_names_exist(doc: Path) -> None:
 
 def test_a_stale_reference_is_found(tmp_path: Path) -> None:
     doc = tmp_path / "x.md"
-    doc.write_text("see `model/fixed/core.py` and `rvsm.model.fixed.core.ArrayContract`\n"
-                   "gone: `model/samplers.py`, `rvsm.model.fixed.core.NoSuchThing`,"
+    doc.write_text("see `model/fixed/contract.py` and `rvsm.model.fixed.contract.ArrayContract`\n"
+                   "gone: `model/samplers.py`, `rvsm.model.fixed.contract.NoSuchThing`,"
                    " `rvsm.model.nosuchmodule`\n")
     assert stale_references(doc) == ["2: model/samplers.py",
-                                     "2: rvsm.model.fixed.core.NoSuchThing",
+                                     "2: rvsm.model.fixed.contract.NoSuchThing",
                                      "2: rvsm.model.nosuchmodule"]

@@ -181,7 +181,7 @@ def describe(cycle: list[Arrow]) -> str:
 def test_every_module_is_walked():
     modules = module_files(PACKAGES)
     assert {"rvsm.model", "rvsm.rtl", "rvsm.sim", "rvsm.sim.cli.main",
-            "rvsm.model.fixed.core"} <= set(modules)
+            "rvsm.model.fixed.contract"} <= set(modules)
     arrows = all_arrows(PACKAGES)
     assert len(modules) > 90 and len(arrows) > 200
     assert {layer(a.source) for a in arrows} == {0, 1, 2}

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rvsm.model.fixed.core import (
+from rvsm.model.fixed.contract import (
     ArrayContract,
     FixedEventIntegrator,
     FixedIntegrator,

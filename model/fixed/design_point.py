@@ -26,7 +26,7 @@ import numpy as np
 
 from rvsm.model.events.config import DEFAULT_CONTRAST, EventConfig
 from rvsm.model.fixed.adc import ADC_CLIPS, ROUNDINGS, adc_gain
-from rvsm.model.fixed.core import SENSORS, ArrayContract
+from rvsm.model.fixed.contract import SENSORS, ArrayContract
 from rvsm.model.fixed.fields import (
     Choice,
     Field,

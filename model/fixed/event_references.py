@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rvsm.model.fixed.core import arithmetic_shift, integer_receptive_sums
+from rvsm.model.fixed.contract import arithmetic_shift, integer_receptive_sums
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.numpy_engine import step_codes
 from rvsm.model.fixed.widths import signed_range

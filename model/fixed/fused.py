@@ -14,7 +14,7 @@ per-step sum and accumulator value exactly (:func:`exact_dtype`, checked from th
 contract): float32 when they stay below ``2**24`` (the default design point: twice the
 SIMD lanes of float64), float64 below ``2**53``, otherwise int64; floats hold integers
 exactly in those ranges and their loops vectorise. Either way the spikes and the datapath
-statistics are the integers of :func:`rvsm.model.fixed.core.run_integer_array`, for any
+statistics are the integers of :func:`rvsm.model.fixed.contract.run_integer_array`, for any
 tile size, chunk length and thread count.
 
 Every inner loop indexes slices with the loop variable alone (``row[x]``, never

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from rvsm.model.fixed.adc import adc_codes, log_adc_codes
-from rvsm.model.fixed.core import (
+from rvsm.model.fixed.contract import (
     arithmetic_shift,
     bit_length_histogram,
     integer_receptive_sums,

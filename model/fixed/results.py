@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rvsm.model.events.config import event_meta
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.sampling.config import sampling_meta
 from rvsm.model.scene.scene import Scene

@@ -1,7 +1,7 @@
 """RTL stimulus: exactly what the fixed twin saw, and what it answered (SPEC section 5).
 
 One format from the fixed twin to the RTL: ``rvsm stimulus`` writes it, the cocotb
-testbench (:mod:`rvsm.sim.cosim.tb_array`) drives the RTL from it, and
+testbench (:mod:`rvsm.sim.cosim.testbenches.tb_parallel`) drives the RTL from it, and
 ``rvsm verify --stimulus FILE`` replays it. A stimulus file (``.npz``, no pickles) holds:
 
 - ``codes``: ``(T, H, W) uint16`` ADC codes, the per-step input of the array;
@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 import numpy.lib.format as npformat
 
-from rvsm.model.fixed.core import SENSORS, ArrayContract
+from rvsm.model.fixed.contract import SENSORS, ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
 from rvsm.model.fixed.twin import simulate_fixed

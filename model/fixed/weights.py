@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from rvsm.model.fixed.adc import quantise
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.widths import signed_range
 from rvsm.model.kernels.receptive_fields import model_spec
 

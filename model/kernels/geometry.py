@@ -9,9 +9,9 @@ weights are constant on each *orbit* ``(a, b)``, ``0 <= b <= a``: the taps
 ``(a, a)``, 8 otherwise). Orbits are listed in the order ``a = 0..L``, ``b = 0..a``.
 
 Used by the float twin (:mod:`rvsm.model.kernels.orbits`), the fixed twin
-(:func:`rvsm.model.fixed.core.integer_receptive_sums`), the RTL sums
+(:func:`rvsm.model.fixed.contract.integer_receptive_sums`), the RTL sums
 (:mod:`rvsm.rtl.stream.pipelined_sum`) and the FPGA state-memory arithmetic
-(:mod:`rvsm.rtl.fpga.sensor`).
+(:mod:`rvsm.rtl.fpga.camera`).
 """
 
 from __future__ import annotations

@@ -34,13 +34,12 @@ from amaranth.back import rtlil as amaranth_rtlil
 from amaranth.back import verilog as amaranth_verilog
 from amaranth.lib import wiring
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.infra.tools import Progress, find_tool, kill_all, run_tool
-from rvsm.rtl.architecture import Architecture
-from rvsm.rtl.architectures import DEFAULT_ARCHITECTURE, get_architecture
+from rvsm.rtl.capabilities import Architecture
+from rvsm.rtl.fpga.camera import state_memory
 from rvsm.rtl.fpga.devices import Device, get_device
 from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM
 from rvsm.rtl.fpga.harness import IoHarness
@@ -51,8 +50,9 @@ from rvsm.rtl.fpga.report import (
     parse_nextpnr_report,
     parse_yosys_stat,
 )
-from rvsm.rtl.fpga.sensor import state_memory
-from rvsm.rtl.fpga.tools import follower
+from rvsm.rtl.fpga.tool_logs import follower
+from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, get_architecture
+from rvsm.rtl.toolchain import Progress, find_tool, kill_all, run_tool
 from rvsm.rtl.verilog import strip_zero_memory_init
 
 __all__ = [
@@ -254,7 +254,7 @@ def run_fpga(
 
     ``point`` is the sensor (its height and width give the camera arithmetic and the
     state memory); ``size`` (H, W) overrides the size of the array actually built;
-    ``arch`` names a registered architecture (:mod:`rvsm.rtl.architectures`), ``lanes``
+    ``arch`` names a registered architecture (:mod:`rvsm.rtl.registry`), ``lanes``
     its option (``None``: not given); ``build`` replaces the architecture's component by
     ``build(contract, lanes)`` (e.g. an IP wrapper around the array; ``arch`` still
     names the report's architecture). ``memory``: see :func:`synthesise`.

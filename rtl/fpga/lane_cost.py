@@ -12,7 +12,7 @@ its memory grows with the array and hardly with ``P``. So a design point's cost 
   subtracted (exact), and
   ``lut4_base`` the logic at zero lanes (control, address counters) by extrapolation;
 * **memory bits** -- exact, from the design point at its own (sensor) size
-  (:class:`~rvsm.rtl.fpga.sensor.StateMemory`): accumulators, thresholds, line buffers;
+  (:class:`~rvsm.rtl.fpga.camera.StateMemory`): accumulators, thresholds, line buffers;
 * optionally **Fmax** -- nextpnr-ecp5 place and route of the ``P1`` array (minutes).
 """
 
@@ -28,10 +28,10 @@ from typing import Any
 
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.infra.tools import Progress
+from rvsm.rtl.fpga.camera import state_memory
 from rvsm.rtl.fpga.devices import get_device
 from rvsm.rtl.fpga.flow import build_component, place_and_route, synthesise
-from rvsm.rtl.fpga.sensor import state_memory
+from rvsm.rtl.toolchain import Progress
 
 __all__ = ["DEFAULT_LANES", "DEFAULT_SIZE", "LaneCost", "LaneSynthesis", "combine_lanes",
            "lane_cost", "lane_synthesis", "logic_lut4"]

@@ -19,14 +19,14 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from rvsm.model.infra.errors import ToolError
-from rvsm.rtl.fpga.devices import Device
-from rvsm.rtl.fpga.sensor import (
+from rvsm.rtl.fpga.camera import (
     CAMERA_STEP_HZ,
     StateMemory,
     clock_needed_hz,
     cycles_per_step,
     lanes_needed,
 )
+from rvsm.rtl.fpga.devices import Device
 
 __all__ = [
     "CriticalPath",

@@ -1,4 +1,4 @@
-"""The AXI IP as an :class:`~rvsm.rtl.architecture.Architecture` value (not registered).
+"""The AXI IP as an :class:`~rvsm.rtl.capabilities.Architecture` value (not registered).
 
 :data:`STREAM_AXIS` is what ``rvsm verilog --interface axis`` generates: the streaming
 array inside :class:`~rvsm.rtl.ip.wrapper.RvsmAxisIp`, options ``lanes`` and
@@ -15,16 +15,16 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.architecture import Architecture, Option
+from rvsm.rtl.capabilities import Architecture, Option
 from rvsm.rtl.ip.axi_lite import AxiLiteSignature
 from rvsm.rtl.ip.axis import spike_tdata_layout, video_lane_bits
 from rvsm.rtl.ip.drive import decode_output, simulate_ip
 from rvsm.rtl.ip.register_map import regs_c_header, regs_json, regs_markdown
 from rvsm.rtl.ip.wrapper import IP_ARCH, RvsmAxisIp
 from rvsm.rtl.ports import port_map
-from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, check_beats
 
 __all__ = ["INTERFACES", "STREAM_AXIS", "interface_architecture", "ip_port_map"]
@@ -175,7 +175,7 @@ STREAM_AXIS = Architecture(
     notes=_notes,
     simulate=simulate_axis,
     compare=_compare,
-    testbench="rvsm.sim.cosim.tb_axis",
+    testbench="rvsm.sim.cosim.testbenches.tb_axis",
     extra_outputs=_extra_outputs,
     extra_suffixes=(".regs.md", ".regs.json", ".regs.h"),
 )

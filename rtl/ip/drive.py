@@ -17,11 +17,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
+from rvsm.rtl.amaranth_sim import run_simulation
 from rvsm.rtl.ip.axis import spike_tdata_layout, video_lane_bits
 from rvsm.rtl.ip.register_map import RegisterMap
 from rvsm.rtl.ip.wrapper import RvsmAxisIp
-from rvsm.rtl.simulation import run_simulation
 from rvsm.rtl.stream.drive import threshold_writes
 from rvsm.rtl.stream.schedule import OutputBeats, StreamSchedule, pack_lanes
 

@@ -20,9 +20,9 @@ import json
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.signatures import field_bits, threshold_word_bits
 
 __all__ = ["ACCESS", "ID_MAGIC", "Field", "Register", "RegisterMap", "ip_register_map",

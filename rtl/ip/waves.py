@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.weights import model_contract
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.rtl.ip.drive import (

@@ -53,16 +53,16 @@ from amaranth.lib import wiring
 from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.wiring import In, Out
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.versions import rvsm_version
-from rvsm.rtl.digest import rtl_digest
 from rvsm.rtl.flow_files import design_point_digest
 from rvsm.rtl.ip.axi_lite import AxiLiteRegisters, AxiLiteSignature
 from rvsm.rtl.ip.axis import AxiStreamSignature, spike_tdata_layout, video_lane_bits
 from rvsm.rtl.ip.register_map import ADDR_BITS, RegisterMap, ip_register_map
+from rvsm.rtl.rtl_digest import rtl_digest
 from rvsm.rtl.stream.array import RvsmStreamArray
-from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.signatures import top_threshold_word
 
 __all__ = ["IP_ARCH", "RvsmAxisIp"]

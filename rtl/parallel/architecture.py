@@ -1,15 +1,15 @@
-"""The fully parallel array as a registered :class:`~rvsm.rtl.architecture.Architecture`."""
+"""The fully parallel array as a registered :class:`~rvsm.rtl.capabilities.Architecture`."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.architecture import Architecture
+from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.parallel.array import RvsmArray
 from rvsm.rtl.parallel.drive import compare_spikes, simulate
-from rvsm.rtl.parallel.formal import parallel_properties
+from rvsm.rtl.parallel.harnesses import parallel_properties
 from rvsm.rtl.ports import port_map
 
 __all__ = ["MAX_SIDE", "PARALLEL", "check_size"]
@@ -55,6 +55,6 @@ PARALLEL = Architecture(
     notes=lambda dut: [],
     simulate=simulate,
     compare=_compare,
-    testbench="rvsm.sim.cosim.tb_array",
+    testbench="rvsm.sim.cosim.testbenches.tb_parallel",
     formal={"properties": parallel_properties},
 )

@@ -32,7 +32,7 @@ from amaranth.hdl import Module, Signal, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.widths import index_bits, unsigned_max
 from rvsm.rtl.interfaces import ThresholdWriteSignature
 from rvsm.rtl.mutations import check_mutation

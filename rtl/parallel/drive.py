@@ -11,9 +11,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
+from rvsm.rtl.amaranth_sim import run_simulation
 from rvsm.rtl.parallel.array import RvsmArray
-from rvsm.rtl.simulation import run_simulation
 
 __all__ = ["compare_spikes", "simulate"]
 

@@ -3,7 +3,7 @@
 The cell is independent of how its input sum is produced; the fully parallel
 :class:`~rvsm.rtl.parallel.array.RvsmArray` builds one per (scale, pixel). (The streaming
 array keeps its accumulators in memories and has its own tail.)
-Per strobe it implements steps 2..5 of the contract (:mod:`rvsm.model.fixed.core`)::
+Per strobe it implements steps 2..5 of the contract (:mod:`rvsm.model.fixed.contract`)::
 
     shifted = sum_in >>> shift                         (arithmetic, floor)
     sat     = clamp(acc + shifted, -2**(W-1), 2**(W-1)-1)
@@ -44,7 +44,7 @@ class PixelCell(wiring.Component):
     In(ThresholdWriteSignature(W-1)): ``thr.we``, ``thr.data``; ``spike_pos``,
     ``spike_neg`` Out(1), registered, valid :attr:`LATENCY` cycles after the strobe;
     ``acc`` Out(signed(W)) and ``threshold`` Out(unsigned(W-1)) for observation (the
-    formal harness :mod:`rvsm.rtl.parallel.formal`). ``mutation``: a deliberate bug of
+    formal harness :mod:`rvsm.rtl.parallel.harnesses`). ``mutation``: a deliberate bug of
     :mod:`rvsm.rtl.mutations` (``parallel.*``) or None.
     """
 

@@ -1,17 +1,17 @@
-"""The streaming array as a registered :class:`~rvsm.rtl.architecture.Architecture`."""
+"""The streaming array as a registered :class:`~rvsm.rtl.capabilities.Architecture`."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
-from rvsm.rtl.architecture import Architecture, Option
+from rvsm.model.fixed.contract import ArrayContract
+from rvsm.rtl.capabilities import Architecture, Option
 from rvsm.rtl.ports import port_map
 from rvsm.rtl.stream.array import RvsmStreamArray
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.drive import simulate
-from rvsm.rtl.stream.formal import PROPERTY_GROUPS, stream_check, stream_equivalence
 from rvsm.rtl.stream.formal_lemmas import composed_equivalence, sum_lemma, window_lemma
-from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.harnesses import PROPERTY_GROUPS, stream_check, stream_equivalence
 from rvsm.rtl.stream.schedule import OutputBeats, check_beats
 
 __all__ = ["STREAM", "stream_port_map"]
@@ -99,7 +99,7 @@ STREAM = Architecture(
     notes=_notes,
     simulate=simulate,
     compare=_compare,
-    testbench="rvsm.sim.cosim.tb_stream",
+    testbench="rvsm.sim.cosim.testbenches.tb_stream",
     formal={**{group: stream_check(group) for group in PROPERTY_GROUPS},
             "equivalence": stream_equivalence, "window": window_lemma, "sums": sum_lemma,
             "composed": composed_equivalence},

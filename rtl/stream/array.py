@@ -83,11 +83,11 @@ from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM, kept_register
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.stream.banked_memory import BankedMemory
-from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.pipelined_sum import Pipeline, Timed
 from rvsm.rtl.stream.schedule import StreamSchedule
 from rvsm.rtl.stream.signatures import (
@@ -143,7 +143,7 @@ class _Tail:
 
 @dataclass
 class StreamProbes:
-    """Internal signals a formal harness observes (:mod:`rvsm.rtl.stream.formal`), set
+    """Internal signals a formal harness observes (:mod:`rvsm.rtl.stream.harnesses`), set
     when the array is elaborated: ``advance`` (the pipeline steps at this edge),
     ``clear`` (the registered clear that flushes it), the accumulator memories' read
     (``acc_read_addr`` sampled at an ``advance`` edge where ``acc_read_valid``) and

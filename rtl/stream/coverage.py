@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.kernels.geometry import kernel_radius
 
 __all__ = ["BorderCoverage"]

@@ -14,10 +14,10 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
-from rvsm.rtl.simulation import run_simulation
+from rvsm.model.fixed.contract import ArrayContract
+from rvsm.rtl.amaranth_sim import run_simulation
 from rvsm.rtl.stream.array import RvsmStreamArray
-from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.protocol import ProtocolScript
 from rvsm.rtl.stream.schedule import OutputBeats, pack_lanes
 from rvsm.rtl.stream.signatures import threshold_word_bits

@@ -1,7 +1,7 @@
 """The compositional form of the streaming array's bounded equivalence (``rvsm formal
 --arch stream --check window sums composed``).
 
-The end-to-end miter (:class:`~rvsm.rtl.stream.formal.StreamEquivalence`) makes the
+The end-to-end miter (:class:`~rvsm.rtl.stream.harnesses.StreamEquivalence`) makes the
 solver prove, at every compared position of both frames, that the stream's pipelined
 receptive sums (orbit sums shared by the scales, retimed CSD trees:
 :mod:`rvsm.rtl.stream.pipelined_sum`) equal the parallel array's (equal-weight groups,
@@ -15,7 +15,7 @@ Three checks cut the proof at the window register:
   outside the array (the line buffer, the slabs and the padding masks). Bounded to the
   equivalence's depth, same inputs (back to back, no clear).
 * ``sums`` (:class:`StreamSumLemma`): the circuit the array builds from its window
-  (:meth:`~rvsm.rtl.stream.geometry.StreamGeometry.stage_q_sums`), fed free codes with
+  (:meth:`~rvsm.rtl.stream.dimensions.StreamGeometry.stage_q_sums`), fed free codes with
   the cells outside the array at 0 around each position in turn, gives at stage Q
   exactly the parallel array's sum of that pixel: :func:`~rvsm.rtl.receptive_sum.weighted_sum`
   over :func:`~rvsm.rtl.parallel.array.receptive_taps`, the expression
@@ -44,16 +44,16 @@ import os
 from amaranth.asserts import AnySeq
 from amaranth.hdl import Array, Cat, Const, Module, Mux, Signal
 
-from rvsm.model.fixed.core import ArrayContract
-from rvsm.rtl.architecture import require_spike_sensor
-from rvsm.rtl.formal import ElaborateAfter, FormalHarness, Property
+from rvsm.model.fixed.contract import ArrayContract
+from rvsm.rtl.capabilities import require_spike_sensor
+from rvsm.rtl.formal_harness import ElaborateAfter, FormalHarness, Property
 from rvsm.rtl.linear_form import linear_form
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.array import RvsmArray, accumulator_index, receptive_taps
 from rvsm.rtl.receptive_sum import weighted_sum
 from rvsm.rtl.stream.array import RvsmStreamArray, StreamProbes
-from rvsm.rtl.stream.formal import StreamEquivalence, _StreamHarness
-from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.dimensions import StreamGeometry
+from rvsm.rtl.stream.harnesses import StreamEquivalence, _StreamHarness
 from rvsm.rtl.stream.pipelined_sum import Pipeline, Timed
 
 __all__ = ["ComposedEquivalence", "StreamSumLemma", "StreamWindowLemma",

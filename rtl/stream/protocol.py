@@ -23,7 +23,7 @@ applied in numpy:
   ``p + threshold_lag``: a write at an earlier edge is seen, one at that edge is not;
 * released positions of a frame cut by a clear are those whose window had arrived, so
   the contract's integrator over the segment's frames (with the thresholds each position
-  read; :func:`~rvsm.model.fixed.core.make_integrator`, either sensor) gives every spike.
+  read; :func:`~rvsm.model.fixed.contract.make_integrator`, either sensor) gives every spike.
 """
 
 from __future__ import annotations
@@ -34,14 +34,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rvsm.model.fixed.core import (
+from rvsm.model.fixed.contract import (
     ArrayContract,
     arithmetic_shift,
     integer_receptive_sums,
     make_integrator,
 )
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, pack_lanes
 from rvsm.rtl.stream.signatures import threshold_word_bits
 

@@ -21,12 +21,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.weights import model_contract
-from rvsm.rtl.simulation import run_simulation
+from rvsm.rtl.amaranth_sim import run_simulation
 from rvsm.rtl.stream.array import RvsmStreamArray
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.drive import threshold_writes
-from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.signatures import threshold_word_bits
 from rvsm.rtl.wavejson import CycleTable
 

@@ -8,7 +8,7 @@ from pathlib import Path
 from rvsm.sim.cli.args import SceneRequest, add_force_argument
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.cosim import SIMULATORS
-from rvsm.sim.studies.demo import (
+from rvsm.sim.studies.main_job import (
     DEMO_MODELS,
     DEMO_RTL_LANES,
     DEMO_RTL_SIZE,
@@ -58,7 +58,7 @@ def run_demo(args: argparse.Namespace) -> int:
           "reconstructions")
     if args.sim == "none":
         return 0
-    from rvsm.sim.studies.demo import run_rtl_demo
+    from rvsm.sim.studies.main_job import run_rtl_demo
 
     h, w = DEMO_RTL_SIZE
     print(f"RTL: default design point, streaming array at {h}x{w} with {DEMO_RTL_LANES} "

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from rvsm.model.decode.reconstruction import MATCH_MODES, METHODS
-from rvsm.model.fixed.core import SENSORS
+from rvsm.model.fixed.contract import SENSORS
 from rvsm.model.sampling.thresholds import THRESHOLD_RULES
 from rvsm.sim.cli.args import (
     SceneRequest,

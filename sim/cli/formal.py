@@ -59,8 +59,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _formal(args: argparse.Namespace) -> int:
     from rvsm.model.infra.atomic import write_text_atomic
-    from rvsm.rtl.architectures import ARCHITECTURES
-    from rvsm.sim.formal.report import run_checks
+    from rvsm.rtl.registry import ARCHITECTURES
+    from rvsm.sim.formal.runner import run_checks
 
     arch = ARCHITECTURES[args.arch]
     options = arch_options(args)

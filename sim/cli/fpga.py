@@ -71,9 +71,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
-    from rvsm.rtl.architectures import ARCHITECTURES
     from rvsm.rtl.fpga.flow import build_component, run_fpga, run_fpga_seeds
     from rvsm.rtl.ip.architecture import interface_architecture
+    from rvsm.rtl.registry import ARCHITECTURES
     from rvsm.sim.cli.rtl import arch_options
 
     base = ARCHITECTURES[args.arch]
@@ -97,7 +97,7 @@ def _fpga(args: argparse.Namespace) -> int:
     else:
         base.check(contract, **options)
 
-    def progress(p) -> None:  # noqa: ANN001 - rvsm.model.infra.tools.Progress
+    def progress(p) -> None:  # noqa: ANN001 - rvsm.rtl.toolchain.Progress
         if not args.quiet:
             print(f"rvsm fpga: {p.line()}", file=sys.stderr, flush=True)
 

@@ -98,7 +98,7 @@ def _interrupted(exc: KeyboardInterrupt) -> int:
     """Stop every tool still running, say so on one line; exit status 130."""
     for sig in _INTERRUPTS:
         signal.signal(sig, signal.SIG_IGN)
-    from rvsm.model.infra.tools import kill_all
+    from rvsm.rtl.toolchain import kill_all
 
     kill_all()
     why = f" by {exc.args[0]}" if exc.args else ""

@@ -84,7 +84,7 @@ def _run(args: argparse.Namespace, archs: tuple[str, ...], checks: tuple[str, ..
 
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.model.infra.atomic import write_text_atomic
-    from rvsm.rtl.architectures import get_architecture
+    from rvsm.rtl.registry import get_architecture
     from rvsm.sim.mutate.run import run_mutants
 
     point = load_design_point(args.point).with_size(*parse_size_arg(args.size))

@@ -9,9 +9,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.architectures import ARCHITECTURES, DEFAULT_ARCHITECTURE
 from rvsm.rtl.flow_files import DEFAULT_CLOCK_MHZ
 from rvsm.rtl.ip.architecture import INTERFACES, STREAM_AXIS, interface_architecture
+from rvsm.rtl.registry import ARCHITECTURES, DEFAULT_ARCHITECTURE
 from rvsm.sim.cli.args import (
     SceneRequest,
     add_force_argument,

@@ -1,8 +1,10 @@
 """Co-simulation: the generated Verilog on Icarus / Verilator against the fixed twin.
 
-:mod:`.build_cache` builds (cached per contract, through the cocotb adapter
-:mod:`.cocotb_adapter`), :mod:`.simulation` runs the cocotb testbench (:mod:`.tb_array`,
-:mod:`.tb_stream`) on one stimulus file; :mod:`.verify` is ``rvsm verify``.
+Split by concern: :mod:`.builds` (cocotb's runner, the verified build cache, code
+coverage), :mod:`.testbenches` (one cocotb testbench per way of driving an architecture),
+:mod:`.long_runs` (the long-run harness and its twin process). Beside them,
+:mod:`.testbench_run` runs one testbench on one stimulus file, :mod:`.protocol_run` and
+:mod:`.axis_run` the protocol scripts and the AXI IP, and :mod:`.verify` is ``rvsm verify``.
 """
 
 #: HDL simulators the runner can build for (``--sim`` of ``rvsm verify`` and the demo).

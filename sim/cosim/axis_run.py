@@ -17,8 +17,8 @@ from pathlib import Path
 from rvsm.model.fixed.stimulus import Stimulus, save_stimulus
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.ip.architecture import STREAM_AXIS
-from rvsm.sim.cosim.build_cache import build, new_run_dir
-from rvsm.sim.cosim.simulation import run_cocotb
+from rvsm.sim.cosim.builds.build_cache import build, new_run_dir
+from rvsm.sim.cosim.testbench_run import run_cocotb
 from rvsm.sim.cosim.verify import DEFAULT_WORK
 
 __all__ = ["AXIS_POLICIES", "axis_verify"]

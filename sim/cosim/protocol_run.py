@@ -15,16 +15,16 @@ import shutil
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.architectures import get_architecture
+from rvsm.rtl.registry import get_architecture
 from rvsm.rtl.stream.protocol import ProtocolScript, random_script, save_script, script_coverage
-from rvsm.sim.cosim.build_cache import build, new_run_dir
-from rvsm.sim.cosim.cocotb_adapter import check_simulator
-from rvsm.sim.cosim.simulation import run_cocotb
+from rvsm.sim.cosim.builds.build_cache import build, new_run_dir
+from rvsm.sim.cosim.builds.cocotb_adapter import check_simulator
+from rvsm.sim.cosim.testbench_run import run_cocotb
 
 __all__ = ["PROTOCOL_TESTBENCH", "check_script_rtl", "protocol_verify"]
 
 #: The cocotb testbench module of protocol runs.
-PROTOCOL_TESTBENCH = "rvsm.sim.cosim.tb_stream_protocol"
+PROTOCOL_TESTBENCH = "rvsm.sim.cosim.testbenches.tb_stream_protocol"
 DEFAULT_WORK = Path("build") / "verify"
 
 

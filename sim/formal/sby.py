@@ -25,7 +25,7 @@ from amaranth.back import rtlil
 from amaranth.hdl import Elaboratable
 
 from rvsm.model.infra.errors import RvsmError, ToolError
-from rvsm.model.infra.tools import Progress, ProgressFollower, find_tool, run_tool
+from rvsm.rtl.toolchain import Progress, ProgressFollower, find_tool, run_tool
 
 __all__ = ["MODES", "SOLVERS", "SbyResult", "check_tools", "run_sby", "sby_config"]
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.widths import unsigned_max
 
 __all__ = ["COSIM_CHECKS", "CosimCheck", "stimulus"]
@@ -41,7 +41,7 @@ def stimulus(contract: ArrayContract, kind: str, seed: int = 0) -> Stimulus:
     steps before it fires and its residual matters; ``exact`` sets each threshold to the
     accumulator's value after the first step (every pixel hits its threshold exactly);
     ``rails`` uses the top threshold, which saturation reaches before firing."""
-    from rvsm.model.fixed.core import arithmetic_shift, integer_receptive_sums
+    from rvsm.model.fixed.contract import arithmetic_shift, integer_receptive_sums
 
     c = contract
     rng = np.random.default_rng(seed)
@@ -77,7 +77,7 @@ def _expected(contract: ArrayContract, stim: Stimulus) -> np.ndarray:
     update's frame on (what ``docs/stream-array.md`` says a paused write does)."""
     if not stim.threshold_updates:
         return contract.run(stim.codes, stim.thresholds, stim.clear_before)
-    from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift, integer_receptive_sums
+    from rvsm.model.fixed.contract import FixedIntegrator, arithmetic_shift, integer_receptive_sums
 
     (frame, new), = stim.threshold_updates.items()
     c = contract
@@ -93,8 +93,8 @@ def _expected(contract: ArrayContract, stim: Stimulus) -> np.ndarray:
 
 def _run_stream(contract: ArrayContract, stim: Stimulus, lanes: int,
                 mutation: str | None) -> int:
+    from rvsm.rtl.stream.dimensions import StreamGeometry
     from rvsm.rtl.stream.drive import simulate
-    from rvsm.rtl.stream.geometry import StreamGeometry
     from rvsm.rtl.stream.schedule import check_beats
 
     got = simulate(contract, stim.codes, stim.thresholds, lanes, stim.clear_before,
@@ -116,9 +116,9 @@ def _run_parallel(contract: ArrayContract, stim: Stimulus, lanes: int,
 def _run_collisions(contract: ArrayContract, lanes: int, mutation: str | None) -> int:
     """Threshold writes while the stream runs, many meeting the read of their word
     (``tests/rtl/stream/test_array.py``'s scenario)."""
-    from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift, integer_receptive_sums
+    from rvsm.model.fixed.contract import FixedIntegrator, arithmetic_shift, integer_receptive_sums
+    from rvsm.rtl.stream.dimensions import StreamGeometry
     from rvsm.rtl.stream.drive import colliding_threshold_writes, simulate_with_threshold_writes
-    from rvsm.rtl.stream.geometry import StreamGeometry
     from rvsm.rtl.stream.schedule import check_beats
 
     c = contract

@@ -2,7 +2,7 @@
 
 A mutant is *killed* when a check fails on it: a co-simulation check
 (:mod:`.checks`) finds a spike that differs from the contract's, or a formal check
-(:func:`rvsm.sim.formal.report.run_checks` on the tiny point) finds a counterexample.
+(:func:`rvsm.sim.formal.runner.run_checks` on the tiny point) finds a counterexample.
 Before any mutant, the shipped RTL must pass every check (else the checks, not the
 mutants, are wrong: an :class:`RvsmError` naming the check). Co-simulation runs each
 check at the point's array size in both reset modes; the formal checks run at the tiny
@@ -16,10 +16,10 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.architecture import require_spike_sensor
+from rvsm.rtl.capabilities import require_spike_sensor
 from rvsm.rtl.mutations import Mutation, mutations_for
 from rvsm.sim.mutate.checks import COSIM_CHECKS
 
@@ -103,7 +103,7 @@ def _formal(point: DesignPoint, arch: str, lanes: int, mutation: str | None,
             workdir: Path, timeout: float | None) -> tuple[list[str], list[str]]:
     """Every formal check of ``arch`` in both reset modes (the shipped RTL), or until
     the first that kills ``mutation`` (a mutant: the fast checks run first)."""
-    from rvsm.sim.formal.report import available_checks, run_checks
+    from rvsm.sim.formal.runner import available_checks, run_checks
 
     killed, passed = [], []
     # the compositional proof (window, sums, composed) re-proves what equivalence

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from rvsm.model.infra.progress import progress_bar
-from rvsm.sim.cosim.code_coverage import merge, summary, write_coverage, write_lcov
+from rvsm.sim.cosim.builds.code_coverage import merge, summary, write_coverage, write_lcov
 from rvsm.sim.regress.plan import RegressionPlan
 from rvsm.sim.regress.report import closure_lines, write_junit
 from rvsm.sim.regress.store import RegressionStore

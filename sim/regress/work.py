@@ -17,8 +17,8 @@ from typing import Any, ClassVar
 
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError, ToolError
-from rvsm.model.infra.tools import ToolFailure
 from rvsm.model.scene.scene import DEFAULT_STEPS_PER_FRAME, Scene
+from rvsm.rtl.toolchain import ToolFailure
 from rvsm.sim.regress.plan import RunSpec
 
 __all__ = ["RegressionWork"]

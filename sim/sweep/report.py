@@ -28,7 +28,7 @@ from rvsm.model.fixed.design_point import FIELD_BY_PATH, FIELD_PATH
 from rvsm.model.fixed.point_toml import parse_design_point
 from rvsm.model.infra.atomic import atomic_path, write_text_atomic
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.fpga.sensor import state_memory
+from rvsm.rtl.fpga.camera import state_memory
 from rvsm.sim.sweep.store import open_existing
 
 PROXY_LABEL = "adc + weight + accumulator bits (proxy: no synthesis)"

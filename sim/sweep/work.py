@@ -56,7 +56,7 @@ def hw_digest(point: DesignPoint, hardware: HardwareSettings) -> str:
     """Cache key of a design's hardware cost: the digest of its RTL contract at
     ``hardware.size`` (RTL sources included), the FPGA flow's sources, the lane counts
     and whether Fmax is measured."""
-    from rvsm.rtl.digest import rtl_digest
+    from rvsm.rtl.rtl_digest import rtl_digest
 
     return rtl_digest(hw_point(point, hardware.size).contract(), "stream",
                       {"lane_counts": list(hardware.lanes), "fmax": hardware.fmax})

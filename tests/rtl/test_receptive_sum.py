@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rvsm.rtl.amaranth_sim import run_simulation
 from rvsm.rtl.receptive_sum import ReceptiveSum, csd_digits
-from rvsm.rtl.simulation import run_simulation
 
 
 @pytest.mark.parametrize("value", [0, 1, 3, 7, 11, 236, 1023, 4095, 12345])

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift, integer_receptive_sums
+from rvsm.model.fixed.contract import FixedIntegrator, arithmetic_shift, integer_receptive_sums
 from rvsm.model.fixed.corner_stimulus import BINS, corner_stimulus, coverage, coverage_summary
 from rvsm.model.infra.errors import RvsmError
 

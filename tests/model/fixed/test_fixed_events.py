@@ -12,7 +12,7 @@ import pytest
 
 from rvsm.model.events.twin import sample_events
 from rvsm.model.fixed.adc import log_adc_codes
-from rvsm.model.fixed.core import ArrayContract, FixedEventIntegrator
+from rvsm.model.fixed.contract import ArrayContract, FixedEventIntegrator
 from rvsm.model.fixed.cost import quantisation_cost, spike_agreement
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.stimulus import (

@@ -11,9 +11,9 @@ import pytest
 
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.infra.errors import ToolError
-from rvsm.model.infra.tools import run_tool
 from rvsm.rtl.fpga.flow import run_fpga, synthesis_script
-from rvsm.rtl.fpga.tools import follower
+from rvsm.rtl.fpga.tool_logs import follower
+from rvsm.rtl.toolchain import run_tool
 
 TINY = (2, 2)
 
@@ -34,7 +34,7 @@ def test_synthesis_only_on_a_tiny_array(tmp_path: Path, fsm_point) -> None:
 
 
 def test_synthesis_only_keeps_the_stream_arrays_state_memories(tmp_path: Path) -> None:
-    from rvsm.rtl.stream.geometry import StreamGeometry
+    from rvsm.rtl.stream.dimensions import StreamGeometry
 
     point = dataclasses.replace(default_design_point(), model="dog1")
     r = run_fpga(point, tmp_path, arch="stream", lanes=2, size=(6, 6), synth_only=True,

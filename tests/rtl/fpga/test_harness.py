@@ -8,8 +8,8 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.amaranth_sim import run_simulation
 from rvsm.rtl.fpga.harness import LFSR_TAPS, XOR_GROUP, IoHarness, component_ports
-from rvsm.rtl.simulation import run_simulation
 
 
 class Echo(wiring.Component):

@@ -10,9 +10,9 @@ import pytest
 
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.fpga.camera import state_memory
 from rvsm.rtl.fpga.lane_cost import lane_cost, logic_lut4
 from rvsm.rtl.fpga.report import parse_yosys_stat
-from rvsm.rtl.fpga.sensor import state_memory
 
 
 def _point(model: str):

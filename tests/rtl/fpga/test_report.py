@@ -8,9 +8,9 @@ import pytest
 
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.infra.errors import ToolError
+from rvsm.rtl.fpga.camera import state_memory
 from rvsm.rtl.fpga.devices import DEVICES, get_device
 from rvsm.rtl.fpga.report import FpgaReport, Usage, parse_nextpnr_report, parse_yosys_stat
-from rvsm.rtl.fpga.sensor import state_memory
 
 
 def _step(kind: str, delay: float, cell: str, net: str | None = None) -> dict:

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
+from rvsm.rtl.amaranth_sim import run_simulation
 from rvsm.rtl.ip.axi_lite import RESP_OKAY, RESP_SLVERR, AxiLiteRegisters
 from rvsm.rtl.ip.register_map import ip_register_map
-from rvsm.rtl.simulation import run_simulation
 from tests.conftest import model_contract
 
 

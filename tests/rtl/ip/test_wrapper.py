@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.flow_files import design_point_digest
 from rvsm.rtl.ip.architecture import STREAM_AXIS

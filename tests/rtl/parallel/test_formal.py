@@ -8,9 +8,9 @@ import dataclasses
 
 import pytest
 
-from rvsm.rtl.architectures import get_architecture
-from rvsm.rtl.formal import property_at
-from rvsm.rtl.parallel.formal import ParallelProperties
+from rvsm.rtl.formal_harness import property_at
+from rvsm.rtl.parallel.harnesses import ParallelProperties
+from rvsm.rtl.registry import get_architecture
 from rvsm.sim.formal.sby import run_sby
 
 ASSERTS = {"valid.latency", "receptive.sum", "saturation.high_rail", "saturation.low_rail",
@@ -37,7 +37,7 @@ def test_statements_name_every_property(formal_point, model, reset):
     assert {"cover.saturate_high", "cover.clear_after_spike"} <= covers
     assert ("cover.saturate_low" in covers) == contract.signed
     assert ("cover.spike_neg" in covers) == contract.signed
-    assert all(p.src.split(":")[0].endswith("rtl/parallel/formal.py") for p in props)
+    assert all(p.src.split(":")[0].endswith("rtl/parallel/harnesses.py") for p in props)
     # sby names a failing statement by its line: one property per line
     assert len({p.src for p in props}) == len(props)
 

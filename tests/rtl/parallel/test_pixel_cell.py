@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import FixedIntegrator, arithmetic_shift
+from rvsm.model.fixed.contract import FixedIntegrator, arithmetic_shift
 from rvsm.model.fixed.widths import signed_range
 from rvsm.rtl.parallel.pixel_cell import PixelCell
 

@@ -7,7 +7,7 @@ import time
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import (
+from rvsm.model.fixed.contract import (
     ArrayContract,
     FixedIntegrator,
     arithmetic_shift,
@@ -17,12 +17,12 @@ from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.weights import quantise_model
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.drive import (
     colliding_threshold_writes,
     simulate,
     simulate_with_threshold_writes,
 )
-from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.schedule import check_beats
 
 

@@ -9,10 +9,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import FixedEventIntegrator, arithmetic_shift, integer_receptive_sums
+from rvsm.model.fixed.contract import FixedEventIntegrator, arithmetic_shift, integer_receptive_sums
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.drive import simulate, simulate_script
-from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.protocol import check_script, random_script
 from rvsm.rtl.stream.schedule import check_beats
 

@@ -11,14 +11,14 @@ import dataclasses
 
 import pytest
 
-from rvsm.rtl.architectures import get_architecture
-from rvsm.rtl.formal import property_at
+from rvsm.rtl.formal_harness import property_at
+from rvsm.rtl.registry import get_architecture
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.formal_lemmas import (
     ComposedEquivalence,
     StreamSumLemma,
     StreamWindowLemma,
 )
-from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.sim.formal.sby import run_sby
 
 
@@ -93,7 +93,7 @@ def test_sum_linear_forms_catch_a_wrong_tap(formal_point, monkeypatch):
 
 def test_sum_lemma_fails_before_the_solver(formal_point, tmp_path):
     """A linear-form failure is the check's counterexample, with no sby run."""
-    from rvsm.sim.formal.report import _run_check
+    from rvsm.sim.formal.runner import _run_check
 
     harness = StreamSumLemma(_contract(formal_point, "gauss1"), 2)
     harness.geometry = StreamGeometry(_contract(formal_point, "dog1"), 2)

@@ -9,8 +9,8 @@ from amaranth.hdl import Module, Signal, unsigned
 from rvsm.model.fixed.weights import quantise_model
 from rvsm.model.kernels.geometry import kernel_radius
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
+from rvsm.rtl.amaranth_sim import run_simulation
 from rvsm.rtl.receptive_sum import sum_width
-from rvsm.rtl.simulation import run_simulation
 from rvsm.rtl.stream.pipelined_sum import Pipeline, weighted_orbits
 
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.drive import simulate_script
-from rvsm.rtl.stream.geometry import StreamGeometry
 from rvsm.rtl.stream.protocol import (
     CLEAR_POSITIONS,
     PROTOCOL_BINS,

@@ -13,8 +13,8 @@ import pytest
 
 from rvsm.model.fixed.design_point import DesignPoint, default_design_point
 from rvsm.model.fixed.point_toml import save_design_point
-from rvsm.rtl.architectures import get_architecture
-from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.registry import get_architecture
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.verilog import strip_zero_memory_init, write_outputs
 from rvsm.sim.cli import main
 

@@ -12,8 +12,8 @@ import pytest
 
 from rvsm.model.infra.errors import ToolError
 from rvsm.rtl.parallel.architecture import PARALLEL
-from rvsm.rtl.parallel.formal import ParallelProperties
-from rvsm.rtl.stream.geometry import StreamGeometry
+from rvsm.rtl.parallel.harnesses import ParallelProperties
+from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.sim.cli import main
 from rvsm.sim.formal import sby
 
@@ -53,7 +53,7 @@ def test_counterexample_block(formal, tmp_path: Path, capsys: pytest.CaptureFixt
     assert formal("--mode", "bmc", "--depth", "3") == 1
     out = capsys.readouterr().out
     block = out[out.index("COUNTEREXAMPLE"):]
-    assert "rtl/parallel/formal.py:" in block and "step:   1" in block
+    assert "rtl/parallel/harnesses.py:" in block and "step:   1" in block
     vcd = Path(block.split("trace:")[1].split()[0])
     assert vcd.is_file() and vcd.parent == tmp_path / "out"
     assert "failed" in out and "a property FAILED" in out

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.stimulus import Stimulus
 from rvsm.sim.cosim.axis_run import axis_verify
 

@@ -1,4 +1,4 @@
-"""The twin's process of the long-run harness (:mod:`rvsm.sim.cosim.chunk_twin`) on its
+"""The twin's process of the long-run harness (:mod:`rvsm.sim.cosim.long_runs.chunk_twin`) on its
 own, without a simulator: its errors reach the testbench's connection. (Whole runs
 through it, on both simulators: ``test_long_run.py``.)"""
 
@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.sim.cosim.chunk_twin import connect, start_twin
+from rvsm.sim.cosim.long_runs.chunk_twin import connect, start_twin
 
 
 def test_the_twin_hands_its_error_to_the_testbench(tmp_path: Path) -> None:

@@ -12,9 +12,9 @@ from pathlib import Path
 import pytest
 
 from rvsm.model.infra.errors import RvsmError, ToolError
-from rvsm.model.infra.tools import ToolFailure
-from rvsm.sim.cosim.cocotb_adapter import build_args, cocotb_build, public_ports_control
-from rvsm.sim.cosim.cocotb_job import safe_path
+from rvsm.rtl.toolchain import ToolFailure
+from rvsm.sim.cosim.builds.cocotb_adapter import build_args, cocotb_build, public_ports_control
+from rvsm.sim.cosim.builds.cocotb_job import safe_path
 
 TWO_LEVELS = """
 module sub(input clk, input [3:0] a, output reg [3:0] q);

@@ -10,14 +10,14 @@ import pytest
 
 from rvsm.model.fixed.stimulus_chunks import StimulusChunks
 from rvsm.model.infra.errors import RvsmError
-from rvsm.sim.cosim.code_coverage import (
+from rvsm.sim.cosim.builds.code_coverage import (
     merge,
     read_coverage,
     summary,
     write_coverage,
     write_lcov,
 )
-from rvsm.sim.cosim.long_run import check_chunks
+from rvsm.sim.cosim.long_runs.long_run import check_chunks
 
 
 def _point(f: str, line: int, page: str, comment: str = "") -> str:

@@ -1,4 +1,4 @@
-"""The long-run harness's Icarus netlist (:mod:`rvsm.sim.cosim.icarus_netlist`) and the
+"""The long-run harness's Icarus netlist (:mod:`rvsm.sim.cosim.long_runs.icarus_netlist`) and the
 harness's own clock: the text passes, the build that uses them, and the oracle: a tiny
 array through the rewritten netlist agrees with the fixed twin spike for spike, at the
 same clock cycles as Verilator (which builds the original Verilog, clocked by cocotb).
@@ -14,15 +14,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.fixed.stimulus import Stimulus
 from rvsm.model.fixed.stimulus_chunks import StimulusChunks
-from rvsm.model.infra.tools import find_tool, run_tool
-from rvsm.sim.cosim.build_cache import cosim_design
-from rvsm.sim.cosim.chunk_harness import HarnessLayout, clock_inside, harness_verilog
-from rvsm.sim.cosim.icarus_netlist import group_enables, merge_clocked, write_icarus_netlist
-from rvsm.sim.cosim.long_run import check_chunks
+from rvsm.rtl.toolchain import find_tool, run_tool
+from rvsm.sim.cosim.builds.build_cache import cosim_design
+from rvsm.sim.cosim.long_runs.chunk_harness import HarnessLayout, clock_inside, harness_verilog
+from rvsm.sim.cosim.long_runs.icarus_netlist import (
+    group_enables,
+    merge_clocked,
+    write_icarus_netlist,
+)
+from rvsm.sim.cosim.long_runs.long_run import check_chunks
 
 #: yosys equivalence of the array's Verilog (gold) and its Icarus netlist (gate):
 #: memories as flip-flops, equal-named signals matched, proven by SAT and induction.

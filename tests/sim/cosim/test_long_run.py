@@ -1,5 +1,5 @@
-"""The long-run harness (:mod:`rvsm.sim.cosim.chunk_harness`, :mod:`.long_run`) against the
-fixed twin, on both simulators: equal verdicts to the per-cycle testbench, clears, a
+"""The long-run harness (:mod:`rvsm.sim.cosim.long_runs.chunk_harness`, :mod:`.long_run`)
+against the fixed twin, on both simulators: equal verdicts to the per-cycle testbench, clears, a
 wrong expectation found at its step with a waveform window around it, and the CLI.
 """
 
@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.fixed.point_toml import save_design_point
 from rvsm.model.fixed.stimulus import Stimulus, make_stimulus
@@ -21,12 +21,12 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.loaders import load_scene
 from rvsm.rtl.stream.schedule import pack_lanes
 from rvsm.sim.cli import main
-from rvsm.sim.cosim.chunk_harness import (
+from rvsm.sim.cosim.long_runs.chunk_harness import (
     decode_output_beats,
     encode_input_beats,
     encode_threshold_writes,
 )
-from rvsm.sim.cosim.long_run import check_chunks
+from rvsm.sim.cosim.long_runs.long_run import check_chunks
 from rvsm.sim.cosim.verify import AUTO_CHUNK_BEATS, choose_harness, run_rtl
 
 SIMS = ["icarus", "verilator"]

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.sim.cosim.verify import run_rtl
 

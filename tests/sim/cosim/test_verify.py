@@ -1,8 +1,8 @@
 """cocotb regressions: generated Verilog vs the fixed twin, on Icarus and Verilator.
 
 One build per (contract, simulator) is shared by many stimuli (the build cache of
-:mod:`rvsm.sim.cosim.build_cache`). Default: a border-heavy dog4 3x5 array and a 4x4 FSM array on
-both simulators, every model on Icarus, the checker-can-fail proof and tool errors.
+:mod:`rvsm.sim.cosim.builds.build_cache`). Default: a border-heavy dog4 3x5 array and a
+4x4 FSM array on both simulators, every model on Icarus, the checker-can-fail proof and tool errors.
 ``-m slow`` (``make regress``): every model on both shapes and simulators, longer streams.
 """
 
@@ -13,10 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.core import ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
-from rvsm.sim.cosim.cocotb_adapter import check_simulator
+from rvsm.sim.cosim.builds.cocotb_adapter import check_simulator
 from rvsm.sim.cosim.verify import run_rtl
 
 SIMS = ["icarus", "verilator"]
@@ -58,7 +58,7 @@ def exact_threshold_case(c: ArrayContract) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _shifted_sums(c: ArrayContract, codes: np.ndarray) -> np.ndarray:
-    from rvsm.model.fixed.core import arithmetic_shift, integer_receptive_sums
+    from rvsm.model.fixed.contract import arithmetic_shift, integer_receptive_sums
 
     return arithmetic_shift(integer_receptive_sums(codes, c.weight_arrays), c.shift)
 

@@ -75,7 +75,7 @@ def _assert_line() -> int:
 
 
 def test_harness_names_the_failing_property(tmp_path):
-    from rvsm.rtl.formal import FormalHarness, property_at
+    from rvsm.rtl.formal_harness import FormalHarness, property_at
 
     class Harness(FormalHarness):
         def __init__(self, wrap):

@@ -62,7 +62,7 @@ enabled = false
         assert d.worst_cost == max(abs(r["psnr_cost"]) for r in d.rows)
         assert d.proxy_bits == sum(d.values[k] for k in d.values if k != "weights.frac_bits")
     from rvsm.model.fixed.point_toml import parse_design_point
-    from rvsm.rtl.fpga.sensor import state_memory
+    from rvsm.rtl.fpga.camera import state_memory
 
     for d in designs:  # exact state memory of the sensor at each design point
         point = parse_design_point(d.toml)

@@ -133,7 +133,7 @@ size = "4x4"
             "SELECT lut4_per_lane, ff_per_lane, memory_bits, lanes FROM lane_cost").fetchone()
         assert lut4 > 0 and ffs > 0 and lanes == "[1, 2]"
         from rvsm.model.fixed.design_point import default_design_point
-        from rvsm.rtl.fpga.sensor import state_memory
+        from rvsm.rtl.fpga.camera import state_memory
 
         assert memory == state_memory(default_design_point().contract()).total
         assert con.execute("SELECT COUNT(*) FROM results r JOIN lane_cost h "

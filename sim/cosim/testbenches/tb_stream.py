@@ -1,0 +1,136 @@
+"""cocotb 2.x testbench: the streaming array against the fixed twin, beat for beat.
+
+Inputs (environment, or ``+rvsm_<name>=`` plusargs): ``RVSM_STIMULUS`` -- a stimulus
+file (:mod:`rvsm.model.fixed.stimulus`): codes, thresholds, expected spikes, the
+contract and ``clear_before``; ``RVSM_PORTS`` -- the build's ``<top>.ports.json`` (its
+lanes, timing properties and payload bit fields, derived from the component);
+``RVSM_RESULT`` -- where the JSON result goes.
+
+cocotb runs everything from Python, one clock cycle at a time (inputs driven on the
+falling edge): reset; every threshold word through ``thr``; then per segment between
+clears (:meth:`StreamSchedule.segments`) the frames as back-to-back beats, the ``lag``
+flush beats, one idle cycle and one ``clear`` cycle. Every cycle with ``spikes_valid``
+high records one output beat; at the end :func:`~rvsm.rtl.stream.schedule.check_beats`
+(the schedule model's checker) compares positions and spikes with the expectation. The
+per-cycle Python is a few handle accesses on vectors of a few hundred bits; the result
+reports ``cycles_per_second`` to show whether it or the simulator dominates.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+
+import cocotb
+import numpy as np
+from cocotb.simtime import get_sim_time
+from cocotb.triggers import FallingEdge
+
+from rvsm.model.fixed.stimulus import load_stimulus
+from rvsm.rtl.ports import load_ports_json
+from rvsm.rtl.stream.drive import threshold_writes
+from rvsm.rtl.stream.schedule import OutputBeats, check_beats, pack_lanes
+from rvsm.sim.cosim.testbenches.tb_common import (
+    clock_and_reset,
+    logic_bits,
+    stream_geometry,
+    testbench_arg,
+)
+
+
+@cocotb.test()
+async def stream_matches_fixed_twin(dut: object) -> None:
+    """Stream every step, compare every output beat with the fixed twin's expectation."""
+    stim = load_stimulus(testbench_arg("stimulus"))
+    ports = load_ports_json(testbench_arg("ports"))
+    result_path = testbench_arg("result")
+    c = stim.contract
+    codes = stim.codes.astype(np.int64)
+    expected = stim.spikes
+    steps, scales, height, width = expected.shape
+    geo = stream_geometry(c, ports)
+    lanes = geo.lanes
+    sched = geo.schedule
+    by_name = {p["name"]: p for p in ports["ports"]}
+    fields = {f["name"]: (f["offset"], f["width"])
+              for f in by_name["spikes_payload"]["fields"]}
+
+    clk = dut.clk  # type: ignore[attr-defined]
+    d = {name: getattr(dut, name) for name in (
+        "rst", "clear", "codes_valid", "codes_payload", "thr_we", "thr_addr", "thr_data",
+        "spikes_valid", "spikes_payload")}
+    await clock_and_reset(dut, ("clear", "codes_valid", "codes_payload", "thr_we",
+                                "thr_addr", "thr_data"))
+
+    t0 = time.perf_counter()
+    cycles = 0
+    d["thr_we"].value = 1
+    for addr, word in threshold_writes(geo, stim.thresholds):
+        d["thr_addr"].value = addr
+        d["thr_data"].value = word
+        await FallingEdge(clk)
+        cycles += 1
+    d["thr_we"].value = 0
+
+    got: dict[str, list[int]] = {k: [] for k in fields}
+    x_beats: list[int] = []
+    beat_times: list[int] = []  # simulation time (ns) at which each output beat was read
+    out_valid, out_payload = d["spikes_valid"], d["spikes_payload"]
+    in_payload = d["codes_payload"]
+
+    def record() -> None:
+        """After a falling edge: record the output beat presented, if any."""
+        if str(out_valid.value) == "1":
+            beat_times.append(int(get_sim_time("ns")))
+            value, xmask = logic_bits(out_payload.value)
+            if xmask:
+                x_beats.append(len(got["row"]))
+            for k, (off, w) in fields.items():
+                got[k].append((value >> off) & ((1 << w) - 1))
+    for seg, (a, b) in enumerate(sched.segments(steps, stim.clear_before)):
+        if seg:
+            d["clear"].value = 1
+            await FallingEdge(clk)
+            cycles += 1
+            record()
+            d["clear"].value = 0
+        beats = pack_lanes(sched.input_beats(codes[a:b]), c.adc_bits)
+        d["codes_valid"].value = 1
+        for word in beats:
+            in_payload.value = word
+            await FallingEdge(clk)
+            cycles += 1
+            record()
+        d["codes_valid"].value = 0
+        await FallingEdge(clk)  # the last released beat is presented one cycle later
+        cycles += 1
+        record()
+    stream_seconds = time.perf_counter() - t0
+
+    out = OutputBeats.from_words(got["row"], got["group"], got["last"], got["pos"],
+                                 got["neg"], scales, lanes)
+    result = check_beats(sched, expected, out)
+    if x_beats:
+        result["mismatches"] += len(x_beats)
+        result["mismatch_list"].insert(0, {"beat": x_beats[0],
+                                           "error": f"X/Z in {len(x_beats)} output beat(s)"})
+        result["first_mismatch"] = result["mismatch_list"][0]
+    first = result["first_mismatch"]
+    at = None
+    if first is not None and beat_times:  # a missing beat: after the last one received
+        at = beat_times[min(first["beat"], len(beat_times) - 1)]
+    result.update({
+        "first_mismatch_time_ns": at,
+        "steps": steps,
+        "accumulators": scales * height * width,
+        "expected_spikes": int(np.count_nonzero(expected)),
+        "lanes": lanes,
+        "cycles": cycles,
+        "cycles_per_second": cycles / stream_seconds if stream_seconds else None,
+        "stream_seconds": stream_seconds,
+        "sim_time_ns": int(get_sim_time("ns")),
+    })
+    with open(result_path, "w", encoding="utf-8") as f:
+        json.dump(result, f)
+    assert result["mismatches"] == 0, \
+        f"{result['mismatches']} mismatches; first {result['first_mismatch']}"
