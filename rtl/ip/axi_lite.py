@@ -5,7 +5,9 @@ a slave takes ``In(AxiLiteSignature(...))``). :class:`AxiLiteRegisters` decodes 
 against the map: one transaction of each kind outstanding (a write and a read may
 overlap), AW and W in either order or together; OKAY, or SLVERR for an unmapped address,
 a write whose strobe is not 0xF, a write to a register without a writable field, a
-field value above its ``max`` and a write the IP refuses (``refuse``, sampled in the
+field value above its ``max`` (judged on the bits up to the next field,
+:meth:`~rvsm.rtl.ip.register_map.Register.span`: a value too wide for the field is refused,
+not truncated) and a write the IP refuses (``refuse``, sampled in the
 write's commit cycle). A refused write changes nothing.
 
 Latency, the handshake's cycle counted 0 (for timing: every decode starts and ends at
@@ -31,12 +33,16 @@ from amaranth.hdl import Cat, Const, Module, Mux, Signal, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from rvsm.rtl.ip.register_map import Field, Register, RegisterMap
+from rvsm.rtl.ip.register_map import (
+    RESP_OKAY,
+    RESP_SLVERR,
+    Field,
+    Register,
+    RegisterMap,
+)
 
 __all__ = ["AxiLiteRegisters", "AxiLiteSignature", "RESP_OKAY", "RESP_SLVERR"]
 
-#: AXI response codes.
-RESP_OKAY, RESP_SLVERR = 0b00, 0b10
 
 
 class AxiLiteSignature(wiring.Signature):
@@ -158,8 +164,9 @@ class AxiLiteRegisters(wiring.Component):
         for n, r in enumerate(writable):
             good = hit[n] & (w_strb == 0xF)
             for f in r.fields:
-                if f.max is not None and f.max < (1 << f.width) - 1:
-                    good = good & (w_data[f.lsb:f.lsb + f.width] <= f.max)
+                span = r.span(f)
+                if f.max is not None and f.max < (1 << span) - 1:
+                    good = good & (w_data[f.lsb:f.lsb + span] <= f.max)
             m.d.sync += ok[n].eq(good)
         # sticky fields: the IP's set pulses always land; a write of 1 clears
         clears = {k: Signal(len(v), name=f"{v.name}_clr") for k, v in self.value.items()

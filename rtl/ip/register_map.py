@@ -39,6 +39,9 @@ ACCESS = {
 #: The ID register's value: ASCII "RVSM".
 ID_MAGIC = 0x5256534D
 
+#: AXI response codes.
+RESP_OKAY, RESP_SLVERR = 0b00, 0b10
+
 #: Byte offset of the first threshold data chunk register.
 THR_DATA_BASE = 0x100
 #: Registers of 32 bits; the address window is 4 KiB.
@@ -51,7 +54,8 @@ class Field:
     constant field's value); ``live``: a read-only field driven by the hardware (not a
     constant); ``external``: a read/write field whose storage is in the IP (it changes
     by itself, e.g. an auto-incrementing address); ``max``: a write of a larger value is
-    refused (SLVERR)."""
+    refused (SLVERR), judged on the field's span (:meth:`Register.span`), so a value
+    that does not fit the field's bits is refused too."""
 
     name: str
     lsb: int
@@ -85,6 +89,14 @@ class Register:
         """The register's access: its fields' if they agree, else ``mixed``."""
         kinds = {f.access for f in self.fields}
         return kinds.pop() if len(kinds) == 1 else "mixed"
+
+    def span(self, field: Field) -> int:
+        """The bits a write to ``field`` is judged on: from its ``lsb`` up to the next
+        field's (or bit 32). A field's ``max`` is checked on these bits, so a value too
+        wide for the field (scale 4 into a 2-bit scale field) is refused, never
+        truncated into range."""
+        above = [f.lsb for f in self.fields if f.lsb > field.lsb]
+        return min(above, default=32) - field.lsb
 
     @property
     def writable(self) -> bool:
