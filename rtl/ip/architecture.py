@@ -141,7 +141,7 @@ def _extra_outputs(dut: RvsmAxisIp, prov: Mapping) -> dict[str, str]:
     top = prov["top"]
     return {".regs.md": header(prov, "<!--") + regs_markdown(dut.regmap, top),
             ".regs.json": regs_json(dut.regmap, {"top": top, "provenance": dict(prov)}),
-            ".regs.h": header(prov, "//") + regs_c_header(dut.regmap, top)}
+            ".regs.h": header(prov, "/*") + regs_c_header(dut.regmap, top)}
 
 
 def simulate_axis(contract: ArrayContract, codes: np.ndarray, thresholds: np.ndarray,

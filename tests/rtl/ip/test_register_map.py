@@ -65,5 +65,5 @@ def test_markdown_json_header_agree(tmp_path: Path) -> None:
         src.write_text('#include "ip.regs.h"\n#include "ip.regs.h"\n'
                        "unsigned f(void) { return IP_STATUS_OVERFLOW_MASK | "
                        "IP_THR_DATA0_OFFSET; }\n")
-        subprocess.run(["gcc", "-Wall", "-Wextra", "-Werror", "-c", "-o",
+        subprocess.run(["gcc", "-std=c89", "-pedantic", "-Wall", "-Wextra", "-Werror", "-c", "-o",
                         str(tmp_path / "use.o"), str(src)], check=True)
