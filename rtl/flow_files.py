@@ -154,6 +154,32 @@ def _sdc_ports(ports: Sequence[Mapping]) -> str:
     return " ".join(p["name"] if p["width"] == 1 else f"{p['name']}[*]" for p in ports)
 
 
+#: Control input families a top may have, by name prefix, and what they are.
+_CONTROL_PORTS = (("thr_", "threshold writes"), ("cfg_", "configuration"),
+                  ("clear", "clear"), ("s_axil_", "AXI4-Lite registers"))
+
+
+def _present(inputs: Sequence[Mapping]) -> list[tuple[str, str]]:
+    """The control families of :data:`_CONTROL_PORTS` that ``inputs`` has."""
+    return [(pre, what) for pre, what in _CONTROL_PORTS
+            if any(p["name"].startswith(pre) for p in inputs)]
+
+
+def _control_note(inputs: Sequence[Mapping]) -> list[str]:
+    """The note on the control inputs this top really has (none: no note)."""
+    present = _present(inputs)
+    if not present:
+        return []
+    names = ", ".join(f"{pre}*" if pre.endswith("_") else pre for pre, _ in present)
+    return [f"# - {names} ({', '.join(w for _, w in present)}) are synchronous control",
+            "#   inputs; they are timed like the data inputs."]
+
+
+def _input_kinds(inputs: Sequence[Mapping]) -> str:
+    """What the synchronous inputs are, for their comment: data and the control present."""
+    return ", ".join(["data, handshake", *(w for _, w in _present(inputs))])
+
+
 def sdc_constraints(top: str, prov: Mapping, ports: Sequence[Mapping],
                     clock_mhz: float = DEFAULT_CLOCK_MHZ) -> str:
     """``<top>.sdc``: the clock ``clk`` at ``clock_mhz`` and the ports by kind. Every port
@@ -173,8 +199,7 @@ def sdc_constraints(top: str, prov: Mapping, ports: Sequence[Mapping],
              "# - rst is a synchronous reset (sampled at clk like any input): drive it from",
              "#   a reset synchroniser when its source is asynchronous to clk. There are no",
              "#   asynchronous inputs.",
-             "# - thr_* / cfg_* (threshold writes) and clear are synchronous control",
-             "#   inputs written a word per clock; they are timed like the data inputs.",
+             *_control_note(inputs),
              "",
              f"# {clock_mhz:g} MHz; change the period (ns) for another target.",
              f"create_clock -name clk -period {period:.3f} [get_ports clk]",
@@ -185,7 +210,7 @@ def sdc_constraints(top: str, prov: Mapping, ports: Sequence[Mapping],
         lines += ["", "# synchronous reset",
                   "set_input_delay -clock clk $rvsm_in_delay [get_ports rst]"]
     if inputs:
-        lines += ["", "# synchronous inputs (data, handshake, threshold writes, clear)",
+        lines += ["", "# synchronous inputs (" + _input_kinds(inputs) + ")",
                   "set_input_delay -clock clk $rvsm_in_delay "
                   f"[get_ports {{{_sdc_ports(inputs)}}}]"]
     if outputs:

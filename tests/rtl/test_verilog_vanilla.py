@@ -167,3 +167,17 @@ def test_cli_lint_runs_verilator_and_icarus(generated: Path,
     out = capsys.readouterr().out
     assert "verilator --lint-only -Wall rvsm_array.vlt rvsm_array.v: clean" in out
     assert "iverilog -g2005 / -g2012 -Wall rvsm_array.v: clean" in out
+
+
+@pytest.mark.parametrize("name", sorted(DESIGNS))
+def test_sdc_comments_name_only_ports_the_top_has(generated: Path, name: str) -> None:
+    """The notes of ``<top>.sdc`` name port families (``thr_*``, ``clear``...) that the top
+    really has: the AXI IP has none of the bare array's control ports (issue 34)."""
+    files = _files(generated, name)
+    names = [p["name"] for p in json.loads(files["ports_json"].read_text())["ports"]]
+    notes = [line for line in files["sdc"].read_text().splitlines()
+             if line.startswith("# - ") and "control" in line]
+    for family in re.findall(r"\b(\w+_)\*", "\n".join(notes)):
+        assert any(n.startswith(family) for n in names), (name, family)
+    if any(n == "clear" for n in names):
+        assert any("clear" in line for line in notes), name
