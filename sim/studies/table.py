@@ -23,6 +23,7 @@ from rvsm.model.sampling.config import DEFAULT_PHI, SamplerConfig
 from rvsm.model.sampling.twin import sample
 from rvsm.model.scene import library as scene_library
 from rvsm.model.scene.scene import Scene
+from rvsm.sim.kernel_cache import compile_float_engine
 from rvsm.sim.studies.labels import column_label, method_label
 
 TABLE_MODELS: tuple[str, ...] = MODEL_NAMES
@@ -109,8 +110,9 @@ def run_table(
                 noise = NoiseParams(k=noise_k, seed=seed) if noisy else None
                 for model in models:
                     bar.set_postfix_str(f"{column_label(scene.name, noisy)} {model}")
-                    t0 = time.perf_counter()
                     config = SamplerConfig(model=model, phi=phi, noise=noise)
+                    compile_float_engine(config)  # seconds exclude numba's first compile
+                    t0 = time.perf_counter()
                     train = sample(scene, config)
                     scores = evaluate_spikes(train.spikes, scene, model, config.phis)
                     if model in shown:
