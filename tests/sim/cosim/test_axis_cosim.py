@@ -3,6 +3,9 @@ idle cycles and back-pressure; the drop policy against the cycle model."""
 
 from __future__ import annotations
 
+import json
+import re
+import shlex
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +14,8 @@ import pytest
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.stimulus import Stimulus
 from rvsm.sim.cosim.axis_run import axis_verify
+
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def _stimulus(c: ArrayContract, steps: int, seed: int, clear_before: tuple[int, ...] = ()
@@ -60,16 +65,39 @@ def test_stall_policy_verilator_and_wider(small_contract, cosim_work: Path,
         assert r["counters"]["OUT_BEATS"] == 3 * 16
 
 
-@pytest.mark.slow
-def test_rvsm_verify_interface_axis(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+#: The two ``rvsm verify --interface axis`` rows of docs/ip.md's table: command -> result.
+_DOC_ROW = re.compile(r"^\| `(rvsm verify --interface axis [^`]*)` \| ([^|]*) \|$", re.M)
+
+
+def _figure(text: str, pattern: str) -> int:
+    found = re.search(pattern, text)
+    assert found, (pattern, text)
+    return int(found.group(1).replace(",", ""))
+
+
+def test_rvsm_verify_interface_axis_as_docs_ip_says(tmp_path: Path,
+                                                    capsys: pytest.CaptureFixture) -> None:
+    """Runs the two commands of docs/ip.md's table as written and checks every figure the
+    table gives (beats in, flush, out, dropped, spikes compared) against ``--json``, so the
+    doc cannot drift from the tool (issue 34)."""
     from rvsm.sim.cli.main import main
 
-    point = tmp_path / "point.toml"
-    assert main(["config", "new", "-o", str(point)]) == 0
-    for policy in ("stall", "drop"):
-        assert main(["verify", "--interface", "axis", "--policy", policy, "--random", "3",
-                     "--fixed", str(point), "--size", "8x8", "--steps", "20", "--lanes",
-                     "2", "--fifo-depth", "6", "--idle-out", "0.6", "--work",
-                     str(tmp_path / "work")]) == 0
-        out = capsys.readouterr().out
-        assert f"{policy} policy" in out and ", 0 mismatches" in out
+    rows = _DOC_ROW.findall((ROOT / "docs" / "ip.md").read_text())
+    assert len(rows) == 2, rows
+    assert main(["config", "new", "-o", str(tmp_path / "point.toml")]) == 0
+    capsys.readouterr()
+    for command, said in rows:
+        argv = shlex.split(command)[1:]
+        argv = [str(tmp_path / "point.toml") if a == "point.toml" else a for a in argv]
+        assert main([*argv, "--json", "--work", str(tmp_path / "work")]) == 0
+        r = json.loads(capsys.readouterr().out)
+        assert r["mismatches"] == 0
+        assert _figure(said, r"([\d,]+) beats in") == r["input_beats"]
+        assert _figure(said, r"([\d,]+) out") == r["output_beats"] == \
+            r["counters"]["OUT_BEATS"]
+        assert _figure(said, r"([\d,]+) dropped") == r["dropped"]
+        if "flush" in said:
+            stream_beats = _figure(said, r"\(([\d,]+) \+")
+            assert stream_beats + _figure(said, r"\+ ([\d,]+) flush") == r["input_beats"]
+        if "spikes compared" in said:
+            assert _figure(said, r"([\d,]+) spikes compared") == r["compared"]
