@@ -26,6 +26,12 @@ def main(argv: list[str] | None = None) -> int:
     for sig, handler in previous.items():
         if handler is not signal.SIG_IGN:  # `nohup rvsm ...` keeps ignoring SIGHUP
             signal.signal(sig, _startup_interrupt)
+    args = sys.argv[1:] if argv is None else list(argv)
+    if args == ["--version"]:  # answered before the command families are imported
+        from rvsm.model.infra.versions import version_line
+
+        print(version_line())
+        return 0
     try:
         try:
             from rvsm.sim.cli.main import main as run
@@ -36,7 +42,7 @@ def main(argv: list[str] | None = None) -> int:
             why = f" by {exc.args[0]}" if exc.args else ""
             print(f"rvsm: interrupted{why} while starting", file=sys.stderr)
             return 130
-        return run(argv)
+        return run(args)
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)

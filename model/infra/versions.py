@@ -1,11 +1,11 @@
-"""Software versions behind a result: ``rvsm --version`` and every spike file's ``meta``."""
+"""Software versions behind a result: ``rvsm --version`` and every spike file's ``meta``.
+
+Read from the installed packages' metadata, so ``rvsm --version`` imports nothing heavy."""
 
 from __future__ import annotations
 
 import platform
 from importlib import metadata
-
-import numpy as np
 
 
 def rvsm_version() -> str:
@@ -19,7 +19,7 @@ def rvsm_version() -> str:
 def software_versions(simulator: dict[str, str] | None = None) -> dict[str, str]:
     """``{"rvsm": .., "numpy": .., "python": ..}`` plus ``simulator`` entries (e.g.
     ``{"icarus": "12.0"}``) when a simulator made the result."""
-    out = {"rvsm": rvsm_version(), "numpy": np.__version__,
+    out = {"rvsm": rvsm_version(), "numpy": metadata.version("numpy"),
            "python": platform.python_version()}
     out.update(simulator or {})
     return out
