@@ -1,66 +1,67 @@
-"""Numba's on-disk kernel cache as the CLI sees it: whether a complete warm-up ran for
-this numba, CPU and source (:func:`kernels_are_warm`, a stamp beside the model's caches),
-the one line a command prints while it did not (:func:`compile_notice`), and a compile of
-one float engine ahead of a timing (:func:`compile_float_engine`). The warm-up itself is
+"""Numba's on-disk kernel cache as the CLI sees it: the one line a command prints when a
+kernel really compiles (:func:`install_compile_notice`), and a compile of one float engine
+ahead of a timing (:func:`compile_float_engine`). The warm-up that fills the cache is
 :mod:`rvsm.sim.warmup` (``make setup`` runs it).
+
+The notice listens for numba's ``numba:compile`` event, which numba raises only when a
+kernel is compiled, never when it is loaded from the cache: a warm cache prints nothing,
+and a cold one says so once, before the wait. ``RVSM_COMPILE_NOTICE=0`` silences it (the
+test suite does, so its checks of a command's one-line errors hold whatever the cache).
 """
 
 from __future__ import annotations
 
-import hashlib
-from pathlib import Path
+import os
+import sys
+from typing import TextIO
 
-__all__ = ["compile_float_engine", "compile_notice", "kernels_are_warm", "stamp_path"]
+__all__ = ["COMPILING_COMMANDS", "NOTICE", "compile_float_engine", "install_compile_notice"]
 
-#: Commands whose first run compiles kernels (``rvsm COMMAND``).
+#: Commands that run numba kernels (``rvsm COMMAND``): the notice is installed for them.
 COMPILING_COMMANDS = frozenset({"simulate", "demo", "table", "robustness", "cost", "profile",
-                                "evaluate", "stimulus", "events"})
+                                "evaluate", "stimulus", "events", "verify", "regress",
+                                "sweep", "dat"})
+#: What a command prints when its first kernel compiles.
+NOTICE = ("rvsm: compiling kernels for this CPU, first run only (1-3 min; `make setup` "
+          "does it ahead)")
+
+_installed: list[object] = []
 
 
-
-def _model_folder() -> Path:
-    """The folder of ``rvsm.model`` (its ``__pycache__`` holds the kernel caches)."""
-    from importlib.util import find_spec
-
-    spec = find_spec("rvsm.model")
-    return Path(next(iter(spec.submodule_search_locations))).resolve()
-
-
-def _kernel_key() -> str:
-    """numba version, host CPU name and features, and every model source's digest."""
-    import numba
-    from llvmlite import binding
-
-    digest = hashlib.sha256()
-    digest.update(numba.__version__.encode())
-    digest.update(binding.get_host_cpu_name().encode())
-    digest.update(binding.get_host_cpu_features().flatten().encode())
-    model = _model_folder()
-    for path in sorted(model.rglob("*.py")):
-        digest.update(path.relative_to(model).as_posix().encode())
-        digest.update(path.read_bytes())
-    return digest.hexdigest()[:16]
-
-
-def stamp_path() -> Path:
-    """Where the stamp of a complete warm-up lives (beside the model's kernel caches)."""
-    return _model_folder() / "__pycache__" / f"rvsm-kernels-{_kernel_key()}.stamp"
-
-
-def kernels_are_warm() -> bool:
-    """True when :func:`warm_kernels` completed for this numba, CPU and source."""
-    try:
-        return stamp_path().exists()
-    except OSError:
+def install_compile_notice(command: str | None, stream: TextIO | None = None) -> bool:
+    """For a command of :data:`COMPILING_COMMANDS`, print :data:`NOTICE` to ``stream``
+    (stderr) when the process's first numba compile starts; True if installed. Once per
+    process; ``RVSM_COMPILE_NOTICE=0`` turns it off."""
+    if command not in COMPILING_COMMANDS or _installed \
+            or os.environ.get("RVSM_COMPILE_NOTICE", "1") == "0":
         return False
+    from numba.core import event
+
+    class _Notice(event.Listener):
+        said = False
+
+        def on_start(self, ev: event.Event) -> None:
+            if not self.said:
+                self.said = True
+                from tqdm import tqdm  # clears and redraws a progress bar around it
+
+                tqdm.write(NOTICE, file=stream or sys.stderr)
+
+        def on_end(self, ev: event.Event) -> None:
+            pass
+
+    listener = _Notice()
+    event.register("numba:compile", listener)
+    _installed.append(listener)
+    return True
 
 
-def compile_notice(command: str | None) -> str | None:
-    """The line to print before ``command`` runs when its kernels may still compile."""
-    if command not in COMPILING_COMMANDS or kernels_are_warm():
-        return None
-    return ("rvsm: compiling kernels for this CPU, first run only (1-3 min; "
-            "`make setup` or `python -m rvsm.sim.warmup` does it ahead)")
+def remove_compile_notice() -> None:
+    """Undo :func:`install_compile_notice` (tests)."""
+    from numba.core import event
+
+    while _installed:
+        event.unregister("numba:compile", _installed.pop())
 
 
 def compile_float_engine(config: object) -> None:

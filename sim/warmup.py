@@ -5,9 +5,8 @@ The fused engines (float, fixed, event twins, noise streams, spike packing) are 
 kernels cached on disk per CPU (``__pycache__`` beside each module). A fresh clone or
 install has none, so the first run of each engine spends a minute or more compiling
 before its first step. :func:`warm_kernels` runs each engine path a user reaches from the
-CLI once on a tiny scene, in this process, so the cache holds every kernel; it then writes
-the stamp of :mod:`rvsm.sim.kernel_cache`, whose notice a command prints while the stamp
-is missing.
+CLI once on a tiny scene, in this process, so the cache holds every kernel. A kernel that
+still compiles later says so (:mod:`rvsm.sim.kernel_cache`).
 """
 
 from __future__ import annotations
@@ -19,8 +18,6 @@ import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
-
-from rvsm.sim.kernel_cache import stamp_path
 
 __all__ = ["warm_kernels"]
 
@@ -56,8 +53,8 @@ def _runs(work: Path) -> list[tuple[str, list[str]]]:
 
 
 def warm_kernels(echo: Callable[[str], None] = print) -> float:
-    """Run every engine path once on a tiny scene (compiling and caching its kernels), then
-    write the stamp; the seconds it took. Raises :class:`RuntimeError` naming the run that
+    """Run every engine path once on a tiny scene (compiling and caching its kernels); the
+    seconds it took. Raises :class:`RuntimeError` naming the run that
     failed."""
     from rvsm.sim.cli.main import main
 
@@ -75,9 +72,6 @@ def warm_kernels(echo: Callable[[str], None] = print) -> float:
                 raise RuntimeError(f"warm-up run `rvsm {' '.join(argv)}` exited {status}: "
                                    f"{last[0]}")
             echo(f"rvsm warm-up {n}/{len(runs)}: {label}: {time.perf_counter() - t0:.1f} s")
-    stamp = stamp_path()
-    stamp.parent.mkdir(parents=True, exist_ok=True)
-    stamp.write_text(f"warmed in {time.perf_counter() - start:.1f} s\n")
     return time.perf_counter() - start
 
 

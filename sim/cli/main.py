@@ -29,7 +29,7 @@ from rvsm.sim.cli import (
     studies,
     sweep,
 )
-from rvsm.sim.kernel_cache import compile_notice
+from rvsm.sim.kernel_cache import install_compile_notice
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
 #: co-simulation, formal checks, FPGA timing and area, paper studies, the demo, design sweeps.
@@ -111,9 +111,8 @@ def _interrupted(exc: KeyboardInterrupt) -> int:
 def _run(args: argparse.Namespace) -> int:
     """``args.func(args)`` with every failure mapped to its exit status."""
     try:
-        notice = compile_notice(getattr(args, "command", None))
-        if notice:  # a first run compiles numba's kernels: say so before the wait
-            print(notice, file=sys.stderr, flush=True)
+        # a kernel that compiles (a first run) says so in one line before the wait
+        install_compile_notice(getattr(args, "command", None))
         return int(args.func(args) or 0)
     except KeyboardInterrupt as exc:
         return _interrupted(exc)

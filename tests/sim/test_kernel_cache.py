@@ -1,50 +1,55 @@
-"""The first-run notice: a command that would compile numba's kernels says so in one line
-before the wait, until the warm-up (``make setup``) has stamped the cache (issue 33)."""
+"""The first-run notice: a command whose kernel really compiles says so in one line before
+the wait; a kernel loaded from numba's cache says nothing (issue 33)."""
 
 from __future__ import annotations
 
-from pathlib import Path
+import io
+from collections.abc import Iterator
 
+import numba
+import numpy as np
 import pytest
 
 from rvsm.sim import kernel_cache
-from rvsm.sim.cli.main import main
 
 
 @pytest.fixture
-def stamp(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    path = tmp_path / "__pycache__" / "rvsm-kernels-test.stamp"
-    monkeypatch.setattr(kernel_cache, "stamp_path", lambda: path)
-    return path
+def notice(monkeypatch: pytest.MonkeyPatch) -> Iterator[io.StringIO]:
+    monkeypatch.setenv("RVSM_COMPILE_NOTICE", "1")
+    kernel_cache.remove_compile_notice()
+    said = io.StringIO()
+    assert kernel_cache.install_compile_notice("simulate", said)
+    yield said
+    kernel_cache.remove_compile_notice()
 
 
-def test_notice_until_the_warm_up_stamp(stamp: Path) -> None:
-    assert not kernel_cache.kernels_are_warm()
-    line = kernel_cache.compile_notice("simulate")
-    assert line is not None and "compiling kernels for this CPU, first run only" in line
-    assert kernel_cache.compile_notice("verilog") is None  # no kernels behind it
-    stamp.parent.mkdir()
-    stamp.write_text("warm\n")
-    assert kernel_cache.kernels_are_warm()
-    assert kernel_cache.compile_notice("simulate") is None
+def _fresh_kernel():  # noqa: ANN202
+    """A kernel no cache holds (a new function object, not cached on disk)."""
+    @numba.njit(cache=False)
+    def twice(x):  # noqa: ANN001, ANN202
+        return 2 * x
+    return twice
 
 
-def test_the_stamp_is_keyed_on_cpu_numba_and_source() -> None:
-    path = kernel_cache.stamp_path()
-    assert path.parent.name == "__pycache__" and path.parent.parent.name == "model"
-    assert path == kernel_cache.stamp_path()  # stable within a run
-    assert len(path.stem.rsplit("-", 1)[1]) == 16
+def test_a_compile_prints_the_notice_once(notice: io.StringIO) -> None:
+    _fresh_kernel()(np.int64(3))
+    _fresh_kernel()(np.float64(3.0))  # a second compile: no second line
+    assert notice.getvalue() == kernel_cache.NOTICE + "\n"
+    assert "compiling kernels for this CPU, first run only" in kernel_cache.NOTICE
 
 
-def test_a_command_prints_the_notice_before_its_work(stamp: Path, tmp_path: Path,
-                                                    capsys: pytest.CaptureFixture) -> None:
-    out = tmp_path / "s.npz"
-    assert main(["simulate", "coin", "--size", "16x24", "--frames", "2", "--model", "fsm",
-                 "--engine", "numpy", "-o", str(out)]) == 0
-    err = capsys.readouterr().err
-    assert err.splitlines()[0].startswith("rvsm: compiling kernels for this CPU")
-    stamp.parent.mkdir()
-    stamp.write_text("warm\n")
-    assert main(["simulate", "coin", "--size", "16x24", "--frames", "2", "--model", "fsm",
-                 "--engine", "numpy", "-o", str(tmp_path / "t.npz")]) == 0
-    assert "compiling kernels" not in capsys.readouterr().err
+def test_a_compiled_kernel_called_again_says_nothing(notice: io.StringIO) -> None:
+    kernel = _fresh_kernel()
+    kernel(np.int64(3))
+    notice.seek(0)
+    notice.truncate()
+    kernel(np.int64(4))  # already compiled in this process
+    assert notice.getvalue() == ""
+
+
+def test_only_commands_that_run_kernels_and_not_when_off(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    kernel_cache.remove_compile_notice()
+    assert not kernel_cache.install_compile_notice("verilog")
+    monkeypatch.setenv("RVSM_COMPILE_NOTICE", "0")
+    assert not kernel_cache.install_compile_notice("simulate")
