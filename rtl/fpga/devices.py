@@ -110,21 +110,6 @@ class Aspect:
         if self.ports not in PORT_KINDS:
             raise ValueError(f"ports must be one of {PORT_KINDS}, got {self.ports!r}")
 
-    @property
-    def read_ports(self) -> int:
-        """Ports that can read at one edge (a true-dual port's two read/write ports)."""
-        return {"true-dual": 2, "pseudo-dual": 1, "single": 1}[self.ports]
-
-    @property
-    def write_ports(self) -> int:
-        """Ports that can write at one edge."""
-        return {"true-dual": 2, "pseudo-dual": 1, "single": 1}[self.ports]
-
-    @property
-    def access_ports(self) -> int:
-        """Reads plus writes one primitive serves per edge at most."""
-        return {"true-dual": 2, "pseudo-dual": 2, "single": 1}[self.ports]
-
     def text(self) -> str:
         """``"512x36 (pseudo-dual)"``, ``"1Kx18"``: depth in K where it is whole."""
         d = f"{self.depth // 1024}K" if self.depth % 1024 == 0 else str(self.depth)
