@@ -1,7 +1,9 @@
 """``rvsm sweep``: fixed-point design sweeps (run, resume, report).
 
 ``rvsm sweep SWEEP.toml`` (or ``rvsm sweep run SWEEP.toml``) computes what is missing into
-a SQLite database; ``rvsm sweep report RESULTS.sqlite`` writes a markdown report and plots.
+a SQLite database; ``rvsm sweep report RESULTS.sqlite`` writes a markdown report and plots
+(and, under a device constraint, ranks the designs that fit); ``rvsm sweep devices`` lists
+the devices a constraint may name and their budgets.
 """
 
 from __future__ import annotations
@@ -19,11 +21,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "sweep", help="fixed-point design sweeps on Dask (resumable) and their reports",
         description="rvsm sweep [run] SWEEP.toml [-o RESULTS.sqlite] [--workers N] "
         "[--scheduler ADDRESS]: run every design point x scene of a sweep file, skipping "
-        "rows already in the database. rvsm sweep report RESULTS.sqlite [-o DIR]: markdown "
-        "report, PSNR-cost and Pareto plots. See docs/design-space.md.",
+        "rows already in the database. rvsm sweep report RESULTS.sqlite [-o DIR] [--fits "
+        "DEVICE --camera HxW --rate-hz R]: markdown report, PSNR-cost and Pareto plots, and "
+        "the designs that fit a device ranked by PSNR cost. rvsm sweep devices: the devices "
+        "and their budgets. See docs/design-space.md.",
     )
-    p.add_argument("target", metavar="SWEEP.toml | run | report",
-                   help="a sweep file, or the action `run` / `report`")
+    p.add_argument("target", metavar="SWEEP.toml | run | report | devices",
+                   help="a sweep file, or the action `run` / `report` / `devices`")
     p.add_argument("path", nargs="?", metavar="FILE",
                    help="the sweep file (run) or the results database (report)")
     p.add_argument("-o", "--output", default=None,
@@ -41,11 +45,27 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--tolerance", type=float, default=0.1,
                    help="report: PSNR cost bound in dB for the recommendation (default 0.1)")
+    p.add_argument("--fits", default=None, metavar="DEVICE[,DEVICE]",
+                   help="report: check every design against these devices (default: the "
+                   "sweep file's fits = ...); see rvsm sweep devices")
+    p.add_argument("--camera", default=None, metavar="HxW",
+                   help="report: the camera's size for --fits (default: the sweep file's)")
+    p.add_argument("--rate-hz", type=float, default=None,
+                   help="report: the camera's steps per second for --fits")
+    p.add_argument("--memory-organisation", default=None,
+                   help="report: rtl | per-scale | packed (default packed)")
     p.set_defaults(func=run_sweep_command)
 
 
 def run_sweep_command(args: argparse.Namespace) -> int:
     """Dispatch ``rvsm sweep FILE``, ``rvsm sweep run FILE`` and ``rvsm sweep report DB``."""
+    if args.target == "devices":
+        from rvsm.sim.sweep.fit import devices_text
+
+        if args.path:
+            raise RvsmError(f"unexpected argument {args.path!r}: rvsm sweep devices")
+        print(devices_text())
+        return 0
     if args.target == "report":
         if not args.path:
             raise RvsmError("rvsm sweep report needs the results database: "
@@ -95,10 +115,53 @@ def _report(args: argparse.Namespace) -> int:
     out = Path(args.output) if args.output else db.with_name(db.stem + "-report")
     check_outputs([Output(out, "-o", FOLDER, (("report.md", None), ("width-cost.png", None),
                                               ("pareto.png", None)))], [db], args.force)
-    files, rec = write_report(db, out, tolerance=args.tolerance)
+    files, rec = write_report(db, out, tolerance=args.tolerance,
+                              constraint=_constraint(args, db))
     for f in files:
         print(f"wrote {f}")
-    if rec is not None:
+    if rec is not None and "label" in rec:
         print(f"recommended (worst PSNR cost <= {args.tolerance} dB on every scene): "
               f"{rec['label']}")
+    for device, fit in (rec or {}).get("fits", {}).items():
+        bad = rec["infeasible"][device]
+        print(f"fits {device}: {len(fit)} of {len(fit) + len(bad)} design(s)")
+        for i, d in enumerate(fit, 1):
+            print(f"  {i}. {d['label']}: {d['worst_cost']:.3f} dB, {d['summary']}")
+        for d in bad:
+            print(f"  x {d['label']}: {d['summary']}")
     return 0
+
+
+def _constraint(args: argparse.Namespace, db: Path):
+    """The constraint of ``--fits`` / ``--camera`` / ``--rate-hz`` (None: the sweep's)."""
+    from rvsm.sim.sweep.fit import parse_constraint
+    from rvsm.sim.sweep.report import stored_constraint
+    from rvsm.sim.sweep.store import open_existing
+
+    given = {"fits": args.fits, "camera": args.camera, "rate_hz": args.rate_hz,
+             "memory_organisation": args.memory_organisation}
+    if all(v is None for v in given.values()):
+        return None
+    with open_existing(db) as store:
+        stored = stored_constraint(list(store.db.execute(
+            "SELECT path, text FROM sweeps ORDER BY last_run")))
+    data: dict = {}
+    if stored is not None:
+        cam = stored.camera
+        data = {"fits": list(stored.devices),
+                "camera": {"size": f"{cam.height}x{cam.width}", "rate_hz": cam.rate_hz,
+                           **({"clock_mhz": cam.clock_hz / 1e6} if cam.clock_hz else {})},
+                "memory_organisation": stored.organisation,
+                "max_utilisation": stored.max_utilisation}
+    if args.fits is not None:
+        data["fits"] = [n.strip() for n in args.fits.split(",") if n.strip()]
+    if args.camera is not None or args.rate_hz is not None:
+        camera = dict(data.get("camera", {}))
+        if args.camera is not None:
+            camera["size"] = args.camera
+        if args.rate_hz is not None:
+            camera["rate_hz"] = args.rate_hz
+        data["camera"] = camera
+    if args.memory_organisation is not None:
+        data["memory_organisation"] = args.memory_organisation
+    return parse_constraint(data, "rvsm sweep report")

@@ -17,8 +17,9 @@ writes files.
 from __future__ import annotations
 
 import os
+import sys
 from collections import defaultdict
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +30,7 @@ from rvsm.model.fixed.point_toml import parse_design_point
 from rvsm.model.infra.atomic import atomic_path, write_text_atomic
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.camera import state_memory
+from rvsm.sim.sweep.fit import FitConstraint, assess_design, fit_markdown, parse_constraint
 from rvsm.sim.sweep.store import open_existing
 
 PROXY_LABEL = "adc + weight + accumulator bits (proxy: no synthesis)"
@@ -58,6 +60,9 @@ class DesignSummary:
     memory_bits: int
     proxy_bits: int
     complete: bool = True
+    #: device -> :class:`~rvsm.rtl.fpga.feasibility.Feasibility` under the sweep's
+    #: constraint (:mod:`rvsm.sim.sweep.fit`); empty without one.
+    feasibility: dict[str, Any] = field(default_factory=dict)
 
     @property
     def hw(self) -> float:
@@ -206,8 +211,9 @@ def pareto_figure(designs: list[DesignSummary], tolerance: float = 0.1):
 
 def report_markdown(db_name: str, designs: list[DesignSummary], invalid: list[dict],
                     errors: list[dict], sweeps: list[tuple[str, str]], tolerance: float,
-                    figures: dict[str, str]) -> str:
-    """The markdown report (``figures``: caption -> relative file name)."""
+                    figures: dict[str, str], constraint: FitConstraint | None = None) -> str:
+    """The markdown report (``figures``: caption -> relative file name; ``constraint``:
+    a section ranking the designs that fit, :func:`~rvsm.sim.sweep.fit.fit_markdown`)."""
     rec = recommend(designs, tolerance)
     hw_sizes = sorted({f"{r.get('hw_size')} at lanes {r.get('hw_lanes')}"
                        if r.get("hw_size") else "-" for d in designs for r in d.rows[:1]})
@@ -232,6 +238,8 @@ def report_markdown(db_name: str, designs: list[DesignSummary], invalid: list[di
     ]
     for cap, f in figures.items():
         lines += [f"![{cap}]({f})", ""]
+    if constraint is not None:
+        lines += fit_markdown(designs, constraint)
     lines += [f"## Recommended (smallest within {tolerance} dB on every run)", ""]
     if rec is None:
         lines += ["No complete design stays within the bound.", ""]
@@ -305,19 +313,49 @@ def _fmt(v: float | None, spec: str) -> str:
     return "-" if v is None else format(v, spec)
 
 
-def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: float = 0.1
+def stored_constraint(texts: list[tuple[str, str]]) -> FitConstraint | None:
+    """The device constraint of the most recently run sweep file that has one
+    (``texts``: ``(path, text)`` in the order run), or None."""
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover
+        import tomli as tomllib
+
+    for path, text in reversed(texts):
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError:  # pragma: no cover - stored only after parsing
+            continue
+        found = parse_constraint(data, path)
+        if found is not None:
+            return found
+    return None
+
+
+def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: float = 0.1,
+                 constraint: FitConstraint | None = None
                  ) -> tuple[list[Path], dict[str, Any] | None]:
     """Write ``report.md``, ``width-cost.png`` and ``pareto.png`` into ``out_dir``.
 
+    ``constraint``: the devices and camera to check every design against (default: the
+    one of the most recent sweep file in the database that states one, if any).
     Returns the files written and the recommended design (``label``, ``toml``,
-    ``worst_cost``, ``lut4_per_lane``, ``ff_per_lane``, ``memory_bits``) or None.
+    ``worst_cost``, ``lut4_per_lane``, ``ff_per_lane``, ``memory_bits``; with a
+    constraint also ``fits``: per device the feasible designs ranked by PSNR cost, each
+    ``{label, worst_cost, summary}``, and ``infeasible``: ``{label, summary}``) or None.
     """
     with open_existing(db) as store:
         rows = store.results()
         sweeps = list(store.db.execute("SELECT sweep_hash, path FROM sweeps"))
+        texts = list(store.db.execute("SELECT path, text FROM sweeps ORDER BY last_run"))
     designs = summarise(rows)
     if not designs:
         raise RvsmError(f"{db}: no finished results yet; run the sweep first")
+    if constraint is None:
+        constraint = stored_constraint(texts)
+    if constraint is not None:
+        for d in designs:
+            d.feasibility = assess_design(d.toml, d.rows[0], constraint)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     figs = {"PSNR cost against each width": ("width-cost.png", width_cost_figure),
@@ -332,7 +370,7 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
     text = report_markdown(
         Path(db).name, designs, [r for r in rows if r["status"] == "invalid"],
         [r for r in rows if r["status"] == "error"], sweeps, tolerance,
-        {cap: name for cap, (name, _) in figs.items()})
+        {cap: name for cap, (name, _) in figs.items()}, constraint)
     write_text_atomic(out / "report.md", text)
     files.append(out / "report.md")
     rec = recommend(designs, tolerance)
@@ -341,8 +379,20 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
                                       "lut4_per_lane": rec.lut4_per_lane,
                                       "ff_per_lane": rec.ff_per_lane,
                                       "memory_bits": rec.memory_bits}
+    if constraint is not None:
+        info = dict(info or {})
+        info["fits"] = {name: [{"label": d.label, "worst_cost": d.worst_cost,
+                                "summary": d.feasibility[name].summary()}
+                               for d in sorted(designs, key=lambda d: (d.worst_cost, d.label))
+                               if d.feasibility[name].feasible]
+                        for name in constraint.devices}
+        info["infeasible"] = {name: [{"label": d.label,
+                                      "summary": d.feasibility[name].summary()}
+                                     for d in designs if not d.feasibility[name].feasible]
+                              for name in constraint.devices}
     return files, info
 
 
 __all__ = ["FIELD_PATH", "DesignSummary", "pareto_figure", "pareto_mask", "recommend",
-           "report_markdown", "summarise", "width_cost_figure", "write_report"]
+           "report_markdown", "stored_constraint", "summarise", "width_cost_figure",
+           "write_report"]

@@ -12,6 +12,9 @@ Axis values: a list (``[6, 7, 8]``), an inclusive range (``{start = 6, stop = 12
 ``"auto+N"`` (the smallest width that holds the quantised weights / the largest threshold,
 plus N). Linked axes move together: ``"weights.bits,weights.frac_bits" = [[8, 6], [9, 7]]``.
 A point the design point validation refuses is kept, as invalid, with the reason.
+Top-level keys ``fits`` and ``camera`` (and optionally ``memory_organisation``,
+``max_utilisation``) state a device constraint (:mod:`rvsm.sim.sweep.fit`) that the report
+checks every design against.
 """
 
 from __future__ import annotations
@@ -46,6 +49,7 @@ from rvsm.model.fixed.point_toml import (
 )
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.loaders import parse_size
+from rvsm.sim.sweep.fit import CONSTRAINT_KEYS, FitConstraint, parse_constraint
 
 #: ``section.key`` -> design point field name of every field a sweep may vary.
 AXES: dict[str, str] = {f.path: f.name for f in FIELDS if f.sweep}
@@ -143,6 +147,8 @@ class SweepSpec:
     run: RunSettings
     hardware: HardwareSettings
     designs: tuple[Design, ...] = field(default=(), repr=False)
+    #: The device constraint (``fits``, ``camera``), or None.
+    constraint: FitConstraint | None = None
 
     @property
     def sweep_hash(self) -> str:
@@ -184,25 +190,28 @@ def parse_sweep(
     text: str, source: str = "sweep", base_dir: str | os.PathLike | None = None
 ) -> SweepSpec:
     """Parse sweep TOML text (``base_dir`` resolves a relative base file)."""
-    data = toml_tables(text, source, SECTIONS)
+    data = toml_tables(text, source, SECTIONS, CONSTRAINT_KEYS)
     base = parse_base_point(data.get("base"), source, Path(base_dir or "."))
     axes = _parse_axes(data.get("axes", {}), source)
     run = _parse_run(data.get("run"), source)
     hardware = _parse_hardware(data.get("hardware", {}), source)
-    spec = SweepSpec(source, text, base, axes, run, hardware)
+    constraint = parse_constraint(data, source)
+    spec = SweepSpec(source, text, base, axes, run, hardware, constraint=constraint)
     return dataclasses.replace(spec, designs=tuple(_expand(spec)))
 
 
-def toml_tables(text: str, source: str, sections: tuple[str, ...]) -> dict[str, Any]:
+def toml_tables(text: str, source: str, sections: tuple[str, ...],
+                keys: tuple[str, ...] = ()) -> dict[str, Any]:
     """TOML ``text`` parsed, refusing (one line naming ``source``) invalid TOML or a
-    top-level table not in ``sections``."""
+    top-level table not in ``sections`` (or key not in ``keys``)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise RvsmError(f"{source}: not valid TOML: {exc}") from None
     for key in data:
-        if key not in sections:
-            raise RvsmError(f"{source}: unknown section [{key}]; valid: {', '.join(sections)}")
+        if key not in sections and key not in keys:
+            valid = ", ".join(sections) + (f"; top-level keys: {', '.join(keys)}" if keys else "")
+            raise RvsmError(f"{source}: unknown section [{key}]; valid: {valid}")
     return data
 
 

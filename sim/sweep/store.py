@@ -202,9 +202,10 @@ class SweepStore:
         return {r[0] for r in self.db.execute("SELECT digest FROM lane_cost")}
 
     def results(self, status: str | None = None) -> list[dict[str, Any]]:
-        """Result rows as dicts (``record`` and ``axes`` decoded), joined with lane_cost."""
+        """Result rows as dicts (``record`` and ``axes`` decoded), joined with lane_cost
+        (its full record as ``hw_record``, JSON text)."""
         q = ("SELECT r.*, h.lut4_per_lane, h.ff_per_lane, h.lut4_base, h.fmax_mhz, "
-             "h.size AS hw_size, h.lanes AS hw_lanes "
+             "h.size AS hw_size, h.lanes AS hw_lanes, h.record AS hw_record "
              "FROM results r LEFT JOIN lane_cost h ON h.digest = r.hw_digest")
         args: tuple = ()
         if status is not None:

@@ -1,0 +1,110 @@
+"""Feasibility of a point on a device at a camera's size and rate: each budget's verdict."""
+
+from __future__ import annotations
+
+import pytest
+
+from rvsm.model.fixed.design_point import default_design_point
+from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.fpga.block_ram import ScaleState, StateLayout
+from rvsm.rtl.fpga.devices import get_budget
+from rvsm.rtl.fpga.feasibility import Camera, LogicCost, MeasuredFmax, assess
+
+CAMERA = Camera(250, 400, 40_000.0)
+#: docs/fpga.md: 1,468 LUT4 and 1,042 FF per lane, 131 LUT4 at zero lanes (16x16)
+DEFAULT_LOGIC = LogicCost(1468, 131, 1042, 300)
+ECP5 = get_budget("ecp5-85")
+
+
+def _dog2_a17_shared() -> StateLayout:
+    return StateLayout(250, 400, (ScaleState(17, 0),) * 2, adc_bits=7, radius=1)
+
+
+def test_dog2_a17_shared_thresholds_fits_the_ecp5_85_at_40_lanes() -> None:
+    f = assess(_dog2_a17_shared(), ECP5, CAMERA, DEFAULT_LOGIC)
+    assert f.feasible and f.lanes == 40 and f.clock_needed_hz == 100e6
+    c = f.checks
+    assert (c["memory"].figure, c["memory"].budget) == (190, 208)
+    # 131 + 40 x 1468 + the line buffer: 10 x (2 x 40 x 7) bits in 16x4 RAMs, 4 LUT4 each
+    assert c["lut4"].figure == 131 + 40 * 1468 + 4 * 140
+    assert c["lut4"].budget == pytest.approx(0.8 * 83640)
+    assert c["ff"].figure == 300 + 40 * 1042
+    # P = 20, 25 need 200 and 160 MHz, above the ECP5 model's 154.1 MHz (P = 8) at P > 8
+    assert c["fmax"].budget == 154.1 and "extrapolated from P = 8" in c["fmax"].detail
+    assert "feasible on ecp5-85 at P = 40" in f.summary()
+
+
+def test_default_point_breaks_memory_with_its_figures() -> None:
+    lay = StateLayout.from_contract(default_design_point().contract())
+    f = assess(lay, ECP5, CAMERA, DEFAULT_LOGIC)
+    assert not f.feasible and f.lanes == 40  # the fewest lanes meeting the clock
+    (broken,) = f.broken
+    assert broken.name == "memory" and (broken.figure, broken.budget) == (779, 208)
+    assert broken.over_by == pytest.approx(779 / 208 - 1)
+    assert "memory BREAKS: 779 / 208 DP16KD (+275 %)" in f.summary()
+    # today's RTL organisation: per scale 3 banks (2 full, one of 452 words) of 40 + 38
+    rtl = assess(lay, ECP5, CAMERA, DEFAULT_LOGIC, organisation="rtl")
+    assert rtl.checks["memory"].figure == 4 * 3 * (40 + 38)
+
+
+def test_logic_budget_breaks_with_headroom() -> None:
+    heavy = LogicCost(2000, 0, 100, 0)
+    f = assess(_dog2_a17_shared(), ECP5, CAMERA, heavy)
+    assert [c.name for c in f.broken] == ["lut4"]
+    assert f.checks["lut4"].figure == 40 * 2000 + 560 > 0.8 * 83640
+    # the same logic fits with no headroom asked: 80,560 <= 83,640
+    assert assess(_dog2_a17_shared(), ECP5, CAMERA, heavy, max_utilisation=1.0).feasible
+    with pytest.raises(RvsmError, match="max_utilisation"):
+        assess(_dog2_a17_shared(), ECP5, CAMERA, heavy, max_utilisation=0)
+
+
+def test_a_measured_fmax_below_the_model_decides() -> None:
+    slow = MeasuredFmax(90.0, 1, "a test")
+    light = LogicCost(1000, 131, 800, 300)
+    f = assess(_dog2_a17_shared(), ECP5, CAMERA, light, measured=slow)
+    # 90 MHz: P = 40 needs 100 MHz, so the fewest lanes are 50 (80 MHz)
+    assert f.feasible and f.lanes == 50 and f.checks["fmax"].budget == 90.0
+    assert "measured: 90.0 MHz at P = 1 (a test), taken for P = 50" in f.checks["fmax"].detail
+    fast = MeasuredFmax(300.0, 1, "a test")
+    f = assess(_dog2_a17_shared(), ECP5, CAMERA, light, measured=fast)
+    assert f.lanes == 40 and f.checks["fmax"].budget == 154.1  # the model is lower
+
+
+def test_a_fixed_clock_sets_the_lanes() -> None:
+    cam = Camera(250, 400, 40_000.0, clock_hz=160e6)
+    f = assess(StateLayout(250, 400, (ScaleState(17, 0),), 7, 1), ECP5, cam, DEFAULT_LOGIC)
+    assert f.lanes == 25 and f.clock_needed_hz == 160e6
+    assert f.checks["fmax"].ok is False and f.broken[0].name == "fmax"  # 154.1 < 160
+
+
+def test_no_timing_model_or_logic_is_unknown_not_feasible() -> None:
+    small = StateLayout(64, 64, (ScaleState(12, 0),), 7, 1)
+    cam = Camera(64, 64, 1000.0)
+    f = assess(small, get_budget("gw2a-18"), cam, DEFAULT_LOGIC)
+    assert not f.feasible and not f.broken
+    assert [c.name for c in f.unknown] == ["fmax"]
+    assert f.summary().startswith("unverified on gw2a-18")
+    assert "ECP5 figures as a proxy on gowin" in f.checks["lut4"].detail
+    g = assess(small, ECP5, cam, None)
+    assert {c.name for c in g.unknown} == {"lut4", "ff"}
+
+
+def test_camera_parse_and_size_mismatch() -> None:
+    cam = Camera.parse({"size": "250x400", "rate_hz": 40000})
+    assert cam == CAMERA and cam.pixel_steps_per_s == 4e9
+    assert Camera.parse({"size": "4x8", "rate_hz": 10, "clock_mhz": 1}).clock_hz == 1e6
+    for bad, msg in (({"size": "250by400", "rate_hz": 1}, "camera.size"),
+                     ({"size": "4x8", "rate_hz": 0}, "rate_hz"),
+                     ({"size": "4x8"}, "takes size, rate_hz"),
+                     ("250x400", "must be a table")):
+        with pytest.raises(RvsmError, match=msg):
+            Camera.parse(bad)
+    with pytest.raises(RvsmError, match="the camera 250x400"):
+        assess(StateLayout(8, 8, (ScaleState(8, 0),), 7, 1), ECP5, CAMERA, DEFAULT_LOGIC)
+
+
+def test_logic_cost_from_a_lane_cost_record() -> None:
+    rec = {"lanes": [1, 2], "ff": [1500, 2500], "ff_per_lane": 1000.0,
+           "lut4_per_lane": 1400.0, "lut4_base": 120.0, "size": [16, 16]}
+    logic = LogicCost.from_record(rec)
+    assert (logic.ff_base, logic.lut4_base, logic.lut4_per_lane) == (500.0, 120.0, 1400.0)

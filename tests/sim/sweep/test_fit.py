@@ -1,0 +1,110 @@
+"""A sweep's device constraint: parsing, the report's ranking and the CLI."""
+
+from __future__ import annotations
+
+import pytest
+
+from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.fpga.lane_cost import LaneSynthesis
+from rvsm.sim.cli import main
+from rvsm.sim.sweep.fit import parse_constraint
+from rvsm.sim.sweep.report import write_report
+from rvsm.sim.sweep.run import run_sweep
+from rvsm.sim.sweep.spec import parse_sweep
+
+HEAD = 'fits = "ecp5-85"\ncamera = { size = "250x400", rate_hz = 40000 }\n'
+BODY = """
+[axes]
+"array.model" = ["dog1", "dog2"]
+[run]
+scenes = ["coin"]
+size = "16x24"
+frames = 3
+[hardware]
+enabled = true
+size = "4x4"
+"""
+
+
+def test_constraint_parsed_with_its_defaults():
+    spec = parse_sweep(HEAD + 'memory_organisation = "rtl"\n' + BODY)
+    c = spec.constraint
+    assert c.devices == ("ecp5-85",) and (c.camera.height, c.camera.width) == (250, 400)
+    assert c.camera.rate_hz == 40000 and c.organisation == "rtl" and c.max_utilisation == 0.8
+    assert parse_sweep(BODY).constraint is None
+    two = parse_constraint({"fits": ["ecp5-85", "gw5ast-138"],
+                            "camera": {"size": "250x400", "rate_hz": 4e4}}, "s")
+    assert two.devices == ("ecp5-85", "gw5ast-138")
+
+
+@pytest.mark.parametrize("text,msg", [
+    ('fits = "ecp5-99"\ncamera = { size = "250x400", rate_hz = 40000 }\n',
+     r"s.toml: fits: unknown device 'ecp5-99'; choose one of: ecp5-25, ecp5-45, ecp5-85, "),
+    ('fits = "ecp5-85"\ncamera = { size = "250by400", rate_hz = 40000 }\n',
+     r"s.toml: camera.size: "),
+    ('fits = "ecp5-85"\n', r"fits and camera go together"),
+    ('max_utilisation = 0.5\n', r"max_utilisation needs fits"),
+    (HEAD + 'max_utilisation = 1.5\n', r"max_utilisation must be a number in \(0, 1\]"),
+    (HEAD + 'memory_organisation = "diagonal"\n', r"one of rtl, per-scale, packed"),
+    ('fitz = "ecp5-85"\n', r"unknown section \[fitz\]; valid: .*top-level keys: fits, camera"),
+])
+def test_bad_constraints_are_one_line_naming_the_choices(text, msg):
+    with pytest.raises(RvsmError, match=msg):
+        parse_sweep(text + BODY, "s.toml")
+
+
+@pytest.fixture
+def fake_synthesis(monkeypatch):
+    """yosys replaced by a linear logic model: dog1 400 LUT4 + 500 FF per lane, dog2 twice
+    that, 100 of each at zero lanes (the hardware measurement is tested elsewhere)."""
+    import rvsm.rtl.fpga.lane_cost as lane_cost_module
+
+    def fake(point, lanes, **kw):
+        k = point.num_scales
+        return LaneSynthesis(lanes=lanes, logic=100 + 400 * k * lanes,
+                             ff=100 + 500 * k * lanes, fmax_mhz=None, seconds=0.0)
+
+    monkeypatch.setattr(lane_cost_module, "lane_synthesis", fake)
+
+
+def test_report_ranks_what_fits_and_says_what_breaks(tmp_path, capsys, fake_synthesis):
+    db = tmp_path / "r.sqlite"
+    run_sweep(parse_sweep(HEAD + BODY), db, workers=0, progress=False)
+    files, info = write_report(db, tmp_path / "rep")
+    text = (tmp_path / "rep" / "report.md").read_text()
+    # dog1, per-pixel thresholds, packed at P = 40: 100 + 95 DP16KD of 208; dog2 twice
+    assert [d["label"].split(",")[0] for d in info["fits"]["ecp5-85"]] == ["array.model=dog1"]
+    (bad,) = info["infeasible"]["ecp5-85"]
+    assert bad["label"].startswith("array.model=dog2")
+    assert "memory BREAKS: 390 / 208 DP16KD (+88 %)" in bad["summary"]
+    assert "## Fits ecp5-85 at 250x400 at 40,000 Hz" in text
+    assert "**1 of 2 designs fit.**" in text and "195 / 208" in text
+    # logic at P = 40: 100 + 40 x 400 LUT4 + the line buffer's 140 16x4 RAMs x 4
+    assert "16,660 / 66,912" in text
+    # the same database checked against another device and camera from the command line
+    capsys.readouterr()
+    assert main(["sweep", "report", str(db), "-o", str(tmp_path / "rep2"), "--fits",
+                 "ecp5-25,ice40-up5k", "--camera", "16x24", "--rate-hz", "1000"]) == 0
+    out = capsys.readouterr().out
+    assert "fits ecp5-25: 2 of 2 design(s)" in out
+    # no Fmax model for the iCE40: unverified, not feasible
+    assert "fits ice40-up5k: 0 of 2 design(s)" in out and "unverified on ice40-up5k" in out
+
+
+def test_cli_devices_and_bad_values_exit_2(tmp_path, capsys, fake_synthesis):
+    assert main(["sweep", "devices"]) == 0
+    out = capsys.readouterr().out
+    assert "ecp5-85: LFE5U-85F speed 6" in out and "208 DP16KD" in out
+    assert "512x36 (pseudo-dual)" in out and "ice40-up5k" in out
+    f = tmp_path / "s.toml"
+    f.write_text(HEAD.replace("ecp5-85", "nosuch") + BODY)
+    assert main(["sweep", str(f), "-o", str(tmp_path / "x.sqlite")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "unknown device 'nosuch'; choose one of: ecp5-25" in err[0]
+    db = tmp_path / "r.sqlite"
+    run_sweep(parse_sweep(BODY), db, workers=0, progress=False)
+    assert main(["sweep", "report", str(db), "--fits", "ecp5-85"]) == 2  # no camera
+    assert "fits and camera go together" in capsys.readouterr().err
+    assert main(["sweep", "report", str(db), "--fits", "nosuch", "--camera", "4x4",
+                 "--rate-hz", "1"]) == 2
+    assert "choose one of" in capsys.readouterr().err
