@@ -12,14 +12,22 @@ imports ``rtl`` or ``sim``):
 - :mod:`.sampling` -- the float twin (SPEC section 2): configuration and results, the
   numpy and fused numba engines, one chunked run pipeline (``sample``,
   ``stream_float``), threshold rules and the literal SPEC oracle.
-- :mod:`.fixed` -- the bit-accurate fixed-point twin (SPEC section 5): design points, the
-  :class:`~.fixed.core.ArrayContract`, the numpy and fused engines and one run pipeline
-  (``simulate_fixed``, ``stream_fixed``), stimulus, profile and cost.
+- :mod:`.fixed` -- the bit-accurate fixed-point twin (SPEC section 5) of either sensor:
+  design points and their rules per sensor kind, the
+  :class:`~.fixed.contract.ArrayContract`, the numpy and fused engines and one run
+  pipeline (``simulate_fixed``, ``stream_fixed``), stimulus and profile.
+- :mod:`.events` -- the event sensor, RVSM-DVS (SPEC section 7): its float twin, its
+  decoder and HDF5 event lists.
 - :mod:`.spikes` -- spike I/O: ``.npz``, the camera's ``.dat``, chunked HDF5, two-bit
-  packing, the sinks a chunked run writes to and one reader entry point
-  (``open_spikes``).
+  packing, the sinks a chunked run writes to and one by-suffix reader
+  (``open_spike_file``).
 - :mod:`.decode` -- reconstruction (TFI/TFP, the RVSM adjoint, the least-squares inverse),
   metrics (PSNR/SSIM) and evaluation, whole-array or streamed.
+- :mod:`.kinds` -- the sensor kind as a declarative value (``SensorKind``, its output
+  rule), importing nothing of the other sub-packages, so all may take it.
+- :mod:`.sensors` -- the top: the registered sensors (spike camera, event sensor)
+  composing the sub-packages above (float twin, decoder, file kinds), every file format
+  behind one reader (``open_spikes``) and the quantisation cost of a design point.
 - :mod:`.infra` -- what the models run on: errors and exit statuses, atomic writes,
   external tools, progress bars, versions, memory checks, text and ``.npy`` guards.
 """

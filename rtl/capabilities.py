@@ -20,6 +20,7 @@ from amaranth.lib import wiring
 
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kinds.sensor_kind import Output
 
 __all__ = ["Architecture", "Option", "require_spike_sensor"]
 
@@ -108,7 +109,7 @@ class Architecture:
 def require_spike_sensor(contract: ArrayContract, what: str) -> None:
     """Refuse (:class:`RvsmError`) a contract of the event sensor for ``what`` (e.g. "the
     formal properties"), which is written for the spike camera's accumulators only."""
-    if getattr(contract, "sensor", "spike") != "spike":
+    if contract.kind.output is not Output.SPIKES:
         raise RvsmError(f"{what} of the event sensor (sensor = {contract.sensor!r}) are not "
                         "written yet: they state the spike camera's accumulator rules; the "
                         "event sensor's RTL is checked by co-simulation (docs/events.md)")

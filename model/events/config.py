@@ -15,14 +15,13 @@ import numpy as np
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import ModelSpec, model_spec
+from rvsm.model.kinds.sensor_kind import DVS
 from rvsm.model.noise.sensor import NoiseParams, NoiseSource
 from rvsm.model.scene.scene import Scene
 
-__all__ = ["DEFAULT_CONTRAST", "SENSORS", "EventConfig", "EventTrain",
-           "contrast_thresholds", "event_meta"]
+__all__ = ["DEFAULT_CONTRAST", "EventConfig", "EventTrain", "contrast_thresholds",
+           "event_meta"]
 
-#: The sensors ``rvsm simulate --sensor`` takes: the spike camera and the event camera.
-SENSORS = ("spike", "dvs")
 #: Default contrast threshold ``C`` (log-intensity units; SPEC section 7).
 DEFAULT_CONTRAST = 0.2
 
@@ -73,7 +72,7 @@ class EventConfig:
 
     def to_dict(self) -> dict:
         """Plain-JSON form, for event-file metadata."""
-        return {"sensor": "dvs", "model": self.model, "contrast": float(self.contrast),
+        return {"sensor": DVS.name, "model": self.model, "contrast": float(self.contrast),
                 "scale_contrast": (list(self.scale_contrast)
                                    if self.scale_contrast is not None else None),
                 "noise": self.noise.to_dict() if self.noise is not None else None}

@@ -9,13 +9,17 @@ DVS), the image ``exp(L_hat) - 1``, then the brightness matching and metrics of 
 section 4. An event list (:mod:`.event_list`) carries the references; the project's own
 event files (the spike-file formats) do not, so they are regenerated from the scene and
 the file's metadata (the same float model, dark current of step 0 included),
-:func:`capture_references`; for the fixed-point twin's events (their meta holds the
-design point) the integer references and the quantised contrasts, in log units
-(:mod:`rvsm.model.fixed.event_references`). Files are read chunk by chunk (memory: one chunk
-plus the running counts and the scored steps' responses).
+:func:`capture_references`. The fixed-point twin's events (their meta holds the design
+point) are decoded with the integer references and the quantised contrasts, in log units
+(:mod:`rvsm.model.fixed.event_references`), which the caller passes as ``reported``:
+the event sensor's decoder, :mod:`rvsm.model.sensors.event_sensor`, above both packages.
+Files are read chunk by chunk (memory: one chunk plus the running counts and the scored
+steps' responses).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 
@@ -97,9 +101,19 @@ def event_images(responses: np.ndarray, config: EventConfig) -> np.ndarray:
     return np.expm1(log_hat)
 
 
-def evaluate_events(source: SpikeSource, scene: Scene, match: str = "gain") -> dict:
+#: What a sensor reported at its capture step, from the scene and the file's meta:
+#: ``(references (S, H, W), contrasts (S,))`` in log-intensity units.
+Reported = Callable[[Scene, dict], tuple[np.ndarray, np.ndarray]]
+
+
+def evaluate_events(source: SpikeSource, scene: Scene, match: str = "gain",
+                    reported: Reported | None = None) -> dict:
     """Score an event file against ``scene``: ``{"mse", "psnr", "ssim", "num_scored",
-    "method"}`` averaged over :func:`scored_event_steps` (SPEC sections 4 and 7)."""
+    "method"}`` averaged over :func:`scored_event_steps` (SPEC sections 4 and 7).
+
+    The references and contrasts are those the source reports (an event list), else
+    ``reported(scene, meta)`` (the fixed-point twin's, required when the meta holds a
+    design point), else the float model's (:func:`capture_references`)."""
     if match not in MATCH_MODES:
         raise RvsmError(f"unknown brightness match {match!r}; choose one of {MATCH_MODES}")
     config = config_from_meta(source.meta)
@@ -111,15 +125,12 @@ def evaluate_events(source: SpikeSource, scene: Scene, match: str = "gain") -> d
     steps = scored_event_steps(scene)
     refs = getattr(source, "references", None)  # reported in an event list
     contrasts = getattr(source, "contrasts", None)
-    if source.meta.get("design_point") is not None:  # the fixed-point twin's events
-        from rvsm.model.fixed.design_point import DesignPoint
-        from rvsm.model.fixed.event_references import fixed_event_references
-
-        try:
-            point = DesignPoint(**source.meta["design_point"]).with_size(*scene.shape)
-        except (TypeError, RvsmError) as exc:
-            raise RvsmError(f"the event file's design point is not valid ({exc})") from None
-        fixed_refs, fixed_contrasts = fixed_event_references(scene, point)
+    if reported is None and source.meta.get("design_point") is not None and \
+            (refs is None or contrasts is None):
+        raise RvsmError("the fixed-point twin's events are decoded with its own references: "
+                        "evaluate them with rvsm.model.sensors (rvsm evaluate)")
+    if reported is not None:  # e.g. the fixed-point twin's events
+        fixed_refs, fixed_contrasts = reported(scene, source.meta)
         refs = fixed_refs if refs is None else refs
         contrasts = fixed_contrasts if contrasts is None else contrasts
     if refs is None:

@@ -15,7 +15,8 @@ way, so the fixed twin (:mod:`rvsm.model.fixed.twin`) and the RTL tests share on
 
 All arithmetic is ``int64``; widths are checked so nothing can overflow it.
 
-The event sensor (``sensor = "dvs"``, SPEC section 7) keeps steps 1-2 (its codes come
+The event sensor (``sensor = "dvs"``, SPEC section 7; its kind's
+:class:`~rvsm.model.kinds.sensor_kind.Output` is ``EVENTS``) keeps steps 1-2 (its codes come
 from a log ADC) and replaces 3-5 by a W-bit signed saturating reference per accumulator
 (:class:`FixedEventIntegrator`): captured as ``clamp(shifted)`` at the first step after
 a clear (no event); afterwards ``d = shifted - ref`` (exact), ``d >= thr`` is ON (+1,
@@ -32,11 +33,12 @@ import numpy as np
 from rvsm.model.fixed.widths import signed_range, unsigned_max
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.geometry import is_symmetric, symmetric_orbits
+from rvsm.model.kinds.sensor_kind import SENSOR_NAMES, SPIKE, Output, SensorKind, sensor_kind
 from rvsm.model.sampling.config import RESET_MODES
 
-#: What an array senses: the spike camera's integrate-and-fire, or the event camera's
-#: log-intensity changes (SPEC section 7).
-SENSORS = ("spike", "dvs")
+#: The names :attr:`ArrayContract.sensor` takes: what an array senses, the spike camera's
+#: integrate-and-fire or the event camera's log-intensity changes (SPEC section 7).
+SENSORS = SENSOR_NAMES
 
 
 def integer_receptive_sums(codes: np.ndarray, weights: Sequence[np.ndarray]) -> np.ndarray:
@@ -262,17 +264,28 @@ class FixedEventIntegrator:
         return events
 
 
-def make_integrator(sensor: str, thresholds: np.ndarray, accumulator_bits: int,
+def _spike_integrator(thresholds: np.ndarray, accumulator_bits: int, signed: bool,
+                      reset: str, track: bool, histogram: bool) -> FixedIntegrator:
+    return FixedIntegrator(thresholds, accumulator_bits, signed, reset, track, histogram)
+
+
+def _event_integrator(thresholds: np.ndarray, accumulator_bits: int, signed: bool,
+                      reset: str, track: bool, histogram: bool) -> FixedEventIntegrator:
+    return FixedEventIntegrator(thresholds, accumulator_bits, track, histogram)
+
+
+#: The integrator of each output rule (arguments of :func:`make_integrator`).
+INTEGRATORS = {Output.SPIKES: _spike_integrator, Output.EVENTS: _event_integrator}
+
+
+def make_integrator(kind: SensorKind, thresholds: np.ndarray, accumulator_bits: int,
                     signed: bool, reset: str = "zero", track: bool = False,
                     histogram: bool = False) -> FixedIntegrator | FixedEventIntegrator:
-    """The state of ``sensor``'s accumulators: :class:`FixedIntegrator` for the spike
-    camera, :class:`FixedEventIntegrator` for the event sensor (``signed``, ``reset``
-    unused there)."""
-    if sensor == "dvs":
-        return FixedEventIntegrator(thresholds, accumulator_bits, track, histogram)
-    if sensor != "spike":
-        raise RvsmError(f"sensor must be one of {SENSORS}, got {sensor!r}")
-    return FixedIntegrator(thresholds, accumulator_bits, signed, reset, track, histogram)
+    """The state of a ``kind`` sensor's accumulators, chosen by its output rule:
+    :class:`FixedIntegrator` for spikes, :class:`FixedEventIntegrator` for events
+    (``signed``, ``reset`` unused there)."""
+    return INTEGRATORS[kind.output](thresholds, accumulator_bits, signed, reset, track,
+                                    histogram)
 
 
 class ContractStream:
@@ -288,7 +301,7 @@ class ContractStream:
 
     def __init__(self, weights: Sequence[np.ndarray], shift: int, thresholds: np.ndarray,
                  accumulator_bits: int, signed: bool, reset: str = "zero",
-                 block_steps: int = 32, sensor: str = "spike"):
+                 block_steps: int = 32, sensor: SensorKind = SPIKE):
         self.weights = list(weights)
         self.shift = int(shift)
         self.block_steps = max(1, int(block_steps))
@@ -324,7 +337,7 @@ def run_integer_array(
     signed: bool,
     reset: str = "zero",
     block_steps: int = 32,
-    sensor: str = "spike",
+    sensor: SensorKind = SPIKE,
 ) -> np.ndarray:
     """Spikes (or events) ``(T, S, H, W) int8`` of the whole contract on ``codes (T, H,
     W)``.
@@ -342,9 +355,10 @@ class ArrayContract:
     ``weights`` holds, per scale, the integer kernel as a tuple of row tuples (hashable, so
     a contract can key a cache of generated RTL). Thresholds are *not* part of it: they are
     loaded at run time through the configuration interface (fixed-pattern noise lives
-    there), each in ``1 .. 2**(accumulator_bits-1) - 1``. ``sensor`` is ``"spike"`` (the
-    spike camera) or ``"dvs"`` (the event sensor: log ADC codes, references instead of
-    accumulators; module docstring).
+    there), each in ``1 .. 2**(accumulator_bits-1) - 1``. ``sensor`` is the name of its
+    :attr:`kind`: ``"spike"`` (the spike camera) or ``"dvs"`` (the event sensor: log ADC
+    codes, references instead of accumulators; module docstring). It stays a name so a
+    contract is written to JSON and digested as text.
     """
 
     height: int
@@ -355,7 +369,13 @@ class ArrayContract:
     accumulator_bits: int
     signed: bool
     reset: str = "zero"
-    sensor: str = "spike"
+    sensor: str = SPIKE.name
+
+    @property
+    def kind(self) -> SensorKind:
+        """The sensor kind named by :attr:`sensor`; its ``output`` is the RTL's output
+        rule."""
+        return sensor_kind(self.sensor)
 
     @property
     def num_scales(self) -> int:
@@ -393,7 +413,7 @@ class ArrayContract:
         parts = [
             run_integer_array(
                 codes[a:b], self.weight_arrays, self.shift, thresholds,
-                self.accumulator_bits, self.signed, self.reset, sensor=self.sensor,
+                self.accumulator_bits, self.signed, self.reset, sensor=self.kind,
             )
             for a, b in zip(bounds[:-1], bounds[1:], strict=True)
         ]
@@ -403,4 +423,4 @@ class ArrayContract:
         """This contract run chunk by chunk from a cleared array (:class:`ContractStream`)."""
         return ContractStream(self.weight_arrays, self.shift, thresholds,
                               self.accumulator_bits, self.signed, self.reset,
-                              sensor=self.sensor)
+                              sensor=self.kind)

@@ -16,6 +16,9 @@ of an unsigned model) is ``None``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+
 import numpy as np
 
 from rvsm.model.fixed.contract import (
@@ -24,10 +27,12 @@ from rvsm.model.fixed.contract import (
     FixedIntegrator,
     arithmetic_shift,
     integer_receptive_sums,
+    make_integrator,
 )
 from rvsm.model.fixed.stimulus import Stimulus
 from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kinds.sensor_kind import Output
 
 __all__ = ["BINS", "corner_stimulus", "coverage", "coverage_summary", "min_steps"]
 
@@ -132,29 +137,24 @@ def coverage(stim: Stimulus) -> list[dict[str, int | None]]:
     """Per scale, accumulator-steps of ``stim`` in each of :data:`BINS` (None: the
     contract cannot reach that bin). Runs chunk by chunk: a lazy stimulus
     (:func:`~.stimulus.open_stimulus`) is read a range of steps at a time. The event
-    sensor's bins follow its rules (:func:`_event_bins`)."""
+    sensor's bins follow its rules (:func:`_event_bins`); each output rule's bins are
+    its :class:`_Bins` in :data:`_BINS_OF`."""
     c = stim.contract
+    rule = _BINS_OF[c.kind.output]
     full = unsigned_max(c.adc_bits)
     counts = np.zeros((c.num_scales, len(BINS)), dtype=np.int64)
     idx = {b: i for i, b in enumerate(BINS)}
-    event = c.sensor == "dvs"
-    integ = (FixedEventIntegrator(stim.thresholds, c.accumulator_bits) if event else
-             FixedIntegrator(stim.thresholds, c.accumulator_bits, c.signed, c.reset))
-    axes = (1, 2)
+    integ = make_integrator(c.kind, stim.thresholds, c.accumulator_bits, c.signed, c.reset)
     for t0, t1, clear in stim.step_ranges(COVERAGE_CHUNK_STEPS):
         codes = np.asarray(stim.codes[t0:t1], dtype=np.int64)
         sums = _shifted(c, codes)
         if clear:
-            if event:
-                if integ.captured:
-                    counts[:, idx["clear_mid_stream"]] += (integ.ref != 0).sum(axis=axes)
-            else:
-                counts[:, idx["clear_mid_stream"]] += (integ.acc != 0).sum(axis=axes)
+            counts[:, idx["clear_mid_stream"]] += rule.dropped(integ)
             integ.clear()
         for b in range(t1 - t0):
             counts[:, idx["code_zero"]] += int((codes[b] == 0).sum())
             counts[:, idx["code_full"]] += int((codes[b] == full).sum())
-            (_event_bins if event else _spike_bins)(integ, sums[b], counts, idx)
+            rule.step(integ, sums[b], counts, idx)
     return _reachable(c, counts)
 
 
@@ -196,15 +196,51 @@ def _event_bins(integ: FixedEventIntegrator, sums: np.ndarray, counts: np.ndarra
     counts[:, idx["spike_neg"]] += (events == -1).sum(axis=axes)
 
 
+def _spike_dropped(integ: FixedIntegrator) -> np.ndarray:
+    """Per scale, the non-zero accumulators a clear drops."""
+    return (integ.acc != 0).sum(axis=(1, 2))
+
+
+def _event_dropped(integ: FixedEventIntegrator) -> np.ndarray | int:
+    """Per scale, the captured non-zero references a clear drops."""
+    return (integ.ref != 0).sum(axis=(1, 2)) if integ.captured else 0
+
+
+def _spike_reachable(c: ArrayContract, s_lo: int) -> dict[str, bool]:
+    """The spike camera's bins a scale with least sum ``s_lo`` can reach (the others
+    are)."""
+    return {"rail_low": s_lo < 0, "exact_threshold_neg": c.signed and s_lo < 0,
+            "spike_neg": c.signed and s_lo < 0}
+
+
+def _event_reachable(c: ArrayContract, s_lo: int) -> dict[str, bool]:
+    """The event sensor's: OFF events whenever the response falls; a reference goes
+    below 0 only with negative sums."""
+    return {"rail_low": s_lo < 0}
+
+
+@dataclass(frozen=True)
+class _Bins:
+    """How one output rule fills the bins: what a clear drops, one step's bins, and
+    which bins a scale can reach."""
+
+    dropped: Callable
+    step: Callable
+    reachable: Callable[[ArrayContract, int], dict[str, bool]]
+
+
+#: The bins of each output rule (:class:`~rvsm.model.kinds.sensor_kind.Output`).
+_BINS_OF = {Output.SPIKES: _Bins(_spike_dropped, _spike_bins, _spike_reachable),
+            Output.EVENTS: _Bins(_event_dropped, _event_bins, _event_reachable)}
+
+
 def _reachable(c: ArrayContract, counts: np.ndarray) -> list[dict[str, int | None]]:
     """Per scale the bin counts, ``None`` for the bins the contract cannot reach."""
     out: list[dict[str, int | None]] = []
+    reachable_of = _BINS_OF[c.kind.output].reachable
     for scale in range(c.num_scales):
-        s_lo, s_hi = c.sum_range(scale)
-        reachable = {"rail_low": s_lo < 0, "exact_threshold_neg": c.signed and s_lo < 0,
-                     "spike_neg": c.signed and s_lo < 0}
-        if c.sensor == "dvs":  # OFF events whenever the response falls; a reference
-            reachable = {"rail_low": s_lo < 0}  # goes below 0 only with negative sums
+        s_lo, _ = c.sum_range(scale)
+        reachable = reachable_of(c, s_lo)
         out.append({b: (int(counts[scale, i]) if reachable.get(b, True) else None)
                     for i, b in enumerate(BINS)})
     return out

@@ -247,7 +247,7 @@ class FusedFixedTwin:
 
     def __init__(self, scene: Scene, point: DesignPoint, thresholds: np.ndarray,
                  tile_rows: int = DEFAULT_TILE_ROWS, ranges: bool = True):
-        if point.sensor != "spike":
+        if not point.rules.fused_twin:
             raise RvsmError("the fused fixed twin runs the spike camera; the event sensor "
                             "runs the numpy engine (rvsm.model.fixed.twin.make_twin)")
         self.scene = scene

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from rvsm.model.fixed.adc import adc_codes, log_adc_codes
 from rvsm.model.fixed.contract import (
     arithmetic_shift,
     bit_length_histogram,
@@ -30,15 +29,11 @@ def step_codes(scene: Scene, point: DesignPoint, noise: NoiseSource | None, t0: 
                t1: int) -> np.ndarray:
     """ADC codes ``(t1 - t0, H, W) int64`` of steps ``t0 .. t1 - 1``: the scene's
     brightness plus ``noise``'s dark current (``point.noise_source()``, or None) through
-    the point's ADC."""
+    the point's ADC (its sensor's law: linear, or the event sensor's log)."""
     analog = scene.brightness(t0, t1)
     if noise is not None:
         analog += noise.dark_current_at(t0, t1 - t0)
-    if point.sensor == "dvs":
-        return log_adc_codes(analog, point.adc_bits, point.adc_log_frac_bits,
-                             point.adc_rounding, point.adc_clip)
-    return adc_codes(analog, point.adc_bits, point.adc_full_scale, point.adc_rounding,
-                     point.adc_clip)
+    return point.rules.adc_codes(point, analog)
 
 
 class NumpyFixedTwin:
@@ -61,7 +56,7 @@ class NumpyFixedTwin:
         self.weights = point.contract().weight_arrays
         self.block_steps = int(block_steps)
         self.integrator = make_integrator(
-            point.sensor, thresholds, point.accumulator_bits, point.signed, point.reset,
+            point.kind, thresholds, point.accumulator_bits, point.signed, point.reset,
             track=True, histogram=histograms,
         )
         s = point.num_scales

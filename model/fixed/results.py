@@ -9,10 +9,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rvsm.model.events.config import event_meta
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
-from rvsm.model.sampling.config import sampling_meta
 from rvsm.model.scene.scene import Scene
 
 
@@ -65,12 +63,8 @@ def fixed_meta(
     """Spike-file metadata: the float sampler's keys plus the design point and counters
     (``stats`` None: before the run, zero saturation counts)."""
     saturated = stats.saturated if stats is not None else np.zeros(point.num_scales, int)
-    if point.sensor == "dvs":  # events: read as the float event sensor's files are
-        base = {**event_meta(scene, point.event_config()), "fixed": True}
-    else:
-        base = {**sampling_meta(scene, point.sampler_config()), "kind": "fixed"}
     return {
-        **base,
+        **point.rules.float_meta(scene, point),  # read as the float model's files are
         "height": point.shape[0],
         "width": point.shape[1],
         "design_point": point.to_dict(),

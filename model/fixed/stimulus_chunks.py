@@ -36,6 +36,7 @@ from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.fused import FusedFixedTwin
 from rvsm.model.fixed.numpy_engine import step_codes
 from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
+from rvsm.model.fixed.sensor_rules import sensor_rules
 from rvsm.model.fixed.stimulus import Stimulus, open_stimulus, step_ranges
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.scene import Scene
@@ -121,8 +122,8 @@ class StimulusChunks:
         """Consecutive chunks of at most ``chunk_steps`` steps, never across a clear."""
         ranges = step_ranges(self.num_steps, self.clear_before, chunk_steps)
         stream = twin = None
-        spike = self.contract.sensor == "spike"  # the event sensor has no fused twin
-        if (self._engine == "numpy" or not spike) and self.stimulus is None \
+        fused = sensor_rules(self.contract.kind).fused_twin  # not the event sensor
+        if (self._engine == "numpy" or not fused) and self.stimulus is None \
                 or self._recompute:
             stream = self.contract.stream(self.thresholds)
         elif self.stimulus is None:

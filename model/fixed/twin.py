@@ -46,9 +46,9 @@ def make_twin(scene: Scene, point: DesignPoint, thresholds: np.ndarray, engine: 
               histograms: bool = False) -> FusedFixedTwin | NumpyFixedTwin:
     """The engine that runs ``point`` on ``scene`` (arguments as :func:`stream_fixed`):
     the fused twin when ``engine == "fused"`` and neither codes nor histograms are kept,
-    for the spike camera; otherwise the numpy engine (the event sensor has no fused
-    kernel)."""
-    if engine == "fused" and not keep_codes and not histograms and point.sensor == "spike":
+    for a sensor the fused engine runs (``point.rules.fused_twin``: the spike camera);
+    otherwise the numpy engine (the event sensor has no fused kernel)."""
+    if engine == "fused" and not keep_codes and not histograms and point.rules.fused_twin:
         return FusedFixedTwin(scene, point, thresholds, tile_rows, ranges)
     return NumpyFixedTwin(scene, point, thresholds, block_steps, keep_codes, histograms)
 

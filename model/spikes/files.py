@@ -1,8 +1,10 @@
-"""Spike files of every format behind one entry point, chosen by suffix.
+"""Spike files of the dense formats behind one entry point, chosen by suffix.
 
-:func:`open_spikes` opens ``.h5`` / ``.hdf5`` lazily (:mod:`.h5`) and ``.npz`` in memory
-(:mod:`.npz`) as a :class:`~.source.SpikeSource`; :func:`write_spikes` writes a whole
-array to either; :func:`copy_source` streams a source into a sink (:mod:`.sinks`).
+:func:`open_spike_file` opens ``.h5`` / ``.hdf5`` lazily (:mod:`.h5`) and ``.npz`` in
+memory (:mod:`.npz`) as a :class:`~.source.SpikeSource`; :func:`write_spikes` writes a
+whole array to either; :func:`copy_source` streams a source into a sink (:mod:`.sinks`).
+Every file a sensor writes, HDF5 event lists included, is opened by
+:func:`rvsm.model.sensors.files.open_spikes` (above this package and the event lists').
 """
 
 from __future__ import annotations
@@ -18,25 +20,14 @@ from rvsm.model.spikes.sinks import SpikeSink, fill_sink
 from rvsm.model.spikes.source import SpikeSource, array_source
 
 
-def open_spikes(path: str | os.PathLike) -> SpikeSource:
-    """Open an ``.h5`` (lazily) or ``.npz`` (in memory) spike file for reading; an HDF5
-    event list (:mod:`rvsm.model.events.event_list`) is read as dense events."""
+def open_spike_file(path: str | os.PathLike) -> SpikeSource:
+    """Open an ``.h5`` (lazily) or ``.npz`` (in memory) spike file for reading."""
     if is_h5_path(path):
-        from rvsm.model.events.event_list import is_event_list, open_event_list
-
-        if is_event_list(path):
-            return open_event_list(path)
         return open_h5(path)
     spikes, meta = load_spikes(path)
     src = array_source(spikes, meta)
     src.path = str(path)
     return src
-
-
-def load_any_spikes(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
-    """Whole spike array and meta of an ``.h5`` or ``.npz`` file (small files only)."""
-    with open_spikes(path) as src:
-        return check_spikes(src.read(0, src.num_steps), str(path)), src.meta
 
 
 def write_spikes(path: str | os.PathLike, spikes: np.ndarray, meta: dict,

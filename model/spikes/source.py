@@ -2,7 +2,7 @@
 
 A source has ``shape (T, S, H, W)``, ``meta`` and ``read(t0, t1)``, so readers stream any
 spike file step range by step range. :func:`array_source` wraps an in-memory array;
-:func:`rvsm.model.spikes.files.open_spikes` opens a file of any format,
+:func:`rvsm.model.sensors.files.open_spikes` opens a file of any format,
 :func:`rvsm.model.spikes.dat.dat_source` a camera ``.dat`` file.
 """
 

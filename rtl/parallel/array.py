@@ -150,7 +150,7 @@ class RvsmArray(wiring.Component):
                     a = accumulator_index(c, s, y, x)
                     cell = PixelCell(sum_width(lo, hi), c.shift, c.accumulator_bits,
                                      c.signed, c.reset, self.mutation,
-                                     getattr(c, "sensor", "spike"))
+                                     c.kind.output)
                     self.cells[a] = cell
                     m.submodules[f"cell_s{s}_y{y}_x{x}"] = cell
                     m.d.comb += [

@@ -25,6 +25,7 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from rvsm.model.fixed.widths import signed_range
+from rvsm.model.kinds.sensor_kind import Output
 from rvsm.rtl.interfaces import ThresholdWriteSignature
 
 __all__ = ["PixelCell"]
@@ -35,10 +36,13 @@ class PixelCell(wiring.Component):
 
     Parameters: ``sum_bits`` (signed width of ``sum_in``), ``shift``, ``accumulator_bits``
     (W), ``signed_model`` (fire -1 spikes), ``reset`` (``"zero"`` or ``"subtract"``),
-    ``sensor``: ``"spike"``, or ``"dvs"`` for the event sensor's cell (``acc`` is then the
-    reference, captured as ``clamp(shifted)`` at the first strobe after a clear or reset
-    with no event; afterwards ``d = shifted - ref``, ``d >= thr`` ON and ``ref =
-    clamp(ref + thr)``, else ``d <= -thr`` OFF and ``ref = clamp(ref - thr)``).
+    ``output``: the output rule (:class:`~rvsm.model.kinds.sensor_kind.Output`, a
+    contract's ``kind.output``): ``SPIKES``, or ``EVENTS`` for the event sensor's cell
+    (``acc`` is then the reference, captured as ``clamp(shifted)`` at the first strobe
+    after a clear or reset with no event; afterwards ``d = shifted - ref``, ``d >= thr``
+    ON and ``ref = clamp(ref + thr)``, else ``d <= -thr`` OFF and ``ref = clamp(ref -
+    thr)``). The next-state logic of each rule is a method, chosen through a table keyed
+    by the rule in :meth:`elaborate`.
 
     Ports: ``sum_in`` In(signed(sum_bits)); ``strobe``, ``clear`` In(1); ``thr``
     In(ThresholdWriteSignature(W-1)): ``thr.we``, ``thr.data``; ``spike_pos``,
@@ -59,11 +63,12 @@ class PixelCell(wiring.Component):
         signed_model: bool,
         reset: str = "zero",
         mutation: str | None = None,
-        sensor: str = "spike",
+        output: Output = Output.SPIKES,
     ):
-        if sensor not in ("spike", "dvs"):
-            raise ValueError(f"sensor must be 'spike' or 'dvs', got {sensor!r}")
-        self.sensor = sensor
+        if not isinstance(output, Output):
+            raise ValueError(f"output must be one of {[o.name for o in Output]}, got "
+                             f"{output!r}")
+        self.output = output
         if reset not in ("zero", "subtract"):
             raise ValueError(f"reset must be 'zero' or 'subtract', got {reset!r}")
         self.sum_bits = sum_bits
@@ -121,8 +126,13 @@ class PixelCell(wiring.Component):
         else:
             after = Mux(pos, sat - thr, Mux(neg, sat + thr, sat))
 
-        if self.sensor == "dvs":
-            return self._event_cell(m, thr, acc, shifted)
+        cells = {Output.SPIKES: lambda: self._spike_cell(m, thr, acc, pos, neg, after),
+                 Output.EVENTS: lambda: self._event_cell(m, thr, acc, shifted)}
+        return cells[self.output]()
+
+    def _spike_cell(self, m: Module, thr: Signal, acc: Signal, pos: Signal, neg: Signal,
+                    after: Value) -> Module:
+        """The spike camera's registers: threshold write, clear, accumulate and fire."""
         with m.If(self.thr.we):
             m.d.sync += thr.eq(self.thr.data)
         clear = self.clear if self.mutation != "parallel.clear_ignored" else 0

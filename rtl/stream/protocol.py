@@ -271,7 +271,7 @@ def _expected(c: ArrayContract, geo: StreamGeometry, seg_info: list, we: np.ndar
             .transpose(0, 3, 1, 2, 4).reshape(n_frames, c.num_scales, c.height, c.width)
         sums = arithmetic_shift(integer_receptive_sums(frames[:n_frames], c.weight_arrays),
                                 c.shift)
-        integ = make_integrator(c.sensor, thr_frames[0], c.accumulator_bits, c.signed,
+        integ = make_integrator(c.kind, thr_frames[0], c.accumulator_bits, c.signed,
                                 c.reset)
         spikes = []
         for t in range(n_frames):

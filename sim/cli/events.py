@@ -9,7 +9,8 @@ from pathlib import Path
 from rvsm.model.events.event_list import EventListWriter, open_event_list
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.spikes.files import copy_source, open_spikes
+from rvsm.model.sensors.files import open_spikes
+from rvsm.model.spikes.files import copy_source
 from rvsm.model.spikes.h5 import H5SpikeWriter, is_h5_path
 from rvsm.model.spikes.npz import save_spikes
 from rvsm.sim.cli.args import SceneRequest, add_force_argument, add_scene_arguments

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from rvsm.model.decode.reconstruction import MATCH_MODES, METHODS
-from rvsm.model.fixed.contract import SENSORS
+from rvsm.model.kinds.sensor_kind import SENSOR_NAMES, SPIKE, sensor_kind
 from rvsm.model.sampling.thresholds import THRESHOLD_RULES
 from rvsm.sim.cli.args import (
     SceneRequest,
@@ -18,9 +18,6 @@ from rvsm.sim.cli.args import (
 )
 from rvsm.sim.cli.outputs import PLAIN, Output, check_outputs
 
-#: ``rvsm config new --sensor dvs``: log ADC bits (ln(I + 1) of 8-bit brightness needs
-#: 5.55 * 2**5 = 178 codes).
-DVS_ADC_BITS = 8
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``config``, ``stimulus``, ``profile`` and ``cost``."""
@@ -30,7 +27,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     q = cfg.add_parser("new", help="print the documented default design point as TOML")
     q.add_argument("-o", "--output", help="write to this file instead of stdout")
     q.add_argument("--size", metavar="HxW", help="array size (default 250x400)")
-    q.add_argument("--sensor", choices=SENSORS, default="spike",
+    q.add_argument("--sensor", choices=SENSOR_NAMES, default=SPIKE.name,
                    help="spike (default) or dvs: the event sensor of SPEC section 7, with "
                    "an 8-bit log ADC of 5 fraction bits (ln(I + 1) up to 7.97)")
     add_force_argument(q)
@@ -88,15 +85,16 @@ def _point_and_scene(args: argparse.Namespace):
 
 def run_config_new(args: argparse.Namespace) -> int:
     """``rvsm config new``."""
+    import dataclasses
+
     from rvsm.model.fixed.design_point import default_design_point
     from rvsm.model.fixed.point_toml import design_point_toml, save_design_point
+    from rvsm.model.fixed.sensor_rules import sensor_rules
 
     check_outputs([args.output and Output(args.output, "-o", PLAIN)], force=args.force)
-    point = default_design_point()
-    if args.sensor == "dvs":
-        import dataclasses
-
-        point = dataclasses.replace(point, sensor="dvs", adc_bits=DVS_ADC_BITS)
+    kind = sensor_kind(args.sensor)
+    point = dataclasses.replace(default_design_point(), sensor=kind.name,
+                                **sensor_rules(kind).new_point)
     size = parse_size_arg(args.size)
     if size is not None:
         point = point.with_size(*size)
@@ -114,20 +112,14 @@ def run_config_check(args: argparse.Namespace) -> int:
 
     p = load_design_point(args.point)
     c = p.contract()
-    sensor = " (event sensor)" if p.sensor == "dvs" else ""
-    print(f"{args.point}: valid design point, {p.model}{sensor} on {p.height}x{p.width}")
-    if p.sensor == "dvs":
-        print(f"  log ADC {p.adc_bits} bits, code = ln(I + 1) * 2**{p.adc_log_frac_bits} "
-              f"({p.adc_rounding}, {p.adc_clip}; ln(I + 1) up to "
-              f"{((1 << p.adc_bits) - 1) / 2 ** p.adc_log_frac_bits:.3g})")
-    else:
-        print(f"  ADC {p.adc_bits} bits, {p.adc_gain:.6g} codes per brightness unit "
-              f"({p.adc_rounding}, {p.adc_clip})")
+    print(f"{args.point}: valid design point, {p.model}{p.kind.suffix} on "
+          f"{p.height}x{p.width}")
+    print(f"  {p.rules.describe_adc(p)}")
     print(f"  weights {p.weight_bits} bits / {p.weight_frac_bits} fraction "
           f"({p.weight_rounding}); shift {p.shift}; accumulator {p.accumulator_bits} bits")
     for s, t in enumerate(p.nominal_thresholds()):
         lo, hi = c.sum_range(s)
-        what = "contrast" if p.sensor == "dvs" else "phi"
+        what = p.rules.threshold_noun
         print(f"  scale {s}: threshold {int(t)} LSBs ({what} {p.nominal_values[s]:g}), "
               f"per-step sum {lo}..{hi}, kernel {len(c.weights[s])}x{len(c.weights[s])}")
     return 0
@@ -174,7 +166,7 @@ def run_profile(args: argparse.Namespace) -> int:
 
 def run_cost(args: argparse.Namespace) -> int:
     """``rvsm cost``."""
-    from rvsm.model.fixed.cost import format_cost, quantisation_cost
+    from rvsm.model.sensors.cost import format_cost, quantisation_cost
 
     point, scene = _point_and_scene(args)
     if args.thresholds is not None:

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import argparse
 import json
-
-import numpy as np
+from collections.abc import Callable
+from dataclasses import dataclass
 
 from rvsm.model.decode.reconstruction import MATCH_MODES, METHODS
-from rvsm.model.events.config import DEFAULT_CONTRAST, SENSORS, EventConfig
+from rvsm.model.events.config import DEFAULT_CONTRAST, EventConfig
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.sampling.config import (
     DEFAULT_CHUNK_STEPS,
@@ -18,10 +18,20 @@ from rvsm.model.sampling.config import (
     SamplerConfig,
 )
 from rvsm.model.sampling.thresholds import THRESHOLD_RULES, rule_thresholds
-from rvsm.model.sampling.twin import stream_float
 from rvsm.model.scene.scene import Scene
+from rvsm.model.sensors.capabilities import Sensor
+from rvsm.model.sensors.event_sensor import EVENT_SENSOR
+from rvsm.model.sensors.files import open_spikes
+from rvsm.model.sensors.registry import (
+    DEFAULT_SENSOR,
+    get_sensor,
+    sensor_names,
+    sensor_of,
+    sensor_of_meta,
+)
+from rvsm.model.sensors.spike_camera import SPIKE_CAMERA
 from rvsm.model.spikes.dat import DatWriter, dat_source
-from rvsm.model.spikes.files import copy_source, open_spikes
+from rvsm.model.spikes.files import copy_source
 from rvsm.model.spikes.h5 import H5SpikeWriter, is_h5_path
 from rvsm.model.spikes.npz import save_spikes
 from rvsm.model.spikes.sinks import ArraySink, CountSink, TeeSink
@@ -44,7 +54,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "(streamed chunk by chunk: any length in bounded memory) or .npz "
                        "(in memory, small runs).")
     add_scene_arguments(p)
-    p.add_argument("--sensor", choices=SENSORS, default="spike",
+    p.add_argument("--sensor", choices=sensor_names(), default=DEFAULT_SENSOR,
                    help="spike: the spike camera (default); dvs: an event camera, RVSM-DVS "
                    "(SPEC section 7): ON/OFF events of the receptive fields applied to the "
                    "log intensity, --model fsm being the plain DVS (docs/events.md)")
@@ -128,7 +138,9 @@ def apply_threads(args: argparse.Namespace) -> None:
     numba.set_num_threads(args.threads)
 
 
-def _float_config(args: argparse.Namespace, scene=None) -> SamplerConfig:
+def _float_config(args: argparse.Namespace, scene: Scene) -> SamplerConfig:
+    """The spike camera's float sampler from ``--model``, ``--phi`` ... (``--thresholds
+    response`` calibrates on ``scene``)."""
     scale_phi = None
     model = args.model or "dog4"
     phi = DEFAULT_PHI if args.phi is None else args.phi
@@ -163,7 +175,8 @@ def run_simulate(args: argparse.Namespace) -> int:
     check_outputs([Output(args.output, "-o", "spike file"),
                    args.dat and Output(args.dat, "--dat", PLAIN)],
                   [args.scene, args.fixed], args.force)
-    _check_sensor_options(args)
+    sensor = get_sensor(args.sensor)
+    _check_sensor_options(args, sensor)
     apply_threads(args)
     h5 = is_h5_path(args.output)
     counts = CountSink()
@@ -183,21 +196,14 @@ def run_simulate(args: argparse.Namespace) -> int:
 
         point, scene = SceneRequest.from_args(args).load_for_point(
             load_design_point(args.fixed))
+        sensor = sensor_of(point.kind)  # the sensor that runs: the point's
         run_fn = lambda sink: stream_fixed(  # noqa: E731
             scene, point, sink, chunk_steps=args.chunk_steps, engine=args.engine,
             progress=True, ranges=False)
-    elif args.sensor == "dvs":
-        from rvsm.model.events.twin import stream_events
-
-        scene = SceneRequest.from_args(args).load()
-        config = _event_config(args)
-        run_fn = lambda sink: stream_events(  # noqa: E731
-            scene, config, sink, chunk_steps=args.chunk_steps, engine=args.engine,
-            progress=True)
     else:
         scene = SceneRequest.from_args(args).load()
-        config = _float_config(args, scene)
-        run_fn = lambda sink: stream_float(  # noqa: E731
+        config = _FLOAT_OPTIONS[sensor].config(args, scene)
+        run_fn = lambda sink: sensor.float_twin(  # noqa: E731
             scene, config, sink, chunk_steps=args.chunk_steps, engine=args.engine,
             progress=True)
     if collect is not None:  # .npz collects every spike in memory: refuse what cannot fit
@@ -210,31 +216,23 @@ def run_simulate(args: argparse.Namespace) -> int:
     t = counts.steps
     s = len(counts.per_scale)
     h, w = scene.shape
-    events = args.sensor == "dvs" or (args.fixed and point.sensor == "dvs")
-    what = ("events", "OFF") if events else ("spikes", "negative")
+    kind = sensor.kind
     print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}, "
-          f"{counts.spikes} {what[0]} ({counts.negative} {what[1]})")
+          f"{counts.spikes} {kind.signals} ({counts.negative} {kind.negative})")
     return 0
 
 
-def _check_sensor_options(args: argparse.Namespace) -> None:
+def _check_sensor_options(args: argparse.Namespace, sensor: Sensor) -> None:
     """Refuse options of the other sensor (exit 2)."""
-    if args.sensor == "dvs":
-        given = [f"--{n.replace('_', '-')}" for n in ("phi", "scale_phi", "reset",
-                                                       "thresholds", "fixed", "dat")
-                 if getattr(args, n) is not None]
-        if given:
-            raise RvsmError(f"{', '.join(given)} do(es) not apply to --sensor dvs (its "
-                            "thresholds are --contrast / --scale-contrast; the fixed-point "
-                            "event twin is not built yet)")
-    else:
-        given = [f"--{n.replace('_', '-')}" for n in ("contrast", "scale_contrast")
-                 if getattr(args, n) is not None]
-        if given:
-            raise RvsmError(f"{', '.join(given)} apply to --sensor dvs only")
+    options = _FLOAT_OPTIONS[sensor]
+    given = [f"--{n.replace('_', '-')}" for n in options.refused
+             if getattr(args, n) is not None]
+    if given:
+        raise RvsmError(f"{', '.join(given)} {options.refusal}")
 
 
-def _event_config(args: argparse.Namespace) -> EventConfig:
+def _event_config(args: argparse.Namespace, scene: Scene) -> EventConfig:
+    """The event sensor's float model from ``--model``, ``--contrast`` ..."""
     scale = None
     if args.scale_contrast:
         try:
@@ -248,35 +246,16 @@ def _event_config(args: argparse.Namespace) -> EventConfig:
 
 
 def run_evaluate(args: argparse.Namespace) -> int:
-    """``rvsm evaluate``."""
-    from rvsm.model.decode.evaluation import evaluate_spikes
-    from rvsm.model.decode.streaming import evaluate_source
-
+    """``rvsm evaluate``: the decoder of the sensor that wrote the file."""
     with open_spikes(args.spikes) as source:
         meta = source.meta
         scene = SceneRequest.from_args(args, meta).load()
-        if meta.get("kind") == "events":
-            from rvsm.model.events.reconstruction import evaluate_events
-
-            if args.method != "auto":
-                raise RvsmError("--method applies to spike files; events are decoded by "
-                                "the least-squares inverse of their log responses")
-            result = evaluate_events(source, scene, match=args.match)
-            return _print_evaluation(args, result, meta["model"] + " (dvs)", scene)
-        _check_scene_fits(scene, source.shape)
-        model = meta.get("model")
-        phis = meta.get("phis")
-        if model is None or phis is None:
-            raise RvsmError("the spike file's meta lacks 'model' or 'phis'; re-run rvsm "
-                            "simulate")
-        phis = np.asarray(phis, dtype=np.float64)
-        if is_h5_path(args.spikes):
-            result = evaluate_source(source, scene, model, phis, method=args.method,
-                                     match=args.match)
-        else:
-            result = evaluate_spikes(source.read(0, source.num_steps), scene, model, phis,
-                                     method=args.method, match=args.match)
-    return _print_evaluation(args, result, model, scene)
+        sensor = sensor_of_meta(meta)
+        if args.method not in sensor.methods:
+            raise RvsmError(f"--method applies to spike files; {sensor.decoding}")
+        result = sensor.evaluate(source, scene, method=args.method, match=args.match,
+                                 stream=is_h5_path(args.spikes))
+    return _print_evaluation(args, result, meta["model"] + sensor.kind.tag, scene)
 
 
 def _print_evaluation(args: argparse.Namespace, result: dict, model: str,
@@ -288,20 +267,6 @@ def _print_evaluation(args: argparse.Namespace, result: dict, model: str,
               f"SSIM {result['ssim']:.3f}  ({result['num_scored']} frames scored after "
               f"{result['warmup']} warm-up steps, {result['method']})")
     return 0
-
-
-def _check_scene_fits(scene: Scene, spikes_shape: tuple[int, int, int, int]) -> None:
-    """Refuse, naming the options that fix it, a scene shaped unlike the spikes
-    ``(T, S, H, W)``."""
-    t, _, h, w = spikes_shape
-    if scene.shape == (h, w) and scene.num_steps == t:
-        return
-    fix = (f"pass --size {h}x{w}" if scene.shape != (h, w) else
-           "pass the --frames, --steps-per-frame and --hold the spikes were made with")
-    raise RvsmError(f"spikes {tuple(spikes_shape)} do not match scene {scene.name!r} "
-                    f"({scene.num_steps} steps of {scene.shape[0]}x{scene.shape[1]}: "
-                    f"{scene.num_frames} frames, {scene.steps_per_frame} steps per frame"
-                    f"{', held' if scene.hold else ''}); {fix}")
 
 
 def run_dat_export(args: argparse.Namespace) -> int:
@@ -327,3 +292,24 @@ def run_dat_import(args: argparse.Namespace) -> int:
         save_spikes(args.output, source.read(0, source.num_steps), meta)
     print(f"wrote {args.output}: {source.num_steps} steps of {h}x{w}")
     return 0
+
+
+@dataclass(frozen=True)
+class _FloatOptions:
+    """A sensor's float model on the command line: its configuration from the options,
+    the options it refuses and what the refusal says."""
+
+    config: Callable[[argparse.Namespace, Scene], SamplerConfig | EventConfig]
+    refused: tuple[str, ...]
+    refusal: str
+
+
+#: Each sensor's float options (``rvsm simulate`` without ``--fixed``).
+_FLOAT_OPTIONS: dict[Sensor, _FloatOptions] = {
+    SPIKE_CAMERA: _FloatOptions(_float_config, ("contrast", "scale_contrast"),
+                                "apply to --sensor dvs only"),
+    EVENT_SENSOR: _FloatOptions(
+        _event_config, ("phi", "scale_phi", "reset", "thresholds", "fixed", "dat"),
+        "do(es) not apply to --sensor dvs (its thresholds are --contrast / "
+        "--scale-contrast; the fixed-point event twin is not built yet)"),
+}

@@ -19,14 +19,14 @@ from rvsm.sim.sweep.spec import HardwareSettings, RunSettings, SweepTask
 
 def evaluate_task(task: SweepTask, frames: int, steps_per_frame: int, method: str = "auto",
                   match: str = "gain", threads: int | None = None) -> dict[str, Any]:
-    """Fixed vs float on one scene: :func:`~rvsm.model.fixed.cost.quantisation_cost` plus
+    """Fixed vs float on one scene: :func:`~rvsm.model.sensors.cost.quantisation_cost` plus
     ``mse_cost`` (fixed minus float, 8-bit units squared), ``saturation_rate`` (per scale,
     saturated accumulator-steps / (steps * H * W)), ``max_saturation_rate`` and
     ``seconds`` (wall time). ``threads`` caps the numba threads of the twins' fused kernels
     in this process (a local cluster gives each of its ``n`` worker processes
     ``cores // n``, so workers x threads never oversubscribe the cores)."""
-    from rvsm.model.fixed.cost import quantisation_cost
     from rvsm.model.scene.loaders import load_scene
+    from rvsm.model.sensors.cost import quantisation_cost
 
     if threads is not None:
         import numba

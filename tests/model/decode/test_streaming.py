@@ -9,7 +9,8 @@ from rvsm.model.noise.sensor import NoiseParams
 from rvsm.model.sampling.config import SamplerConfig
 from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.library import builtin_scene
-from rvsm.model.spikes.files import open_spikes, write_spikes
+from rvsm.model.sensors.files import open_spikes
+from rvsm.model.spikes.files import write_spikes
 from rvsm.model.spikes.source import array_source
 
 

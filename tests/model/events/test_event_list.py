@@ -20,7 +20,8 @@ from rvsm.model.events.reconstruction import evaluate_events
 from rvsm.model.events.twin import sample_events
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.loaders import load_scene
-from rvsm.model.spikes.files import copy_source, open_spikes
+from rvsm.model.sensors.files import open_spikes
+from rvsm.model.spikes.files import copy_source
 from rvsm.model.spikes.source import array_source
 
 

@@ -13,7 +13,6 @@ import pytest
 from rvsm.model.events.twin import sample_events
 from rvsm.model.fixed.adc import log_adc_codes
 from rvsm.model.fixed.contract import ArrayContract, FixedEventIntegrator
-from rvsm.model.fixed.cost import quantisation_cost, spike_agreement
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.stimulus import (
     load_stimulus,
@@ -24,6 +23,7 @@ from rvsm.model.fixed.stimulus import (
 from rvsm.model.fixed.twin import simulate_fixed
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.loaders import load_scene
+from rvsm.model.sensors.cost import quantisation_cost, spike_agreement
 
 IDENTITY = (((1,),),)
 

@@ -5,13 +5,13 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.cost import quantisation_cost
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.noise.presets import PAPER_K
 from rvsm.model.sampling.thresholds import calibration_thresholds
 from rvsm.model.scene.library import builtin_scene
+from rvsm.model.sensors.cost import quantisation_cost
 
 
 def test_response_rule_sets_integer_thresholds_from_the_calibration_scene():

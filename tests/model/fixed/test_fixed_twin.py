@@ -9,13 +9,13 @@ import json
 import numpy as np
 import pytest
 
-from rvsm.model.fixed.cost import quantisation_cost, spike_agreement
 from rvsm.model.fixed.design_point import DesignPoint, default_design_point
 from rvsm.model.fixed.profile import format_profile, profile_figure, profile_report
 from rvsm.model.fixed.stimulus import load_stimulus, make_stimulus, save_stimulus
 from rvsm.model.fixed.twin import simulate_fixed
 from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.library import builtin_scene
+from rvsm.model.sensors.cost import quantisation_cost, spike_agreement
 
 SIZE = (24, 32)
 

@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 from rvsm.model.fixed.stimulus import Stimulus, load_stimulus, save_stimulus
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.integrity import header_crc32, verify_npz
-from rvsm.model.spikes.files import load_any_spikes, write_spikes
+from rvsm.model.sensors.files import load_any_spikes
+from rvsm.model.spikes.files import write_spikes
 from rvsm.sim.cli import main
 from tests.fuzzing import fuzz_settings, reader_outcome
 

@@ -13,8 +13,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from rvsm.model.sensors.files import load_any_spikes
 from rvsm.model.spikes.dat import export_dat, import_dat
-from rvsm.model.spikes.files import load_any_spikes, write_spikes
+from rvsm.model.spikes.files import write_spikes
 from rvsm.model.spikes.h5 import H5SpikeWriter
 from rvsm.model.spikes.sinks import fill_sink
 from tests.fuzzing import assert_no_partial_files, corrupted, fuzz_settings, reader_outcome

@@ -4,7 +4,8 @@ import pytest
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.versions import with_versions
-from rvsm.model.spikes.files import load_any_spikes, open_spikes, write_spikes
+from rvsm.model.sensors.files import load_any_spikes, open_spikes
+from rvsm.model.spikes.files import write_spikes
 from rvsm.model.spikes.h5 import H5SpikeWriter
 
 

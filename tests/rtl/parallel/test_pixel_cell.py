@@ -91,3 +91,16 @@ def test_clear_restarts_accumulator(amaranth_sim) -> None:
 def test_unsigned_model_never_fires_negative(amaranth_sim) -> None:
     got = run_cell(amaranth_sim, [-100] * 20, 5, 8, False, "zero")
     assert set(got) == {0}
+
+
+def test_the_cell_takes_an_output_rule_not_a_name():
+    """The cell's next-state logic is chosen by the contract's ``kind.output``; a sensor's
+    name is refused."""
+    from amaranth.hdl import Fragment
+
+    from rvsm.model.kinds.sensor_kind import Output
+
+    for output in Output:
+        Fragment.get(PixelCell(12, 0, 8, True, output=output), None)
+    with pytest.raises(ValueError, match="output must be one of"):
+        PixelCell(12, 0, 8, True, output="dvs")  # type: ignore[arg-type]

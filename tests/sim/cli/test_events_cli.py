@@ -5,7 +5,7 @@ import json
 
 import numpy as np
 
-from rvsm.model.spikes.files import load_any_spikes
+from rvsm.model.sensors.files import load_any_spikes
 from rvsm.sim.cli import main
 
 SMALL = ["--size", "24x32", "--frames", "4", "--steps-per-frame", "8"]

@@ -95,7 +95,8 @@ WRITERS = list(_writers({k: Path("x") for k in ("point", "spikes", "dat", "sweep
 
 #: The functions doing each command's work: none may run when the output is refused.
 WORK = [
-    "rvsm.sim.cli.sampling.stream_float", "rvsm.model.fixed.twin.stream_fixed",
+    "rvsm.model.sensors.spike_camera.stream_float",
+    "rvsm.model.sensors.event_sensor.stream_events", "rvsm.model.fixed.twin.stream_fixed",
     "rvsm.model.fixed.twin.simulate_fixed", "rvsm.sim.cli.sampling.open_spikes",
     "rvsm.sim.cli.sampling.dat_source",
     "rvsm.sim.cli.scenes.render_frames", "rvsm.model.fixed.stimulus.make_stimulus",

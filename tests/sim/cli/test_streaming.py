@@ -4,7 +4,7 @@ import json
 
 import numpy as np
 
-from rvsm.model.spikes.files import load_any_spikes
+from rvsm.model.sensors.files import load_any_spikes
 from rvsm.model.spikes.npz import load_spikes
 from rvsm.sim.cli import main
 

@@ -1,12 +1,14 @@
 """What quantisation costs: fixed twin against the float model on the same scene (SPEC 5).
 
-Both run on the same scene with the same seed and noise (the float sampler with
-``point.sampler_config()``); both are scored with
-:func:`~rvsm.model.decode.evaluation.evaluate_spikes` using the nominal float thresholds.
-For the event sensor (``array.sensor = "dvs"``) the float model is
-:func:`~rvsm.model.events.twin.sample_events` with ``point.event_config()`` and both are
-scored by :func:`~rvsm.model.events.reconstruction.evaluate_events` (the twin's events
-decoded with its own integer references and contrasts).
+Both run on the same scene with the same seed and noise, the float model being the one
+the point's sensor approximates (:attr:`~.capabilities.Sensor.float_of_point`: the
+sampler of ``point.sampler_config()``, or for the event sensor
+:func:`~rvsm.model.events.twin.sample_events` of ``point.event_config()``), and both
+outputs are scored by the sensor's decoder (:attr:`~.capabilities.Sensor.evaluate`:
+:func:`~rvsm.model.decode.evaluation.evaluate_spikes` with the nominal float thresholds,
+or :func:`~rvsm.model.events.reconstruction.evaluate_events`, the twin's events decoded
+with its own integer references and contrasts). It sits above the fixed twin and the
+sensors it combines.
 
 Spike agreement (:func:`spike_agreement`): over every (step, scale, pixel) where either
 model fired, the fraction where both fired the same spike (+1 or -1), i.e.
@@ -19,8 +21,10 @@ import numpy as np
 
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.twin import fit_point, simulate_fixed
-from rvsm.model.sampling.twin import sample
+from rvsm.model.kinds.sensor_kind import sensor_kind
 from rvsm.model.scene.scene import Scene
+from rvsm.model.sensors.registry import DEFAULT_SENSOR, sensor_of
+from rvsm.model.spikes.source import array_source
 
 
 def spike_agreement(fixed: np.ndarray, float_: np.ndarray) -> dict:
@@ -65,28 +69,14 @@ def quantisation_cost(
     ``ssim_cost``, ``mse_float``, ``mse_fixed``, ``saturated`` (per scale), ``method``,
     ``scene``, ``model``, ``height``, ``width``, ``steps``, ``design_point``.
     """
-    from rvsm.model.decode.evaluation import evaluate_spikes
-
     point = fit_point(scene, point)
+    sensor = sensor_of(point.kind)
     fix = simulate_fixed(scene, point, progress=progress, ranges=False)
-    if point.sensor == "dvs":  # events of the float event sensor against the twin's
-        from rvsm.model.events.reconstruction import evaluate_events
-        from rvsm.model.events.twin import sample_events
-        from rvsm.model.spikes.source import array_source
-
-        flt_events = sample_events(scene, point.event_config())
-        agree = spike_agreement(fix.spikes, flt_events.events)
-        ev_float = evaluate_events(array_source(flt_events.events, flt_events.meta), scene,
-                                   match=match)
-        ev_fixed = evaluate_events(array_source(fix.spikes, fix.meta), scene, match=match)
-    else:
-        flt = sample(scene, point.sampler_config(), progress=progress)
-        agree = spike_agreement(fix.spikes, flt.spikes)
-        phis = point.phis
-        ev_float = evaluate_spikes(flt.spikes, scene, point.model, phis, method=method,
-                                   match=match)
-        ev_fixed = evaluate_spikes(fix.spikes, scene, point.model, phis, method=method,
-                                   match=match)
+    flt, flt_meta = sensor.float_of_point(scene, point, progress)
+    agree = spike_agreement(fix.spikes, flt)
+    ev_float = sensor.evaluate(array_source(flt, flt_meta), scene, method=method, match=match)
+    ev_fixed = sensor.evaluate(array_source(fix.spikes, fix.meta), scene, method=method,
+                               match=match)
     return {
         "scene": scene.name,
         "model": point.model,
@@ -118,7 +108,7 @@ def format_cost(result: dict) -> str:
     per = ", ".join(f"{100 * a:.2f}%" for a in result["agreement_per_scale"])
     return "\n".join([
         f"quantisation cost: {result['model']}"
-        f"{' (event sensor)' if result.get('sensor') == 'dvs' else ''} on {result['scene']} "
+        f"{sensor_kind(result.get('sensor', DEFAULT_SENSOR)).suffix} on {result['scene']} "
         f"({result['height']}x{result['width']}, {result['steps']} steps, "
         f"{result['method']} reconstruction)",
         f"spike agreement  {100 * result['agreement']:.2f}% of spikes (per scale: {per}); "
