@@ -9,9 +9,9 @@ import sys
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
-from rvsm.sim.cli.args import sized_contract
+from rvsm.sim.cli.args import parse_size_arg
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
-from rvsm.sim.cli.rtl import add_arch_arguments, arch_options
+from rvsm.sim.cli.rtl import add_arch_arguments, command_architecture
 
 #: The most pixels ``rvsm formal`` takes: solvers handle tiny arrays only (a 3x3
 #: parallel array needs about 2 minutes to prove; docs/formal.md), so a full-size point
@@ -58,37 +58,40 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _formal(args: argparse.Namespace) -> int:
+    from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.model.infra.atomic import write_text_atomic
-    from rvsm.rtl.registry import ARCHITECTURES
     from rvsm.sim.formal.runner import run_checks
 
-    arch = ARCHITECTURES[args.arch]
-    options = arch_options(args)
+    arch, options = command_architecture(args)
     if args.depth is not None and args.depth < 1:
         raise RvsmError(f"--depth must be at least 1, got {args.depth}")
     if args.jobs < 1:
         raise RvsmError(f"--jobs must be at least 1, got {args.jobs}")
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be positive, got {args.timeout}")
-    point, contract = sized_contract(args.point, args.size, arch, options)
-    if contract.height * contract.width > MAX_FORMAL_PIXELS:
-        raise RvsmError(f"rvsm formal checks tiny arrays (at most {MAX_FORMAL_PIXELS} "
-                        f"pixels); this one is {contract.height}x{contract.width}: pass "
-                        "--size, for example --size 3x4 --lanes 2")
+    size = parse_size_arg(args.size)
+    point = load_design_point(args.point)
+    if size is not None:
+        point = point.with_size(*size)
     if args.model is not None and args.model != point.model:
         if point.scale_phi is not None:
             raise RvsmError(f"--model {args.model}: the point sets per-scale thresholds "
                             "(scale_phi) for its own model; remove them or drop --model")
-        contract = dataclasses.replace(point, model=args.model).contract()
-        arch.check(contract, **options)
+        point = dataclasses.replace(point, model=args.model)
+    contract = point.contract()  # once: the size rule, then every check, use it
+    arch.check(contract, **options)
+    if contract.height * contract.width > MAX_FORMAL_PIXELS:
+        raise RvsmError(f"rvsm formal checks tiny arrays (at most {MAX_FORMAL_PIXELS} "
+                        f"pixels); this one is {contract.height}x{contract.width}: pass "
+                        "--size, for example --size 3x4 --lanes 2")
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
-    report = run_checks(contract, args.arch, options, checks=args.check, mode=args.mode,
+    report = run_checks(contract, arch, options, checks=args.check, mode=args.mode,
                         depth=args.depth, workdir=args.out, timeout=args.timeout,
                         solver=args.solver, jobs=args.jobs,
                         progress=lambda line: print(line, file=sys.stderr, flush=True))
     data = report.to_json()
     data["size"] = [contract.height, contract.width]
-    data["model"] = args.model or point.model
+    data["model"] = point.model
     write_text_atomic(f"{args.out}/report.json", json.dumps(data, indent=2) + "\n")
     if args.json:
         print(json.dumps(data, indent=2))

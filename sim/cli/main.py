@@ -28,12 +28,13 @@ from rvsm.sim.cli import (
     scenes,
     studies,
     sweep,
+    verify,
 )
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
 #: co-simulation, formal checks, FPGA timing and area, paper studies, the demo, design sweeps.
-FAMILIES: tuple[ModuleType, ...] = (sampling, events, scenes, fixed, rtl, regress, formal,
-                                    mutate, fpga, studies, demo, sweep)
+FAMILIES: tuple[ModuleType, ...] = (sampling, events, scenes, fixed, rtl, verify, regress,
+                                    formal, mutate, fpga, studies, demo, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:
