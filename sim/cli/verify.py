@@ -137,7 +137,12 @@ class StimulusRequest:
             return cls("file", file=args.stimulus, **common)
         if args.random is not None or args.protocol is not None:
             kind = "random" if args.random is not None else "protocol"
-            _check_generated(f"--{kind}", args, shaping)
+            besides = [n for n, v in (("SCENE", args.scene), *shaping) if v is not None]
+            if args.random is not None and args.protocol is not None:
+                besides.append("--protocol")
+            _check_generated(f"--{kind}", besides, {"--fixed": args.fixed,
+                                                    "--size": args.size,
+                                                    "--steps": args.steps})
             return cls(kind, seed=args.random if kind == "random" else args.protocol,
                        size=parse_size_arg(args.size), **common)
         if args.scene is not None and args.fixed is not None:
@@ -161,17 +166,13 @@ class StimulusRequest:
         return scene, RunPoint.of(point, self.fixed)
 
 
-def _check_generated(flag: str, args: argparse.Namespace,
-                     shaping: tuple[tuple[str, object], ...]) -> None:
-    """Refuse what cannot go with ``--random``/``--protocol`` and ask for what is missing."""
-    given = [n for n, v in (("SCENE", args.scene), *shaping) if v is not None]
-    if args.random is not None and args.protocol is not None:
-        given.append("--protocol")
-    if given:
-        raise RvsmError(f"{', '.join(given)} cannot be combined with {flag} (the "
+def _check_generated(flag: str, besides: list[str], needs: dict[str, object]) -> None:
+    """Refuse the options ``besides`` that cannot go with ``flag`` (``--random``,
+    ``--protocol``) and ask for those of ``needs`` (option: value) not given."""
+    if besides:
+        raise RvsmError(f"{', '.join(besides)} cannot be combined with {flag} (the "
                         "stimulus is generated)")
-    missing = [n for n, v in (("--fixed", args.fixed), ("--size", args.size),
-                              ("--steps", args.steps)) if v is None]
+    missing = [n for n, v in needs.items() if v is None]
     if missing:
         raise RvsmError(f"rvsm verify {flag} SEED also needs {', '.join(missing)}, "
                         f"e.g. {flag} 1 --fixed point.toml --size 16x16 --steps 40")
