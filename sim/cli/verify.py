@@ -14,6 +14,7 @@ import argparse
 import json
 import shlex
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from rvsm.model.fixed.stimulus import Stimulus
 from rvsm.model.infra.errors import RvsmError
@@ -29,6 +30,9 @@ from rvsm.sim.cli.rtl import (
 )
 from rvsm.sim.cosim import SIMULATORS
 from rvsm.sim.cosim.run_point import RunPoint
+
+if TYPE_CHECKING:
+    from rvsm.model.scene.scene import Scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -157,7 +161,7 @@ class StimulusRequest:
         """The generated stimulus's design point: ``--fixed`` parsed once, sized."""
         return RunPoint.load(self.fixed, self.size)
 
-    def scene_and_point(self):  # noqa: ANN201 - (Scene, RunPoint)
+    def scene_and_point(self) -> tuple[Scene, RunPoint]:
         """The scene by the scene rule and the point sized to it (``--fixed`` parsed
         once)."""
         from rvsm.model.fixed.point_toml import load_design_point
