@@ -66,7 +66,7 @@ formal: setup
 	$(MAKE) formal-equivalence
 
 formal-equivalence: setup
-	$(BIN)/python scripts/formal_matrix.py --jobs $(JOBS)
+	$(BIN)/rvsm formal --plan regressions/formal-equivalence.toml -j $(JOBS) -o build/formal
 
 # every RTL mutation against the co-simulation and formal checks (docs/mutation.md)
 mutate: setup

@@ -28,6 +28,7 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 from amaranth.back import rtlil as amaranth_rtlil
@@ -264,7 +265,8 @@ def run_fpga(
     Products and logs go into ``work_dir``. Raises :class:`RvsmError` for bad input and
     :class:`~rvsm.model.infra.errors.ToolError` when a tool is missing or fails.
     """
-    job = _Job(point, arch, lanes, size, device, speed, target_mhz, netlist, memory, build)
+    job = _Job(point, get_architecture(arch), lanes, size, device, speed, target_mhz,
+               netlist, memory, build)
     syn, per_clock = job.synthesise(work_dir, synth_only, on_progress, timeout)
     slope = job.slope(syn, slope_lanes, on_progress, timeout)
     if synth_only:
@@ -336,7 +338,8 @@ def run_fpga_seeds(
     jobs = min(len(seeds), os.cpu_count() or 1) if jobs is None else int(jobs)
     if jobs < 1:
         raise RvsmError(f"jobs must be >= 1, got {jobs}")
-    job = _Job(point, arch, lanes, size, device, speed, target_mhz, netlist, memory, build)
+    job = _Job(point, get_architecture(arch), lanes, size, device, speed, target_mhz,
+               netlist, memory, build)
     syn, per_clock = job.synthesise(work_dir, False, on_progress, timeout)
     slope = job.slope(syn, slope_lanes, on_progress, timeout)
 
@@ -369,7 +372,7 @@ class _Job:
     """What :func:`run_fpga` and :func:`run_fpga_seeds` share: checks, synthesis, report."""
 
     point: DesignPoint
-    arch: str | Architecture
+    arch: Architecture
     lanes: int | None
     size: tuple[int, int] | None
     device_name: str | Device
@@ -436,10 +439,16 @@ class _Job:
                             "--synth-only, a smaller --size or fewer --lanes")
         return syn, per_clock
 
-    @property
+    @cached_property
     def contract(self) -> ArrayContract:
+        """The contract of the array built (the point at ``size``), built once."""
         p = self.point
         return (p.with_size(*self.size) if self.size else p).contract()
+
+    @cached_property
+    def sensor_contract(self) -> ArrayContract:
+        """The full sensor's contract (the point's own size), built once."""
+        return self.point.contract()
 
     def report(self, syn: Synthesis, per_clock: int, pnr: dict | None,
                seconds: dict[str, float], seed: int | None = None,
@@ -457,13 +466,14 @@ class _Job:
             mode = "place-and-route"
         times = {**syn.seconds, **seconds}
         return FpgaReport(
-            arch=get_architecture(self.arch).name, model=point.model,
+            arch=self.arch.name, model=point.model,
             height=contract.height, width=contract.width, lanes=per_clock, device=dev,
             speed=self.speed, target_mhz=self.target_mhz, mode=mode, lut4=lut4, ff=ff,
             bram=bram, harness_ff=syn.harness.overhead_ff,
             harness_lut4=syn.harness.overhead_lut, sensor_height=point.height,
             sensor_width=point.width,
-            sensor_state=state_memory(point.contract(), thresholds_uniform=not point.noise),
+            sensor_state=state_memory(self.sensor_contract,
+                                      thresholds_uniform=not point.noise),
             fmax_mhz=fmax, critical_path=path, synth_cells=stat["cells"],
             seconds={k: round(v, 1) for k, v in times.items()},
             work_dir=str(work or syn.work_dir), netlist=self.netlist, memory=self.memory,

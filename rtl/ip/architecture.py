@@ -1,12 +1,15 @@
-"""The AXI IP as an :class:`~rvsm.rtl.capabilities.Architecture` value (not registered).
+"""The AXI IP as an :class:`~rvsm.rtl.capabilities.Architecture` value: a wrapper.
 
 :data:`STREAM_AXIS` is what ``rvsm verilog --interface axis`` generates: the streaming
 array inside :class:`~rvsm.rtl.ip.wrapper.RvsmAxisIp`, options ``lanes`` and
 ``fifo_depth``, its port map derived from the IP's signature (with the bit fields of
 both ``tdata`` s), and the register-map files beside the Verilog
 (:attr:`Architecture.extra_outputs`: ``<top>.regs.md``, ``.regs.json``, ``.regs.h``).
-It stays out of the registry of ``--arch`` choices: the IP is an interface around an
-architecture (``--interface``), not an array of its own.
+Its beats are the streaming array's (:data:`~rvsm.rtl.stream.architecture.STREAM_BEATS`);
+its testbench drives them through cocotbext-axi. The registry offers it as the ``axis``
+interface of the streaming array (``get_architecture("stream", "axis")``), not as an
+``--arch`` choice: the IP is an interface around an architecture, not an array of its
+own.
 """
 
 from __future__ import annotations
@@ -24,10 +27,11 @@ from rvsm.rtl.ip.drive import decode_output, simulate_ip
 from rvsm.rtl.ip.register_map import regs_c_header, regs_json, regs_markdown
 from rvsm.rtl.ip.wrapper import IP_ARCH, RvsmAxisIp
 from rvsm.rtl.ports import port_map
+from rvsm.rtl.stream.architecture import STREAM_BEATS
 from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, check_beats
 
-__all__ = ["INTERFACES", "STREAM_AXIS", "interface_architecture", "ip_port_map"]
+__all__ = ["STREAM_AXIS", "ip_port_map"]
 
 _AXIL = {
     "awaddr": "write address (byte address; registers are 32-bit words)",
@@ -165,7 +169,8 @@ STREAM_AXIS = Architecture(
     default_top="rvsm_axis_ip",
     options=(Option("lanes", 1, "pixels per beat of the streaming array (divides the "
                     "width)"),
-             Option("fifo_depth", RvsmAxisIp.FIFO_DEPTH, "output FIFO depth in beats")),
+             Option("fifo_depth", RvsmAxisIp.FIFO_DEPTH, "output FIFO depth in beats",
+                    metavar="BEATS")),
     build=RvsmAxisIp,
     check=_check,
     pixels_per_clock=lambda contract, lanes, fifo_depth: lanes,
@@ -178,21 +183,5 @@ STREAM_AXIS = Architecture(
     testbench="rvsm.sim.cosim.testbenches.tb_axis",
     extra_outputs=_extra_outputs,
     extra_suffixes=(".regs.md", ".regs.json", ".regs.h"),
+    beats=STREAM_BEATS,
 )
-
-#: ``rvsm verilog --interface`` choices: the architecture a base architecture becomes.
-INTERFACES = ("native", "axis")
-
-
-def interface_architecture(arch: Architecture, interface: str) -> Architecture:
-    """``arch`` itself for ``native``, the IP around it for ``axis`` (the streaming
-    array only; :class:`RvsmError` otherwise)."""
-    if interface == "native":
-        return arch
-    if interface != "axis":
-        raise RvsmError(f"unknown interface {interface!r}; choose one of: "
-                        f"{', '.join(INTERFACES)}")
-    if arch.name != "stream":
-        raise RvsmError(f"--interface axis wraps the streaming array (--arch stream), "
-                        f"not --arch {arch.name}")
-    return STREAM_AXIS

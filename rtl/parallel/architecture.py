@@ -6,7 +6,8 @@ import numpy as np
 
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.capabilities import Architecture
+from rvsm.rtl.capabilities import Architecture, MutationSites
+from rvsm.rtl.mutations import mutations_for
 from rvsm.rtl.parallel.array import RvsmArray
 from rvsm.rtl.parallel.drive import compare_spikes, simulate
 from rvsm.rtl.parallel.harnesses import parallel_properties
@@ -40,8 +41,10 @@ def _compare(contract: ArrayContract, expected: np.ndarray, got: np.ndarray) -> 
     return compare_spikes(expected, got)
 
 
+_NAME = "parallel"
+
 PARALLEL = Architecture(
-    name="parallel",
+    name=_NAME,
     title="fully parallel array",
     default_top="rvsm_array",
     options=(),
@@ -57,4 +60,7 @@ PARALLEL = Architecture(
     compare=_compare,
     testbench="rvsm.sim.cosim.testbenches.tb_parallel",
     formal={"properties": parallel_properties},
+    # the formal checks of a mutant run at 2x2 with the point's model
+    mutation_sites=MutationSites(tuple(mutations_for(_NAME)), formal_size=(2, 2),
+                                 formal_checks=("properties",)),
 )

@@ -1,20 +1,48 @@
-"""The streaming array as a registered :class:`~rvsm.rtl.capabilities.Architecture`."""
+"""The streaming array as a registered :class:`~rvsm.rtl.capabilities.Architecture`.
+
+Besides the component and its port map, :data:`STREAM` states the streaming array's
+capabilities: its beat stream (:data:`STREAM_BEATS`), its three cocotb testbenches (per
+cycle, the long-run harness's, the protocol scripts'), what its ``amaranth.sim`` driver
+takes (stalls, paused and running threshold writes), its mutation sites and its formal
+harnesses.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
 from rvsm.model.fixed.contract import ArrayContract
-from rvsm.rtl.capabilities import Architecture, Option
+from rvsm.rtl.capabilities import (
+    Architecture,
+    BeatStream,
+    MutationSites,
+    Option,
+    ProtocolScripts,
+)
+from rvsm.rtl.mutations import mutations_for
 from rvsm.rtl.ports import port_map
 from rvsm.rtl.stream.array import RvsmStreamArray
+from rvsm.rtl.stream.coverage import BorderCoverage
 from rvsm.rtl.stream.dimensions import StreamGeometry
-from rvsm.rtl.stream.drive import simulate
+from rvsm.rtl.stream.drive import (
+    colliding_threshold_writes,
+    simulate,
+    simulate_with_threshold_writes,
+    threshold_writes,
+)
 from rvsm.rtl.stream.formal_lemmas import composed_equivalence, sum_lemma, window_lemma
 from rvsm.rtl.stream.harnesses import PROPERTY_GROUPS, stream_check, stream_equivalence
-from rvsm.rtl.stream.schedule import OutputBeats, check_beats
+from rvsm.rtl.stream.protocol import (
+    check_script,
+    load_script,
+    protocol_summary,
+    random_script,
+    save_script,
+    script_coverage,
+)
+from rvsm.rtl.stream.schedule import OutputBeats, StreamChecker, check_beats, pack_lanes
 
-__all__ = ["STREAM", "stream_port_map"]
+__all__ = ["STREAM", "STREAM_BEATS", "stream_port_map"]
 
 _FIELD_DESCRIPTIONS = {
     "row": "row y of the position",
@@ -84,8 +112,42 @@ def _compare(contract: ArrayContract, expected: np.ndarray, got: OutputBeats,
     return check_beats(StreamGeometry(contract, lanes).schedule, expected, got)
 
 
+def _running_threshold_writes(contract: ArrayContract, codes: np.ndarray,
+                              thresholds: np.ndarray, seed: int, top: int,
+                              mutation: str | None = None, lanes: int = 1
+                              ) -> tuple[np.ndarray, OutputBeats]:
+    """Threshold writes below ``top`` while ``codes`` stream back to back, many at the
+    edge reading their own word (:func:`~rvsm.rtl.stream.drive.colliding_threshold_writes`,
+    seeded): the thresholds each frame reads under the documented rule ``(T, S, H, W)``
+    and the output beats."""
+    geo = StreamGeometry(contract, lanes)
+    writes, frames, _, _ = colliding_threshold_writes(geo, thresholds, len(codes), seed, top)
+    got = simulate_with_threshold_writes(contract, lanes, codes, thresholds, writes,
+                                         mutation=mutation)
+    shape = (contract.num_scales, contract.height, contract.width)
+    return np.stack([f.reshape(shape) for f in frames]), got  # words (S, H*G, P) -> pixels
+
+
+#: The streaming array's beats: input beats of ``lanes`` codes, one output beat per
+#: position (the AXI IP around it streams the same beats).
+STREAM_BEATS = BeatStream(
+    geometry=StreamGeometry,
+    threshold_writes=threshold_writes,
+    pack_lanes=pack_lanes,
+    output_beats=OutputBeats,
+    check_beats=check_beats,
+    checker=StreamChecker,
+    border_coverage=BorderCoverage,
+)
+
+#: The formal checks a mutant faces, cheapest first; the compositional proof (window,
+#: sums, composed) re-proves what equivalence checks end to end and is not run again.
+_MUTANT_CHECKS = ("tail", "protocol", "equivalence", "state", "thresholds")
+
+_NAME = "stream"
+
 STREAM = Architecture(
-    name="stream",
+    name=_NAME,
     title="streaming array",
     default_top="rvsm_stream_array",
     options=(Option("lanes", 1, "pixels per beat of the streaming array (divides the "
@@ -103,4 +165,16 @@ STREAM = Architecture(
     formal={**{group: stream_check(group) for group in PROPERTY_GROUPS},
             "equivalence": stream_equivalence, "window": window_lemma, "sums": sum_lemma,
             "composed": composed_equivalence},
+    long_run_testbench="rvsm.sim.cosim.testbenches.tb_stream_chunks",
+    beats=STREAM_BEATS,
+    protocol=ProtocolScripts(
+        testbench="rvsm.sim.cosim.testbenches.tb_stream_protocol",
+        random_script=random_script, save=save_script, load=load_script,
+        check=check_script, coverage=script_coverage, summary=protocol_summary),
+    simulate_keywords=frozenset({"idle_every", "threshold_updates"}),
+    running_threshold_writes=_running_threshold_writes,
+    # dog2: two signed scales with a surround, so every kernel, padding, sign, lane and
+    # reset bug shows at 3x4, and each check takes seconds
+    mutation_sites=MutationSites(tuple(mutations_for(_NAME)), formal_size=(3, 4),
+                                 formal_model="dog2", formal_checks=_MUTANT_CHECKS),
 )

@@ -9,9 +9,9 @@ import sys
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
-from rvsm.sim.cli.args import sized_contract
+from rvsm.sim.cli.args import parse_size_arg
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
-from rvsm.sim.cli.rtl import add_arch_arguments, arch_options
+from rvsm.sim.cli.rtl import add_arch_arguments, command_architecture
 
 #: The most pixels ``rvsm formal`` takes: solvers handle tiny arrays only (a 3x3
 #: parallel array needs about 2 minutes to prove; docs/formal.md), so a full-size point
@@ -28,8 +28,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "usually at a tiny --size. Prints each property's status and, on a failure, the "
         "property, its source line, the failing step and the counterexample VCD. Exit "
         "status: 0 every property holds (every cover reached), 1 a counterexample or an "
-        "unreached cover, 2 bad input, 3 a tool failed (docs/formal.md).")
-    p.add_argument("point", help="design point TOML")
+        "unreached cover, 2 bad input, 3 a tool failed (docs/formal.md). With --plan, "
+        "a matrix of such runs (models x sizes x reset modes), the worst status.")
+    p.add_argument("point", nargs="?", help="design point TOML (not with --plan)")
+    p.add_argument("--plan", metavar="PLAN.toml",
+                   help="run a formal plan instead: every model x size x reset mode it "
+                   "lists, one line per run, <name>-matrix.json in -o (e.g. "
+                   "regressions/formal-equivalence.toml, the streaming array's bounded "
+                   "equivalence matrix); -j runs N runs at once"),
     p.add_argument("--size", metavar="HxW", help="override the array size (keep it tiny)")
     p.add_argument("--model", choices=MODEL_NAMES,
                    help="override the point's sampling model (one point, every model)")
@@ -47,7 +53,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="smtbmc's SMT solver (default yices: much faster on the streaming "
                    "array's memories; z3 for a second opinion)")
     p.add_argument("-j", "--jobs", type=int, default=1, metavar="N",
-                   help="run N checks at once (one sby process each; default 1)")
+                   help="run N checks (with --plan: N runs) at once (one sby process "
+                   "each; default 1)")
     p.add_argument("--timeout", type=float, metavar="SECONDS",
                    help="stop a check's solver after this long (exit 3)")
     p.add_argument("-o", "--out", default="build/formal",
@@ -58,37 +65,44 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _formal(args: argparse.Namespace) -> int:
+    from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.model.infra.atomic import write_text_atomic
-    from rvsm.rtl.registry import ARCHITECTURES
     from rvsm.sim.formal.runner import run_checks
 
-    arch = ARCHITECTURES[args.arch]
-    options = arch_options(args)
     if args.depth is not None and args.depth < 1:
         raise RvsmError(f"--depth must be at least 1, got {args.depth}")
     if args.jobs < 1:
         raise RvsmError(f"--jobs must be at least 1, got {args.jobs}")
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be positive, got {args.timeout}")
-    point, contract = sized_contract(args.point, args.size, arch, options)
-    if contract.height * contract.width > MAX_FORMAL_PIXELS:
-        raise RvsmError(f"rvsm formal checks tiny arrays (at most {MAX_FORMAL_PIXELS} "
-                        f"pixels); this one is {contract.height}x{contract.width}: pass "
-                        "--size, for example --size 3x4 --lanes 2")
+    if args.plan is not None:
+        return _formal_plan(args)
+    if args.point is None:
+        raise RvsmError("rvsm formal needs a design point TOML (or --plan PLAN.toml)")
+    arch, options = command_architecture(args)
+    size = parse_size_arg(args.size)
+    point = load_design_point(args.point)
+    if size is not None:
+        point = point.with_size(*size)
     if args.model is not None and args.model != point.model:
         if point.scale_phi is not None:
             raise RvsmError(f"--model {args.model}: the point sets per-scale thresholds "
                             "(scale_phi) for its own model; remove them or drop --model")
-        contract = dataclasses.replace(point, model=args.model).contract()
-        arch.check(contract, **options)
+        point = dataclasses.replace(point, model=args.model)
+    contract = point.contract()  # once: the size rule, then every check, use it
+    arch.check(contract, **options)
+    if contract.height * contract.width > MAX_FORMAL_PIXELS:
+        raise RvsmError(f"rvsm formal checks tiny arrays (at most {MAX_FORMAL_PIXELS} "
+                        f"pixels); this one is {contract.height}x{contract.width}: pass "
+                        "--size, for example --size 3x4 --lanes 2")
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
-    report = run_checks(contract, args.arch, options, checks=args.check, mode=args.mode,
+    report = run_checks(contract, arch, options, checks=args.check, mode=args.mode,
                         depth=args.depth, workdir=args.out, timeout=args.timeout,
                         solver=args.solver, jobs=args.jobs,
                         progress=lambda line: print(line, file=sys.stderr, flush=True))
     data = report.to_json()
     data["size"] = [contract.height, contract.width]
-    data["model"] = args.model or point.model
+    data["model"] = point.model
     write_text_atomic(f"{args.out}/report.json", json.dumps(data, indent=2) + "\n")
     if args.json:
         print(json.dumps(data, indent=2))
@@ -101,6 +115,34 @@ def _formal(args: argparse.Namespace) -> int:
             print(f"rvsm: error: formal check {r.check}: {r.message}{where}",
                   file=sys.stderr)
     return report.exit_status
+
+
+def _formal_plan(args: argparse.Namespace) -> int:
+    """``rvsm formal --plan PLAN.toml``: every run of the plan (:mod:`rvsm.sim.formal.plan`)."""
+    from rvsm.rtl.registry import ARCHITECTURES
+    from rvsm.sim.formal.plan import load_formal_plan
+    from rvsm.sim.formal.plan_run import run_formal_plan
+
+    options = {o.name for a in ARCHITECTURES.values() for o in a.options}
+    given = [n for n, v in (("POINT", args.point), ("--size", args.size),
+                            ("--model", args.model), ("--check", args.check),
+                            *((f"--{o}", getattr(args, o)) for o in sorted(options)))
+             if v is not None]
+    if given:
+        raise RvsmError(f"{', '.join(given)} cannot be combined with --plan: the plan "
+                        "names its point, architecture, models, sizes and checks")
+    plan = load_formal_plan(args.plan)
+    check_outputs([Output(args.out, "-o", FOLDER)], [args.plan])
+    print(f"formal plan {plan.name}: {len(plan.runs)} run(s), --arch {plan.arch.name}, "
+          f"{args.jobs} at a time -> {args.out}", file=sys.stderr, flush=True)
+    summary = run_formal_plan(plan, args.out, jobs=args.jobs, mode=args.mode,
+                              depth=args.depth, timeout=args.timeout, solver=args.solver,
+                              progress=None if args.json else print)
+    if args.json:
+        print(json.dumps(summary.to_json(), indent=2))
+    else:
+        print(f"\nformal plan {plan.name}: {summary.line()}; {summary.json_path}")
+    return summary.exit_status
 
 
 def format_report(report, height: int, width: int, model: str = "",

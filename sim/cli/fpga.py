@@ -72,30 +72,21 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.fpga.flow import build_component, run_fpga, run_fpga_seeds
-    from rvsm.rtl.ip.architecture import interface_architecture
-    from rvsm.rtl.registry import ARCHITECTURES
-    from rvsm.sim.cli.rtl import arch_options
+    from rvsm.rtl.registry import get_architecture
+    from rvsm.sim.cli.rtl import command_architecture
 
-    base = ARCHITECTURES[args.arch]
-    options = arch_options(args)
+    arch, options = command_architecture(args)  # the IP with --interface axis
+    base = get_architecture(args.arch)
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be > 0 seconds, got {args.timeout}")
-    arch = interface_architecture(base, args.interface)
-    if args.fifo_depth is not None and args.interface != "axis":
-        raise RvsmError("--fifo-depth applies to --interface axis only")
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
     point = load_design_point(args.point)
     contract = (point.with_size(*args.size) if args.size else point).contract()
+    arch.check(contract, **options)
     build = None
-    if arch is not base:  # the IP around the array: the flow places what rvsm verilog writes
-        ip_options = arch.resolve({**options, **({"fifo_depth": args.fifo_depth}
-                                                  if args.fifo_depth is not None else {})})
-        arch.check(contract, **ip_options)
-
+    if arch is not base:  # a wrapper around the array: the flow places what rvsm verilog
         def build(c, lanes):  # noqa: ANN001, ANN202 - rtl.fpga.flow.ComponentFactory
-            return build_component(c, arch, **{**ip_options, "lanes": lanes})
-    else:
-        base.check(contract, **options)
+            return build_component(c, arch, **{**options, "lanes": lanes})
 
     def progress(p) -> None:  # noqa: ANN001 - rvsm.rtl.toolchain.Progress
         if not args.quiet:

@@ -28,13 +28,14 @@ from rvsm.sim.cli import (
     scenes,
     studies,
     sweep,
+    verify,
 )
 from rvsm.sim.kernel_cache import install_compile_notice
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
 #: co-simulation, formal checks, FPGA timing and area, paper studies, the demo, design sweeps.
-FAMILIES: tuple[ModuleType, ...] = (sampling, events, scenes, fixed, rtl, regress, formal,
-                                    mutate, fpga, studies, demo, sweep)
+FAMILIES: tuple[ModuleType, ...] = (sampling, events, scenes, fixed, rtl, verify, regress,
+                                    formal, mutate, fpga, studies, demo, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:

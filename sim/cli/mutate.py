@@ -7,8 +7,13 @@ import json
 import sys
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.capabilities import Architecture
+from rvsm.rtl.registry import ARCHITECTURES
 from rvsm.sim.cli.args import parse_size_arg
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
+
+#: ``--arch`` choices: each architecture with mutation sites, or all of them.
+ALL = "all"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -22,7 +27,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "mutation killed, 1 one survived, 2 bad input, 3 a tool failed "
         "(docs/mutation.md).")
     p.add_argument("point", nargs="?", help="design point TOML (its model and widths)")
-    p.add_argument("--arch", choices=("stream", "parallel", "all"), default="all",
+    p.add_argument("--arch", choices=tuple(_mutated()), default=ALL,
                    help="the architecture whose mutations run (default: all)")
     p.add_argument("--size", metavar="HxW", default="6x8",
                    help="co-simulation array size (default 6x8)")
@@ -45,11 +50,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_mutate)
 
 
+def _mutated() -> dict[str, tuple[Architecture, ...]]:
+    """Each ``--arch`` choice's architectures: every registered one with mutation sites
+    by its name, and all of them (:data:`ALL`)."""
+    with_sites = {n: a for n, a in ARCHITECTURES.items() if a.mutation_sites is not None}
+    return {**{n: (a,) for n, a in with_sites.items()}, ALL: tuple(with_sites.values())}
+
+
 def _mutate(args: argparse.Namespace) -> int:
     from rvsm.rtl.mutations import MUTATIONS
 
-    archs = ("stream", "parallel") if args.arch == "all" else (args.arch,)
-    chosen = [m for m in MUTATIONS.values() if m.architecture in archs]
+    archs = _mutated()[args.arch]
+    chosen = [m for a in archs for m in a.mutation_sites.mutations]
     if args.mutation:
         unknown = [n for n in args.mutation if n not in MUTATIONS]
         if unknown:
@@ -75,35 +87,36 @@ def _mutate(args: argparse.Namespace) -> int:
         raise RvsmError(f"--lanes must be at least 1, got {args.lanes}")
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be positive, got {args.timeout}")
-    return _run(args, archs, checks, [m.name for m in chosen])
+    from rvsm.sim.cosim.run_point import RunPoint
+
+    point = RunPoint.load(args.point, parse_size_arg(args.size))
+    for a in archs:
+        a.check(point.contract, **a.resolve_own({"lanes": args.lanes}))
+    check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
+    return _run(point, archs, args.lanes, checks, tuple(m.name for m in chosen), args.out,
+                args.first_kill, args.timeout, args.json)
 
 
-def _run(args: argparse.Namespace, archs: tuple[str, ...], checks: tuple[str, ...],
-         names: list[str]) -> int:
+def _run(point, archs: tuple[Architecture, ...], lanes: int,  # noqa: ANN001 - RunPoint
+         checks: tuple[str, ...], names: tuple[str, ...], out: str, first_kill: bool,
+         timeout: float | None, as_json: bool) -> int:
     import time
 
-    from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.model.infra.atomic import write_text_atomic
-    from rvsm.rtl.registry import get_architecture
     from rvsm.sim.mutate.run import run_mutants
 
-    point = load_design_point(args.point).with_size(*parse_size_arg(args.size))
-    for arch in archs:
-        get_architecture(arch).check(point.contract(),
-                                     **({"lanes": args.lanes} if arch == "stream" else {}))
-    check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
     t0 = time.perf_counter()
-    results = run_mutants(point, archs, args.lanes, checks, args.first_kill, args.out,
-                          args.timeout, tuple(names),
+    results = run_mutants(point, archs, lanes, checks, first_kill, out, timeout, names,
                           progress=lambda line: print(line, file=sys.stderr, flush=True))
     wall = time.perf_counter() - t0
     survivors = [r.mutation.name for r in results if not r.killed]
-    data = {"checks": list(checks), "size": [point.height, point.width],
-            "lanes": args.lanes, "mutations": len(results),
+    h, w = point.shape
+    data = {"checks": list(checks), "size": [h, w],
+            "lanes": lanes, "mutations": len(results),
             "killed": len(results) - len(survivors), "survivors": survivors,
             "seconds": round(wall, 1), "results": [r.to_json() for r in results]}
-    write_text_atomic(f"{args.out}/report.json", json.dumps(data, indent=2) + "\n")
-    if args.json:
+    write_text_atomic(f"{out}/report.json", json.dumps(data, indent=2) + "\n")
+    if as_json:
         print(json.dumps(data, indent=2))
     else:
         for r in results:
@@ -111,7 +124,7 @@ def _run(args: argparse.Namespace, archs: tuple[str, ...], checks: tuple[str, ..
             more = f" (+{len(r.killed_by) - 1} more)" if len(r.killed_by) > 1 else ""
             print(f"{r.mutation.name:36} {by}{more}")
         print(f"rvsm mutate: {data['killed']} of {len(results)} mutations killed "
-              f"({', '.join(checks)}), {wall:.0f} s; report {args.out}/report.json")
+              f"({', '.join(checks)}), {wall:.0f} s; report {out}/report.json")
         if survivors:
             print(f"survivors: {', '.join(survivors)}")
     return 1 if survivors else 0

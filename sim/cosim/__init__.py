@@ -3,7 +3,8 @@
 Split by concern: :mod:`.builds` (cocotb's runner, the verified build cache, code
 coverage), :mod:`.testbenches` (one cocotb testbench per way of driving an architecture),
 :mod:`.long_runs` (the long-run harness and its twin process). Beside them,
-:mod:`.testbench_run` runs one testbench on one stimulus file, :mod:`.protocol_run` and
+:mod:`.run_point` holds a design point parsed once, :mod:`.testbench_run` runs one
+testbench on one stimulus file, :mod:`.protocol_run` and
 :mod:`.axis_run` the protocol scripts and the AXI IP, and :mod:`.verify` is ``rvsm verify``.
 """
 

@@ -1,10 +1,11 @@
 """Co-simulation of the AXI IP (``rvsm verilog --interface axis``) with cocotbext-axi.
 
-:func:`axis_verify` builds the IP (:data:`~rvsm.rtl.ip.architecture.STREAM_AXIS`)
-through the shared build cache (:func:`~.build_cache.build`), writes the stimulus into
-a fresh run folder and runs the testbench :mod:`.tb_axis` through the one cocotb runner
-(:func:`~.simulation.run_cocotb`): the policy, the seed of the pause generators and the
-idle/back-pressure probabilities go in as ``RVSM_AXIS``.
+:func:`axis_verify` builds the IP (the registry's ``axis`` wrapper of the streaming
+array, ``rtl/ip/architecture.py``) through the shared build cache
+(:func:`~.build_cache.build`), writes the stimulus into a fresh run folder and runs the
+wrapper's testbench (:mod:`.tb_axis`) through the one cocotb runner
+(:func:`~.testbench_run.run_cocotb`): the policy, the seed of the pause generators and
+the idle/back-pressure probabilities go in as ``RVSM_AXIS``.
 """
 
 from __future__ import annotations
@@ -16,7 +17,8 @@ from pathlib import Path
 
 from rvsm.model.fixed.stimulus import Stimulus, save_stimulus
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.ip.architecture import STREAM_AXIS
+from rvsm.rtl.capabilities import Architecture
+from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.sim.cosim.builds.build_cache import build, new_run_dir
 from rvsm.sim.cosim.testbench_run import run_cocotb
 from rvsm.sim.cosim.verify import DEFAULT_WORK
@@ -30,12 +32,13 @@ AXIS_POLICIES = ("stall", "drop")
 def axis_verify(stim: Stimulus, sim: str = "icarus", policy: str = "stall", seed: int = 0,
                 idle_in: float = 0.3, idle_out: float = 0.3, lanes: int = 1,
                 fifo_depth: int | None = None, work_dir: str | os.PathLike = DEFAULT_WORK,
-                waves: bool = False) -> dict:
+                waves: bool = False, arch: str | Architecture | None = None) -> dict:
     """Drive the IP of ``stim.contract`` with ``stim`` under ``policy``, the source idle
     with probability ``idle_in`` per cycle and the sink stalling with ``idle_out``
     (seeded by ``seed``); returns the testbench's result (``mismatches`` 0 when every
     beat, counter and register checked out; ``dropped``, ``counters``, ``cycles``...)
-    with the build's timings and ``run_dir``."""
+    with the build's timings and ``run_dir``. ``arch`` is the wrapper (default the
+    streaming array's ``axis`` one), ``lanes`` and ``fifo_depth`` its options."""
     if policy not in AXIS_POLICIES:
         raise RvsmError(f"unknown policy {policy!r}; choose one of {AXIS_POLICIES}")
     for name, p in (("idle_in", idle_in), ("idle_out", idle_out)):
@@ -44,10 +47,12 @@ def axis_verify(stim: Stimulus, sim: str = "icarus", policy: str = "stall", seed
     if policy == "drop" and stim.clear_before:
         raise RvsmError("the drop-policy check takes a stimulus without clears")
     contract = stim.contract
-    options = STREAM_AXIS.resolve({"lanes": lanes, "fifo_depth": fifo_depth})
-    STREAM_AXIS.check(contract, **options)
+    wrapper = get_architecture(DEFAULT_ARCHITECTURE, "axis") if arch is None \
+        else get_architecture(arch)
+    options = wrapper.resolve({"lanes": lanes, "fifo_depth": fifo_depth})
+    wrapper.check(contract, **options)
     work = Path(work_dir)
-    sb = build(contract, sim, work / "builds", waves=waves, arch=STREAM_AXIS, **options)
+    sb = build(contract, sim, work / "builds", waves=waves, arch=wrapper, **options)
     run_dir = new_run_dir(work, f"axis-{policy}-{sim}")
     try:
         path = run_dir / "stimulus.npz"
@@ -61,5 +66,5 @@ def axis_verify(stim: Stimulus, sim: str = "icarus", policy: str = "stall", seed
         raise
     result.update(build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
                   build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),
-                  arch=STREAM_AXIS.name, options=options)
+                  arch=wrapper.name, options=options)
     return result

@@ -7,7 +7,10 @@ comparison. On a mismatch without ``waves`` it re-runs the stimulus up to the fi
 failing step with waves on, so a waveform is always kept. The entry points build the
 stimulus three ways: :func:`run_rtl` from a contract, codes and thresholds (the
 expectation from :meth:`ArrayContract.run`); :func:`verify` from a scene and a design
-point TOML via the fixed twin; :func:`replay` from a stimulus file (``rvsm stimulus``).
+point (a :class:`~.run_point.RunPoint`, read once by the command) via the fixed twin;
+:func:`replay` from a stimulus file (``rvsm stimulus``). The architecture is a value of
+the registry; whether it has a long-run harness is its capability
+(:attr:`~rvsm.rtl.capabilities.Architecture.long_run_testbench`).
 """
 
 from __future__ import annotations
@@ -26,11 +29,11 @@ from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.scene import Scene
 from rvsm.rtl.capabilities import Architecture
-from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, get_architecture
+from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, architectures_with, get_architecture
 from rvsm.sim.cosim.builds.build_cache import SimBuild, build, new_run_dir
 from rvsm.sim.cosim.builds.cocotb_adapter import check_simulator
-from rvsm.sim.cosim.long_runs.chunk_harness import LONG_RUN_TESTBENCHES
 from rvsm.sim.cosim.long_runs.long_run import DEFAULT_CHUNK_STEPS, check_chunks
+from rvsm.sim.cosim.run_point import RunPoint
 from rvsm.sim.cosim.testbench_run import run_testbench
 
 #: The testbenches ``rvsm verify --harness`` chooses: per cycle from Python, or the
@@ -60,13 +63,12 @@ def _check_inputs(contract: ArrayContract, codes: np.ndarray, thresholds: np.nda
                         f"got {thresholds.shape}")
 
 
-def _resolve(arch: str | Architecture, options: dict[str, int | None],
-             contract: ArrayContract) -> tuple[Architecture, dict[str, int]]:
-    """The architecture, its options (defaults filled in) and its size rule applied."""
-    a = get_architecture(arch)
+def _resolve(a: Architecture, options: dict[str, int | None],
+             contract: ArrayContract) -> dict[str, int]:
+    """The options of ``a`` (defaults filled in), after its size rule."""
     resolved = a.resolve(options)
     a.check(contract, **resolved)
-    return a, resolved
+    return resolved
 
 
 def check_stimulus(
@@ -92,7 +94,8 @@ def check_stimulus(
     None), ``build_seconds``, ``stream_seconds``, ``run_dir``...
     """
     contract = stim.contract
-    a, resolved = _resolve(arch, options, contract)
+    a = get_architecture(arch)
+    resolved = _resolve(a, options, contract)
     _check_inputs(contract, stim.codes, stim.thresholds)
     want = (stim.num_steps, contract.num_scales, contract.height, contract.width)
     if stim.spikes.shape != want:
@@ -189,16 +192,17 @@ def replay(
     ``height``, ``width`` and ``expectation`` (``"file"`` or ``"recomputed"``).
     """
     check_simulator(sim)
-    check_harness(harness, arch)
+    a = get_architecture(arch)
+    check_harness(harness, a)
     stim = open_stimulus(stimulus)  # codes and spikes read a range of steps at a time
     c = stim.contract
-    _resolve(arch, options, c)
+    _resolve(a, options, c)
     if steps is not None and steps > stim.num_steps:
         raise RvsmError(f"--steps {steps}: {stimulus} holds {stim.num_steps} steps; ask for "
                         f"at most {stim.num_steps}")
     if steps is not None and steps < stim.num_steps:
         stim = stim.first_steps(steps)
-    harness = choose_harness(harness, arch, c.height * c.width, stim.num_steps, options)
+    harness = choose_harness(harness, a, c.height * c.width, stim.num_steps, options)
     check_code_coverage(code_coverage, harness, sim)
     if harness != "chunk":  # the per-cycle testbench takes the stimulus whole
         stim = stim.loaded()
@@ -216,13 +220,13 @@ def replay(
         # the testbench opens the file again and reads it a chunk at a time
         source = StimulusChunks.from_stimulus(stim, str(Path(stimulus).resolve()),
                                               recompute=recompute_expected)
-        result = check_chunks(source, sim, work_dir=work_dir, name=name, arch=arch,
+        result = check_chunks(source, sim, work_dir=work_dir, name=name, arch=a,
                               waves=waves, progress=progress, chunk_steps=chunk_steps,
                               code_coverage=code_coverage,
                               **options)
     else:
         result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=name,
-                                arch=arch, **options)
+                                arch=a, **options)
     result.update(stimulus=str(stimulus), height=c.height, width=c.width,
                   coverage=with_lane_coverage(_coverage(stim), result),
                   expectation="recomputed" if recompute_expected else "file")
@@ -231,7 +235,7 @@ def replay(
 
 def verify(
     scene: str | Scene,
-    fixed: str | os.PathLike,
+    point: RunPoint | str | os.PathLike,
     sim: str = "icarus",
     steps: int | None = None,
     waves: bool = False,
@@ -244,10 +248,11 @@ def verify(
     code_coverage: bool = False,
     **options: int | None,
 ) -> dict:
-    """Verify the RTL of design point ``fixed`` (TOML) on ``scene``, spike for spike.
+    """Verify the RTL of design ``point`` on ``scene``, spike for spike.
 
-    ``arch`` and ``options`` as :func:`check_stimulus` (the streaming array takes any
-    array size).
+    ``point`` is a :class:`~.run_point.RunPoint` (a command reads its TOML once) or the
+    TOML path; ``arch`` and ``options`` as :func:`check_stimulus` (the streaming array
+    takes any array size).
 
     ``size = (H, W)`` overrides the point's array size (a scene name or path is rendered
     or cropped to it; a :class:`Scene`, shaped by the caller, must have it); ``steps``
@@ -259,20 +264,18 @@ def verify(
     :class:`RvsmError` on user errors (not on mismatches: check
     ``result["mismatches"]``).
     """
-    from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.model.fixed.stimulus import make_stimulus
     from rvsm.model.scene.loaders import load_scene
 
     check_simulator(sim)
-    check_harness(harness, arch)
-    point = load_design_point(fixed)
-    if size is not None:
-        point = point.with_size(*size)
-    h, w = point.height, point.width
-    _resolve(arch, options, point.contract())
+    a = get_architecture(arch)
+    check_harness(harness, a)
+    run = RunPoint.coerce(point, size)
+    h, w = run.shape
+    _resolve(a, options, run.contract)
     if not isinstance(scene, Scene):
         scene = load_scene(scene, size=(h, w))
-    harness = choose_harness(harness, arch, h * w,
+    harness = choose_harness(harness, a, h * w,
                              scene.num_steps if steps is None else steps, options,
                              reloadable=scene.source is not None)
     check_code_coverage(code_coverage, harness, sim)
@@ -280,24 +283,24 @@ def verify(
         if steps is not None and steps > scene.num_steps:
             raise RvsmError(f"--steps {steps} is more than the {scene.num_steps} steps of "
                             f"scene {scene.name!r}; ask for at most {scene.num_steps}")
-        source = StimulusChunks.from_scene(scene, point, steps)
+        source = StimulusChunks.from_scene(scene, run.point, steps)
         result = check_chunks(source, sim, work_dir=work_dir, name=scene.name or "scene",
-                              arch=arch, waves=waves, progress=progress, chunk_steps=chunk_steps,
+                              arch=a, waves=waves, progress=progress, chunk_steps=chunk_steps,
                               code_coverage=code_coverage,
                               **options)
-        result.update(scene=scene.source or scene.name, point=str(fixed), height=h,
+        result.update(scene=scene.source or scene.name, point=run.source, height=h,
                       width=w, coverage=result.get("lane_coverage"))
         return result
-    stim = make_stimulus(scene, point, num_steps=steps)
+    stim = make_stimulus(scene, run.point, num_steps=steps)
     result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
-                            name=scene.name or "scene", arch=arch, **options)
-    result.update(scene=scene.source or scene.name, point=str(fixed), height=h, width=w,
+                            name=scene.name or "scene", arch=a, **options)
+    result.update(scene=scene.source or scene.name, point=run.source, height=h, width=w,
                   coverage=_coverage(stim))
     return result
 
 
 def random_verify(
-    fixed: str | os.PathLike,
+    point: RunPoint | str | os.PathLike,
     seed: int,
     steps: int,
     sim: str = "icarus",
@@ -311,51 +314,50 @@ def random_verify(
     code_coverage: bool = False,
     **options: int | None,
 ) -> dict:
-    """Verify the RTL of design point ``fixed`` on a seeded random and corner stimulus
-    (:func:`~rvsm.model.fixed.corner_stimulus.corner_stimulus`, ``steps`` steps);
-    ``arch`` and ``options`` as :func:`check_stimulus`.
+    """Verify the RTL of design ``point`` (as :func:`verify`) on a seeded random and
+    corner stimulus (:func:`~rvsm.model.fixed.corner_stimulus.corner_stimulus`,
+    ``steps`` steps); ``arch`` and ``options`` as :func:`check_stimulus`.
 
     Returns :func:`check_stimulus`'s result plus ``seed``, ``point``, ``height``,
     ``width`` and ``coverage`` (per scale, accumulator-steps per bin).
     """
     from rvsm.model.fixed.corner_stimulus import corner_stimulus, coverage
-    from rvsm.model.fixed.point_toml import load_design_point
 
     check_simulator(sim)
-    check_harness(harness, arch)
-    point = load_design_point(fixed)
-    if size is not None:
-        point = point.with_size(*size)
-    _resolve(arch, options, point.contract())
-    stim = corner_stimulus(point.contract(), seed, steps)
-    stim.point = point
-    harness = choose_harness(harness, arch, point.height * point.width, steps, options)
+    a = get_architecture(arch)
+    check_harness(harness, a)
+    run = RunPoint.coerce(point, size)
+    _resolve(a, options, run.contract)
+    stim = corner_stimulus(run.contract, seed, steps)
+    stim.point = run.point
+    h, w = run.shape
+    harness = choose_harness(harness, a, h * w, steps, options)
     check_code_coverage(code_coverage, harness, sim)
     if harness == "chunk":
         result = check_chunks(StimulusChunks.from_stimulus(stim), sim, work_dir=work_dir,
-                              name=f"random{seed}", arch=arch, waves=waves,
+                              name=f"random{seed}", arch=a, waves=waves,
                               progress=progress, chunk_steps=chunk_steps,
                               code_coverage=code_coverage,
                               **options)
     else:
         result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
-                                name=f"random{seed}", arch=arch, **options)
-    result.update(seed=seed, point=str(fixed), height=point.height, width=point.width,
+                                name=f"random{seed}", arch=a, **options)
+    result.update(seed=seed, point=run.source, height=h, width=w,
                   coverage=with_lane_coverage(coverage(stim), result))
     return result
 
 
 def choose_harness(harness: str, arch: str | Architecture, pixels: int, steps: int,
                    options: dict, reloadable: bool = True) -> str:
-    """``harness``, with ``"auto"`` resolved: ``"chunk"`` for the streaming array when
-    ``pixels * steps / lanes`` (input beats) exceeds :data:`AUTO_CHUNK_BEATS` and the
-    stimulus can be opened again in the simulator (``reloadable``), else ``"cycle"``."""
+    """``harness``, with ``"auto"`` resolved: ``"chunk"`` for an architecture with a
+    long-run harness (the streaming array) when ``pixels * steps / lanes`` (input beats)
+    exceeds :data:`AUTO_CHUNK_BEATS` and the stimulus can be opened again in the
+    simulator (``reloadable``), else ``"cycle"``."""
     if harness != "auto":
         return harness
-    name = get_architecture(arch).name
+    long_run = get_architecture(arch).long_run_testbench is not None
     lanes = int(options.get("lanes") or 1)
-    if name in LONG_RUN_TESTBENCHES and reloadable and pixels * steps // lanes > \
-            AUTO_CHUNK_BEATS:
+    if long_run and reloadable and pixels * steps // lanes > AUTO_CHUNK_BEATS:
         return "chunk"
     return "cycle"
 
@@ -372,16 +374,17 @@ def check_harness(harness: str, arch: str | Architecture) -> None:
     architecture it does not drive."""
     if harness not in HARNESSES:
         raise RvsmError(f"unknown harness {harness!r}; choose one of {', '.join(HARNESSES)}")
-    name = get_architecture(arch).name
-    if harness == "chunk" and name not in LONG_RUN_TESTBENCHES:
-        raise RvsmError(f"--harness chunk drives the {', '.join(LONG_RUN_TESTBENCHES)} "
-                        f"architecture only; use --harness cycle for --arch {name}")
+    a = get_architecture(arch)
+    if harness == "chunk" and a.long_run_testbench is None:
+        names = architectures_with(lambda x: x.long_run_testbench)
+        raise RvsmError(f"--harness chunk drives the {', '.join(names)} "
+                        f"architecture only; use --harness cycle for --arch {a.name}")
 
 
 def with_lane_coverage(bins: list[dict], result: dict) -> list[dict]:
     """The stimulus's coverage ``bins`` per scale plus, for a long run, the lanes'
-    border bins it measured (``lane_coverage``, :mod:`rvsm.rtl.stream.coverage`; its
-    spike counts are already among ``bins``)."""
+    border bins it measured (``lane_coverage``, the beat stream's ``border_coverage``;
+    its spike counts are already among ``bins``)."""
     lanes = result.get("lane_coverage")
     if not lanes:
         return bins

@@ -25,6 +25,7 @@ from typing import Any
 
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.formal_harness import FormalHarness, Property, property_at
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.registry import get_architecture
@@ -133,14 +134,14 @@ class FormalReport:
                 "checks": [r.to_json() for r in self.results]}
 
 
-def available_checks(arch: str) -> list[str]:
+def available_checks(arch: str | Architecture) -> list[str]:
     """The formal checks ``arch`` registers, in :data:`CHECK_ORDER`."""
     names = list(get_architecture(arch).formal)
     return sorted(names, key=lambda n: (CHECK_ORDER.index(n) if n in CHECK_ORDER
                                         else len(CHECK_ORDER), n))
 
 
-def run_checks(contract: ArrayContract, arch: str, options: dict[str, int], *,
+def run_checks(contract: ArrayContract, arch: str | Architecture, options: dict[str, int], *,
                checks: list[str] | None = None, mode: str | None = None,
                depth: int | None = None, mutation: str | None = None, workdir: Path,
                timeout: float | None = None, solver: str = "yices", jobs: int = 1,
@@ -159,7 +160,8 @@ def run_checks(contract: ArrayContract, arch: str, options: dict[str, int], *,
     not exceptions.
     """
     architecture = get_architecture(arch)
-    known = available_checks(arch)
+    arch = architecture.name
+    known = available_checks(architecture)
     if not known:
         raise RvsmError(f"--arch {arch} has no formal checks")
     unknown = [c for c in checks or () if c not in known]

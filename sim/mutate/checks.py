@@ -1,27 +1,31 @@
 """The co-simulation checks a mutant must fail: the default suite's scenarios, in
 ``amaranth.sim``.
 
-Each :class:`CosimCheck` drives one array (built with a mutation, or the shipped one) the
-way the default co-simulation does (``tests/sim/cosim/test_stream.py``): random codes with
-the extremes 0 and full scale, per-pixel thresholds, the input stalled every other beat, a
-clear between steps, thresholds rewritten while the stream pauses, accumulators driven into
-both rails. It compares every spike with :meth:`ArrayContract.run` and returns the number
-of mismatches (an exception of the simulation counts as a kill too). ``amaranth.sim``
-rather than cocotb: the same RTL (the co-simulation suite shows the generated Verilog
-agrees with it spike for spike), a second per mutant instead of a Verilog build each.
+Each :class:`CosimCheck` drives one array (built with a mutation, or the shipped one)
+through its architecture's ``amaranth.sim`` driver (:attr:`Architecture.simulate` and
+:attr:`Architecture.running_threshold_writes`), on every architecture whose driver can
+play it (:meth:`CosimCheck.runs_on`), the way the default co-simulation does
+(``tests/sim/cosim/test_stream.py``): random codes with the extremes 0 and full scale,
+per-pixel thresholds, the input stalled every other beat, a clear between steps,
+thresholds rewritten while the stream pauses, accumulators driven into both rails. It
+compares every spike with :meth:`ArrayContract.run` and returns the number of mismatches
+(an exception of the simulation counts as a kill too). ``amaranth.sim`` rather than
+cocotb: the same RTL (the co-simulation suite shows the generated Verilog agrees with it
+spike for spike), a second per mutant instead of a Verilog build each.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.widths import unsigned_max
+from rvsm.rtl.capabilities import Architecture
+from rvsm.rtl.registry import get_architecture
 
-__all__ = ["COSIM_CHECKS", "CosimCheck", "stimulus"]
+__all__ = ["COSIM_CHECKS", "RUNNING_WRITES", "CosimCheck", "stimulus"]
 
 
 @dataclass(frozen=True)
@@ -91,84 +95,81 @@ def _expected(contract: ArrayContract, stim: Stimulus) -> np.ndarray:
     return out
 
 
-def _run_stream(contract: ArrayContract, stim: Stimulus, lanes: int,
-                mutation: str | None) -> int:
-    from rvsm.rtl.stream.dimensions import StreamGeometry
-    from rvsm.rtl.stream.drive import simulate
-    from rvsm.rtl.stream.schedule import check_beats
-
-    got = simulate(contract, stim.codes, stim.thresholds, lanes, stim.clear_before,
-                   stim.threshold_updates, stim.idle_every, mutation=mutation)
-    result = check_beats(StreamGeometry(contract, lanes).schedule,
-                         _expected(contract, stim), got)
-    return int(result["mismatches"])
+def _run(contract: ArrayContract, stim: Stimulus, arch: Architecture,
+         options: dict[str, int], mutation: str | None) -> int:
+    """``stim`` through ``arch``'s ``amaranth.sim`` driver, compared with the contract."""
+    drive = {k: v for k, v in (("idle_every", stim.idle_every),
+                               ("threshold_updates", stim.threshold_updates)) if v}
+    got = arch.simulate(contract, stim.codes, stim.thresholds,
+                        clear_before=stim.clear_before, mutation=mutation, **drive, **options)
+    return int(arch.compare(contract, _expected(contract, stim), got, **options)["mismatches"])
 
 
-def _run_parallel(contract: ArrayContract, stim: Stimulus, lanes: int,
-                  mutation: str | None) -> int:
-    from rvsm.rtl.parallel.drive import simulate
-
-    got = simulate(contract, stim.codes, stim.thresholds, stim.clear_before,
-                   mutation=mutation)
-    return int((got != _expected(contract, stim)).sum())
-
-
-def _run_collisions(contract: ArrayContract, lanes: int, mutation: str | None) -> int:
+def _run_collisions(contract: ArrayContract, arch: Architecture, options: dict[str, int],
+                    mutation: str | None) -> int:
     """Threshold writes while the stream runs, many meeting the read of their word
     (``tests/rtl/stream/test_array.py``'s scenario)."""
     from rvsm.model.fixed.contract import FixedIntegrator, arithmetic_shift, integer_receptive_sums
-    from rvsm.rtl.stream.dimensions import StreamGeometry
-    from rvsm.rtl.stream.drive import colliding_threshold_writes, simulate_with_threshold_writes
-    from rvsm.rtl.stream.schedule import check_beats
 
     c = contract
     stim = stimulus(c, "random")
-    steps = len(stim.codes)
-    geo = StreamGeometry(c, lanes)
     top = int(stim.thresholds.max()) + 1
-    writes, frames, _, _ = colliding_threshold_writes(geo, stim.thresholds, steps, 7, top)
+    frames, got = arch.running_threshold_writes(c, stim.codes, stim.thresholds, 7, top,
+                                                mutation=mutation, **options)
     integrator = FixedIntegrator(stim.thresholds, c.accumulator_bits, c.signed, c.reset)
     sums = arithmetic_shift(integer_receptive_sums(stim.codes, c.weight_arrays), c.shift)
     want = []
-    for t in range(steps):
-        integrator.thr = frames[t].reshape(c.num_scales, c.height, c.width)  # words -> pixels
+    for t in range(len(stim.codes)):
+        integrator.thr = frames[t]
         want.append(integrator.step(sums[t]))
-    got = simulate_with_threshold_writes(c, lanes, stim.codes, stim.thresholds, writes,
-                                         mutation=mutation)
-    return int(check_beats(geo.schedule, np.stack(want), got)["mismatches"])
+    return int(arch.compare(c, np.stack(want), got, **options)["mismatches"])
+
+
+#: What a scenario needs of an architecture's ``amaranth.sim`` driver: a keyword of its
+#: ``simulate`` (:attr:`Architecture.simulate_keywords`), or :data:`RUNNING_WRITES`, its
+#: :attr:`Architecture.running_threshold_writes`.
+RUNNING_WRITES = "running_threshold_writes"
 
 
 @dataclass(frozen=True)
 class CosimCheck:
-    """One co-simulation scenario: ``name``, ``description``, the architectures it runs
-    on and :meth:`mismatches`."""
+    """One co-simulation scenario: ``name``, ``description``, what it ``needs`` of an
+    architecture's driver (``None``: codes, thresholds and clears only) and
+    :meth:`mismatches`."""
 
     name: str
     description: str
-    architectures: tuple[str, ...]
+    needs: str | None = None
 
-    def mismatches(self, contract: ArrayContract, arch: str, lanes: int,
+    def runs_on(self, arch: str | Architecture) -> bool:
+        """Whether ``arch``'s driver can play this scenario."""
+        a = get_architecture(arch)
+        if self.needs is None:
+            return True
+        if self.needs == RUNNING_WRITES:
+            return a.running_threshold_writes is not None
+        return self.needs in a.simulate_keywords
+
+    def mismatches(self, contract: ArrayContract, arch: str | Architecture, lanes: int,
                    mutation: str | None) -> int:
-        """Spikes of the (mutated) array that differ from the contract's."""
-        if self.name == "threshold_collisions":
-            return _run_collisions(contract, lanes, mutation)
-        stim = stimulus(contract, self.name)
-        run: Callable[..., int] = _run_stream if arch == "stream" else _run_parallel
-        return run(contract, stim, lanes, mutation)
+        """Spikes of the (mutated) array that differ from the contract's; ``lanes`` for
+        an architecture that takes them."""
+        a = get_architecture(arch)
+        options = a.resolve_own({"lanes": lanes})
+        if self.needs == RUNNING_WRITES:
+            return _run_collisions(contract, a, options, mutation)
+        return _run(contract, stimulus(contract, self.name), a, options, mutation)
 
 
 #: The co-simulation checks, in the order they run.
 COSIM_CHECKS: tuple[CosimCheck, ...] = (
-    CosimCheck("random", "random codes (0 and full scale included), per-pixel thresholds",
-               ("stream", "parallel")),
-    CosimCheck("stall", "the input stalled after every other beat", ("stream",)),
-    CosimCheck("clear", "a clear between steps, mid-stream", ("stream", "parallel")),
+    CosimCheck("random", "random codes (0 and full scale included), per-pixel thresholds"),
+    CosimCheck("stall", "the input stalled after every other beat", "idle_every"),
+    CosimCheck("clear", "a clear between steps, mid-stream"),
     CosimCheck("threshold_update", "thresholds rewritten while the stream pauses",
-               ("stream",)),
+               "threshold_updates"),
     CosimCheck("threshold_collisions", "threshold writes while the stream runs, many "
-               "meeting the read of their own word", ("stream",)),
-    CosimCheck("exact", "every threshold equal to the accumulator after the first step",
-               ("stream", "parallel")),
-    CosimCheck("rails", "the top threshold: accumulators saturate at both rails",
-               ("stream", "parallel")),
+               "meeting the read of their own word", RUNNING_WRITES),
+    CosimCheck("exact", "every threshold equal to the accumulator after the first step"),
+    CosimCheck("rails", "the top threshold: accumulators saturate at both rails"),
 )

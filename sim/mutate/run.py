@@ -6,21 +6,25 @@ A mutant is *killed* when a check fails on it: a co-simulation check
 Before any mutant, the shipped RTL must pass every check (else the checks, not the
 mutants, are wrong: an :class:`RvsmError` naming the check). Co-simulation runs each
 check at the point's array size in both reset modes; the formal checks run at the tiny
-point of :func:`tiny_formal_point`.
+point of :func:`tiny_formal_point`. What differs between architectures (their mutants,
+the scenarios their drivers play, their tiny point and formal checks) is theirs to say:
+:class:`~rvsm.rtl.capabilities.MutationSites` and the driver's capabilities.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.capabilities import require_spike_sensor
-from rvsm.rtl.mutations import Mutation, mutations_for
+from rvsm.rtl.capabilities import Architecture, MutationSites, require_spike_sensor
+from rvsm.rtl.mutations import Mutation
+from rvsm.rtl.registry import get_architecture
+from rvsm.sim.cosim.run_point import RunPoint
 from rvsm.sim.mutate.checks import COSIM_CHECKS
 
 __all__ = ["MutantResult", "run_mutants", "tiny_formal_point"]
@@ -55,36 +59,35 @@ class MutantResult:
                 "seconds": round(self.seconds, 2)}
 
 
-#: The stream's formal checks run at dog2: two signed scales with a surround, so every
-#: kernel, padding, sign, lane and reset bug shows, and each check takes seconds.
-STREAM_FORMAL_MODEL = "dog2"
-
-
-def tiny_formal_point(point: DesignPoint, arch: str) -> DesignPoint:
-    """A point the solver closes quickly, as ``tests/data/formal-tiny.toml``: 2x2 and the
-    point's model (parallel), or 3x4 and :data:`STREAM_FORMAL_MODEL` (stream); 2-bit ADC,
-    5 weight fraction bits, shift 1, 6-bit accumulators, threshold 8 (the formal
-    harnesses take thresholds from the solver anyway)."""
-    if arch == "parallel":
-        h, w, model = 2, 2, point.model
-    else:
-        h, w, model = 3, 4, STREAM_FORMAL_MODEL
+def tiny_formal_point(point: DesignPoint, arch: str | Architecture) -> DesignPoint:
+    """A point the solver closes quickly, as ``tests/data/formal-tiny.toml``: the size and
+    model of ``arch``'s :class:`~rvsm.rtl.capabilities.MutationSites` (parallel: 2x2 and
+    the point's model; stream: 3x4 and dog2); 2-bit ADC, 5 weight fraction bits, shift
+    1, 6-bit accumulators, threshold 8 (the formal harnesses take thresholds from the
+    solver anyway)."""
+    sites = _sites(get_architecture(arch))
+    (h, w), model = sites.formal_size, sites.formal_model or point.model
     return dataclasses.replace(point, height=h, width=w, model=model, adc_bits=2,
                                weight_frac_bits=5, shift=1, accumulator_bits=6, phi=8.0,
                                scale_phi=None)
 
 
-def _contracts(point: DesignPoint) -> dict[str, ArrayContract]:
-    base = point.contract()
-    require_spike_sensor(base, "the mutations")
+def _sites(arch: Architecture) -> MutationSites:
+    if arch.mutation_sites is None:
+        raise RvsmError(f"--arch {arch.name} has no mutations")
+    return arch.mutation_sites
+
+
+def _contracts(base: ArrayContract) -> dict[str, ArrayContract]:
+    """``base`` in each reset mode of :data:`RESETS`."""
     return {reset: dataclasses.replace(base, reset=reset) for reset in RESETS}
 
 
-def _cosim(contracts: dict[str, ArrayContract], arch: str, lanes: int,
+def _cosim(contracts: dict[str, ArrayContract], arch: Architecture, lanes: int,
            mutation: str | None, first_kill: bool) -> tuple[list[str], list[str]]:
     killed, passed = [], []
     for check in COSIM_CHECKS:
-        if arch not in check.architectures:
+        if not check.runs_on(arch):
             continue
         for reset, contract in contracts.items():
             name = f"cosim:{check.name} ({reset} reset)"
@@ -99,26 +102,37 @@ def _cosim(contracts: dict[str, ArrayContract], arch: str, lanes: int,
     return killed, passed
 
 
-def _formal(point: DesignPoint, arch: str, lanes: int, mutation: str | None,
-            workdir: Path, timeout: float | None) -> tuple[list[str], list[str]]:
-    """Every formal check of ``arch`` in both reset modes (the shipped RTL), or until
+@dataclasses.dataclass(frozen=True)
+class _FormalSetup:
+    """What every formal run of one architecture shares: the tiny point's contract in
+    each reset mode, the options there and the checks a mutant faces, cheapest first."""
+
+    contracts: dict[str, ArrayContract]
+    options: dict[str, int]
+    checks: tuple[str, ...]
+
+    @classmethod
+    def of(cls, point: DesignPoint, arch: Architecture, lanes: int) -> _FormalSetup:
+        """The tiny point of ``arch``; ``lanes`` where they fit it, else the defaults."""
+        contracts = _contracts(tiny_formal_point(point, arch).contract())
+        options = arch.resolve_own({"lanes": lanes})
+        try:
+            arch.check(contracts[RESETS[0]], **options)
+        except RvsmError:  # e.g. lanes that do not divide the tiny width
+            options = arch.resolve()
+        return cls(contracts, options, _sites(arch).formal_checks)
+
+
+def _formal(setup: _FormalSetup, arch: Architecture, mutation: str | None, workdir: Path,
+            timeout: float | None) -> tuple[list[str], list[str]]:
+    """Every formal check of ``setup`` in both reset modes (the shipped RTL), or until
     the first that kills ``mutation`` (a mutant: the fast checks run first)."""
-    from rvsm.sim.formal.runner import available_checks, run_checks
+    from rvsm.sim.formal.runner import run_checks
 
     killed, passed = [], []
-    # the compositional proof (window, sums, composed) re-proves what equivalence
-    # checks end to end: not run again for each mutant
-    checks = [c for c in available_checks(arch) if c not in ("window", "sums", "composed")]
-    if arch == "stream":  # cheapest first: a mutant usually dies in seconds
-        order = ("tail", "protocol", "equivalence", "state", "thresholds")
-        checks = sorted(checks, key=lambda c: order.index(c) if c in order else len(order))
-    for check in checks:
-        for reset in RESETS:
-            base = tiny_formal_point(point, arch).contract()
-            contract = dataclasses.replace(base, reset=reset)
-            options = {"lanes": lanes if contract.width % lanes == 0 else 1} \
-                if arch == "stream" else {}
-            report = run_checks(contract, arch, options, checks=[check],
+    for check in setup.checks:
+        for reset, contract in setup.contracts.items():
+            report = run_checks(contract, arch, setup.options, checks=[check],
                                 mutation=mutation, workdir=workdir / reset,
                                 timeout=timeout)
             k, p = _verdicts(report, reset, mutation)
@@ -145,42 +159,46 @@ def _verdicts(report, reset: str, mutation: str | None) -> tuple[list[str], list
 
 
 def run_mutants(
-    point: DesignPoint, architectures: tuple[str, ...], lanes: int,
+    point: DesignPoint | RunPoint, architectures: Sequence[str | Architecture], lanes: int,
     checks: tuple[str, ...] = CHECK_KINDS, first_kill: bool = False,
     workdir: str | Path = "build/mutate", timeout: float | None = None,
     names: tuple[str, ...] | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> list[MutantResult]:
     """Run every mutant of ``architectures`` (or only ``names``) against ``checks``;
-    the shipped RTL first, which must pass them all."""
-    contracts = _contracts(point)
+    the shipped RTL first, which must pass them all. ``point`` is the design point (a
+    :class:`~rvsm.sim.cosim.run_point.RunPoint`: its contract built once); ``lanes``
+    applies to the architectures that take lanes."""
+    run = point if isinstance(point, RunPoint) else RunPoint.of(point, "")
+    require_spike_sensor(run.contract, "the mutations")
+    contracts = _contracts(run.contract)
     work = Path(workdir)
     say = progress or (lambda line: None)
     results = []
-    for arch in architectures:
-        a_lanes = lanes if arch == "stream" else 1
+    for a in (get_architecture(x) for x in architectures):
+        setup = _FormalSetup.of(run.point, a, lanes) if "formal" in checks else None
         if "cosim" in checks:
-            killed, _ = _cosim(contracts, arch, a_lanes, None, False)
+            killed, _ = _cosim(contracts, a, lanes, None, False)
             if killed:
-                raise RvsmError(f"the shipped {arch} RTL fails {killed[0]}: the checks or "
+                raise RvsmError(f"the shipped {a.name} RTL fails {killed[0]}: the checks or "
                                 f"the RTL are wrong, not the mutants; run rvsm verify")
-        if "formal" in checks:
-            killed, _ = _formal(point, arch, a_lanes, None, work / arch / "shipped", timeout)
+        if setup is not None:
+            killed, _ = _formal(setup, a, None, work / a.name / "shipped", timeout)
             if killed:
-                raise RvsmError(f"the shipped {arch} RTL fails {killed[0]}; run rvsm formal")
-        mutants = [m for m in mutations_for(arch) if names is None or m.name in names]
+                raise RvsmError(f"the shipped {a.name} RTL fails {killed[0]}; run rvsm formal")
+        mutants = [m for m in _sites(a).mutations if names is None or m.name in names]
         for i, m in enumerate(mutants, 1):
             t0 = time.perf_counter()
             killed, passed = [], []
             if "cosim" in checks:
-                killed, passed = _cosim(contracts, arch, a_lanes, m.name, first_kill)
-            if "formal" in checks and not (first_kill and killed):
-                k, p = _formal(point, arch, a_lanes, m.name, work / arch / m.name, timeout)
+                killed, passed = _cosim(contracts, a, lanes, m.name, first_kill)
+            if setup is not None and not (first_kill and killed):
+                k, p = _formal(setup, a, m.name, work / a.name / m.name, timeout)
                 killed += k
                 passed += p
             result = MutantResult(m, killed, passed, time.perf_counter() - t0)
             results.append(result)
             verdict = f"killed by {killed[0]}" if killed else "SURVIVED"
-            say(f"mutate: {arch} {i}/{len(mutants)} {m.name}: {verdict} "
+            say(f"mutate: {a.name} {i}/{len(mutants)} {m.name}: {verdict} "
                 f"({result.seconds:.1f} s)")
     return results

@@ -13,14 +13,16 @@ A plan is TOML with three tables::
     models = ["dog4", "dog2"]      # array.model values (default: the base's model)
     size = "16x16"                 # array size (H x W)
     arch = "stream"                # stream | parallel
-    lanes = [2, 4]                 # streaming array lanes (ignored for parallel)
+    lanes = [2, 4]                 # lanes, for an architecture that takes them (stream)
     simulators = ["verilator"]     # icarus | verilator
-    harness = "chunk"              # chunk (long-run harness) | cycle (per-cycle testbench)
+    harness = "chunk"              # chunk (long-run harness) | cycle (per-cycle testbench);
+                                   # default chunk where the architecture has a long run
     steps = 200                    # steps per run
     scenes = ["coin"]              # scene runs (optional)
     seeds = { start = 0, stop = 8 }  # random and corner stimuli (optional; or a list)
     protocol_seeds = [0, 1]        # protocol scripts: stalls, clears at any position,
-                                   # colliding threshold writes (stream; per cycle)
+                                   # colliding threshold writes (stream: an architecture
+                                   # with protocol scripts; per cycle)
     code_coverage = false          # Verilator line and toggle coverage, merged (chunk)
 
 Its runs are the product (scenes, then seeds, then protocol seeds) x models x lanes x
@@ -44,7 +46,7 @@ from rvsm.model.fixed.point_toml import design_point_toml
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.model.scene.loaders import is_builtin, parse_size
-from rvsm.rtl.registry import ARCHITECTURES
+from rvsm.rtl.registry import ARCHITECTURES, DEFAULT_ARCHITECTURE, architectures_with
 from rvsm.sim.cosim import SIMULATORS
 from rvsm.sim.cosim.verify import HARNESSES
 from rvsm.sim.sweep.spec import parse_base_point, toml_tables
@@ -156,11 +158,12 @@ def parse_plan(text: str, source: str = "plan",
         size = parse_size(str(raw.get("size", f"{base.height}x{base.width}")))
     except RvsmError as exc:
         raise RvsmError(f"{source}: run.size: {exc}") from None
-    arch = raw.get("arch", "stream")
+    arch = raw.get("arch", DEFAULT_ARCHITECTURE)
     if arch not in ARCHITECTURES:
         raise RvsmError(f"{source}: run.arch must be one of {', '.join(ARCHITECTURES)}, "
                         f"got {arch!r}")
-    lanes = _list(raw, "lanes", 1, source) if arch == "stream" else [None]
+    a = ARCHITECTURES[arch]
+    lanes = _list(raw, "lanes", 1, source) if a.takes("lanes") else [None]
     for p in lanes:
         if p is not None and (isinstance(p, bool) or not isinstance(p, int) or p < 1
                               or size[1] % p):
@@ -171,10 +174,12 @@ def parse_plan(text: str, source: str = "plan",
         if s not in SIMULATORS:
             raise RvsmError(f"{source}: run.simulators: {s!r} is not one of "
                             f"{', '.join(SIMULATORS)}")
-    harness = raw.get("harness", "chunk" if arch == "stream" else "cycle")
-    if harness not in HARNESSES or (harness == "chunk" and arch != "stream"):
+    long_run = a.long_run_testbench is not None
+    harness = raw.get("harness", "chunk" if long_run else "cycle")
+    if harness not in HARNESSES or (harness == "chunk" and not long_run):
+        names = ", ".join(architectures_with(lambda x: x.long_run_testbench))
         raise RvsmError(f"{source}: run.harness must be one of {', '.join(HARNESSES)} "
-                        f"(chunk for the stream architecture only), got {harness!r}")
+                        f"(chunk for the {names} architecture only), got {harness!r}")
     steps = raw.get("steps", 100)
     if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
         raise RvsmError(f"{source}: run.steps must be an integer >= 1, got {steps!r}")
@@ -191,8 +196,9 @@ def parse_plan(text: str, source: str = "plan",
         raise RvsmError(f"{source}: run.code_coverage needs harness = \"chunk\" and "
                         "simulators = [\"verilator\"]")
     protocol = _seeds(raw.get("protocol_seeds"), source, "protocol_seeds")
-    if protocol and arch != "stream":
-        raise RvsmError(f"{source}: run.protocol_seeds drive the stream architecture only")
+    if protocol and a.protocol is None:
+        names = ", ".join(architectures_with(lambda x: x.protocol))
+        raise RvsmError(f"{source}: run.protocol_seeds drive the {names} architecture only")
     if not scenes and not seeds and not protocol:
         raise RvsmError(f"{source}: [run] needs scenes, seeds or protocol_seeds")
     runs = []

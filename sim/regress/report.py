@@ -5,8 +5,9 @@ Coverage bins, per scale, are those of :func:`rvsm.model.fixed.corner_stimulus.c
 (codes at 0 and full scale, exact threshold hits of both signs, both saturation rails,
 spikes of both signs, a clear mid-stream; measured on seed runs and on scene runs with
 the per-cycle testbench) and, for runs in the long-run harness, the lanes at the image
-borders (:class:`rvsm.rtl.stream.coverage.BorderCoverage`: ``top_lane<i>``, ...; a bin
-is named by its lane, so plans with several lane counts close each). Bins a contract
+borders (the beat stream's ``border_coverage``, ``rtl/stream/coverage.py``:
+``top_lane<i>``, ...; a bin is named by its lane, so plans with several lane counts
+close each). Bins a contract
 cannot reach (``None`` in every run) are left out of the closure.
 """
 

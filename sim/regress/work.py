@@ -49,29 +49,35 @@ class RegressionWork:
 
     def run(self) -> dict[str, Any]:
         """The run's record (never raises for a tool failure: ``status`` is ``"error"``)."""
+        from rvsm.model.fixed.point_toml import parse_design_point
+        from rvsm.rtl.registry import get_architecture
         from rvsm.sim.cosim.protocol_run import protocol_verify
+        from rvsm.sim.cosim.run_point import RunPoint
         from rvsm.sim.cosim.verify import random_verify, verify
 
         s = self.spec
         work = Path(self.work_dir)
-        point = work / "points" / f"{s.key}.toml"
-        point.parent.mkdir(parents=True, exist_ok=True)
-        write_text_atomic(point, s.point_toml)
+        path = work / "points" / f"{s.key}.toml"  # kept beside the run folders
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_text_atomic(path, s.point_toml)
         options: dict = {"lanes": s.lanes} if s.lanes else {}
         if s.code_coverage:
             options["code_coverage"] = True
         kind, _, what = s.stimulus.partition(":")
         t0 = time.perf_counter()
         try:
+            # parsed once here (the plan sized it), the architecture looked up once
+            point = RunPoint.of(parse_design_point(s.point_toml, str(path)), path)
+            arch = get_architecture(s.arch)
             if kind == "scene":
-                r = verify(scene_for(s), point, s.sim, steps=s.steps, size=s.size, work_dir=work,
-                           arch=s.arch, harness=s.harness, **options)
+                r = verify(scene_for(s), point, s.sim, steps=s.steps, work_dir=work,
+                           arch=arch, harness=s.harness, **options)
             elif kind == "protocol":
-                r = protocol_verify(point, int(what), s.steps, s.sim, size=s.size,
-                                    work_dir=work, lanes=s.lanes)
+                r = protocol_verify(point, int(what), s.steps, s.sim, work_dir=work,
+                                    lanes=s.lanes, arch=arch)
             else:
-                r = random_verify(point, int(what), s.steps, s.sim, size=s.size,
-                                  work_dir=work, arch=s.arch, harness=s.harness, **options)
+                r = random_verify(point, int(what), s.steps, s.sim, work_dir=work, arch=arch,
+                                  harness=s.harness, **options)
         except (ToolError, ToolFailure, RvsmError, OSError) as exc:
             return {"status": "error", "error": str(exc).splitlines()[0][:500],
                     "seconds": time.perf_counter() - t0}

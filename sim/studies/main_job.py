@@ -27,7 +27,7 @@ from rvsm.sim.kernel_cache import compile_float_engine
 DEMO_SCENE = "flyball"
 DEMO_MODELS = ("fsm", "dog4", "gauss4")
 # The flat RTL array is verified on a small window: Verilator builds grow with the array.
-#: The RTL check of the demo: the streaming array (rvsm.rtl.stream) at this size,
+#: The RTL check of the demo: the streaming array (rtl/stream) at this size,
 #: lanes and steps, spike for spike against the fixed twin.
 DEMO_RTL_SIZE = (64, 96)
 DEMO_RTL_LANES = 8

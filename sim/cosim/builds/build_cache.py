@@ -13,7 +13,10 @@ contract already generated for another build is reused; each run gets a fresh fo
 
 What is built for a contract (architecture, default top, Verilog writer, testbench) comes
 from the architecture registry (:mod:`rvsm.rtl.registry`) through one function,
-:func:`cosim_design`.
+:func:`cosim_design`; which testbench runs a build is the architecture's to say
+(:attr:`~rvsm.rtl.capabilities.Architecture.testbench`, or
+:attr:`~rvsm.rtl.capabilities.Architecture.long_run_testbench` inside the long-run
+harness).
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.ports import load_ports_json
-from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, get_architecture
+from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, architectures_with, get_architecture
 from rvsm.rtl.rtl_digest import rtl_digest
 from rvsm.rtl.toolchain import ToolFailure, run_tool
 from rvsm.rtl.verilog import GeneratedVerilog, write_outputs
@@ -46,7 +49,6 @@ from rvsm.sim.cosim.builds.cocotb_adapter import build_args, check_simulator, co
 from rvsm.sim.cosim.long_runs.chunk_harness import (
     HARNESS_TOP,
     HARNESS_VERSION,
-    LONG_RUN_TESTBENCHES,
     HarnessLayout,
     clock_inside,
     harness_verilog,
@@ -74,10 +76,16 @@ class CosimDesign:
     options: dict[str, int]
     top: str
 
-    @property
-    def testbench(self) -> str:
-        """The architecture's cocotb testbench module."""
-        return self.arch.testbench
+    def testbench(self, harness: bool = False) -> str:
+        """The architecture's cocotb testbench module: per cycle, or in the long-run
+        harness (``harness``; :class:`RvsmError` when it has none)."""
+        if not harness:
+            return self.arch.testbench
+        if self.arch.long_run_testbench is None:
+            names = architectures_with(lambda a: a.long_run_testbench)
+            raise RvsmError(f"the long-run harness drives {', '.join(names)} only, not the "
+                            f"{self.arch.name} architecture")
+        return self.arch.long_run_testbench
 
     def write(self, contract: ArrayContract, out: Path
               ) -> tuple[dict[str, Path], GeneratedVerilog]:
@@ -112,7 +120,7 @@ class SimBuild:
     cached: bool
     test_module: str
     waves: bool = False
-    arch: str = DEFAULT_ARCHITECTURE
+    arch: Architecture = field(default_factory=get_architecture)  # a registry value
     options: dict[str, int] = field(default_factory=dict)  # the architecture's options
     harness: bool = False  # built inside the long-run harness (:mod:`.chunk_harness`)
 
@@ -202,8 +210,9 @@ def build(
     already generated for another build is reused, not regenerated. ``arch`` and
     ``options`` (e.g. ``lanes=8``) name the architecture (:func:`cosim_design`).
     ``harness`` builds the array inside the long-run harness (:mod:`.chunk_harness`,
-    for architectures in :data:`~.chunk_harness.LONG_RUN_TESTBENCHES`), run by the
-    long-run testbench. Its dumps are the harness's own ``$dumpvars``: Icarus builds need
+    for an architecture with a
+    :attr:`~rvsm.rtl.capabilities.Architecture.long_run_testbench`), run by that
+    testbench. Its dumps are the harness's own ``$dumpvars``: Icarus builds need
     nothing for them; Verilator builds need ``waves`` (``--trace-fst``: 11 of the 18 MB
     of C++ at 250x400 with 40 lanes, so a long run builds without it and a failing one
     builds it for its waveform window). ``coverage`` (Verilator) builds line and toggle
@@ -212,9 +221,7 @@ def build(
     check_simulator(sim)
     design = cosim_design(arch, top, **options)
     top = design.top
-    if harness and design.arch.name not in LONG_RUN_TESTBENCHES:
-        raise RvsmError(f"the long-run harness drives {', '.join(LONG_RUN_TESTBENCHES)} "
-                        f"only, not the {design.arch.name} architecture")
+    design.testbench(harness)  # refuses the long-run harness without its testbench
     traced = waves or (sim == "icarus" and not harness)
     digest = design.digest(contract)
     if coverage and sim != "verilator":
@@ -345,10 +352,9 @@ def _cached(root: Path, sim: str, top: str, traced: bool, key: str,
             os.rename(root, stale)
         shutil.rmtree(stale, ignore_errors=True)
         return None
-    testbench = LONG_RUN_TESTBENCHES[design.arch.name] if harness else design.testbench
     return SimBuild(sim, root / "sim_build", top, root / f"{top}.v",
-                    meta["generate_seconds"], meta["build_seconds"], True, testbench,
-                    traced, design.arch.name, design.options, harness)
+                    meta["generate_seconds"], meta["build_seconds"], True,
+                    design.testbench(harness), traced, design.arch, design.options, harness)
 
 
 def _reuse_verilog(

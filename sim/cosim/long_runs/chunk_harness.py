@@ -52,12 +52,10 @@ import numpy as np
 from rvsm.model.infra.errors import ToolError
 
 __all__ = ["CLOCK_NS", "DEFAULT_DEPTH", "HARNESS_TOP", "HARNESS_VERSION",
-           "LONG_RUN_TESTBENCHES", "STAMP_BITS", "TAIL", "HarnessLayout", "clock_inside",
+           "STAMP_BITS", "TAIL", "HarnessLayout", "clock_inside",
            "decode_output_beats", "encode_input_beats", "encode_threshold_writes",
            "harness_verilog"]
 
-#: The long-run testbench of each architecture the harness drives.
-LONG_RUN_TESTBENCHES = {"stream": "rvsm.sim.cosim.testbenches.tb_stream_chunks"}
 #: Bump when the harness's Verilog changes (part of a harness build's cache key).
 HARNESS_VERSION = "3"
 #: Module name of the harness (the simulation's top level).

@@ -26,7 +26,8 @@ messages, in order:
   once read), ``("chunk_end", steps_done)``, ``("finish", ended, steps_done)``; sent as
   ``("batch", [...])``, one per output file (each message wakes the twin's process).
 
-The check is :class:`~rvsm.rtl.stream.schedule.StreamChecker`'s, in the same order as
+The check is the beat stream's checker (the architecture's
+:attr:`~rvsm.rtl.capabilities.BeatStream.checker`), in the same order as
 the beats were simulated, so a mismatch reports its step, scale, row, column and clock
 cycle exactly as before; after the first failing chunk (``stop_on_mismatch``) later
 output is ignored, so the counts are those of the run up to that chunk.
@@ -53,10 +54,8 @@ import numpy as np
 
 from rvsm.model.fixed.stimulus_chunks import open_stimulus_chunks
 from rvsm.model.infra.errors import ToolError
+from rvsm.rtl.capabilities import BeatStream
 from rvsm.rtl.ports import load_ports_json
-from rvsm.rtl.stream.coverage import BorderCoverage
-from rvsm.rtl.stream.drive import threshold_writes
-from rvsm.rtl.stream.schedule import OutputBeats, StreamChecker
 from rvsm.sim.cosim.long_runs.chunk_harness import (
     STAMP_BITS,
     HarnessLayout,
@@ -64,7 +63,7 @@ from rvsm.sim.cosim.long_runs.chunk_harness import (
     encode_input_beats,
     encode_threshold_writes,
 )
-from rvsm.sim.cosim.testbenches.tb_common import stream_geometry
+from rvsm.sim.cosim.testbenches.tb_common import beat_stream, stream_geometry
 
 __all__ = ["AHEAD", "TwinProcess", "connect", "decode_beats", "start_twin"]
 
@@ -140,9 +139,10 @@ def connect(address: str, key: str, timeout: float = 120.0) -> Connection:
             time.sleep(0.005)
 
 
-def decode_beats(text: bytes, layout: HarnessLayout, scales: int, lanes: int
-                 ) -> tuple[OutputBeats, np.ndarray, np.ndarray]:
-    """An output file's text as ``(OutputBeats, cycles (K,), unknown (K,) bool)``."""
+def decode_beats(text: bytes, layout: HarnessLayout, scales: int, lanes: int,
+                 beats: BeatStream) -> tuple[object, np.ndarray, np.ndarray]:
+    """An output file's text as ``(output beats, cycles (K,), unknown (K,) bool)``, the
+    beats of ``beats`` (:attr:`~rvsm.rtl.capabilities.BeatStream.output_beats`)."""
     bits, unknown = decode_output_beats(text, layout.out_bits + STAMP_BITS)
     fields = layout.fields
     cycles = _bits_value(bits, layout.out_bits, STAMP_BITS)
@@ -151,8 +151,9 @@ def decode_beats(text: bytes, layout: HarnessLayout, scales: int, lanes: int
     ne, _ = fields["neg"]
     spikes = (bits[:, po:po + npos].astype(np.int8)
               - bits[:, ne:ne + npos].astype(np.int8)).reshape(-1, scales, lanes)
-    got = OutputBeats(_bits_value(bits, *fields["row"]), _bits_value(bits, *fields["group"]),
-                      _bits_value(bits, *fields["last"]).astype(bool), spikes)
+    got = beats.output_beats(_bits_value(bits, *fields["row"]),
+                             _bits_value(bits, *fields["group"]),
+                             _bits_value(bits, *fields["last"]).astype(bool), spikes)
     return got, cycles, unknown
 
 
@@ -172,17 +173,18 @@ class _Twin:
         source = open_stimulus_chunks(cfg["source"])
         ports = load_ports_json(cfg["ports"])
         self.contract = c = source.contract
+        self.beats = beats = beat_stream(ports)
         self.geo = geo = stream_geometry(c, ports)
         self.sched = geo.schedule
         self.layout = HarnessLayout.from_ports(ports, int(cfg["depth"]))
         self._encode_beats = lambda beats: encode_input_beats(beats, c.adc_bits,
                                                               self.layout.in_bits)
-        self.checker = StreamChecker(self.sched)
-        self.border = BorderCoverage(c, geo.lanes)
+        self.checker = beats.checker(self.sched)
+        self.border = beats.border_coverage(c, geo.lanes)
         self.chunks: Iterator = source.chunks(int(cfg["chunk_steps"]))
         self.num_steps = source.num_steps
         flush = np.zeros((self.sched.lag, geo.lanes), dtype=np.uint16)
-        writes = threshold_writes(geo, source.thresholds)
+        writes = beats.threshold_writes(geo, source.thresholds)
         (self.dir / "thresholds.hex").write_bytes(encode_threshold_writes(
             writes, self.layout.widths["thr_addr"], self.layout.widths["thr_data"]))
         self.setup = {"thresholds": len(writes),
@@ -264,7 +266,7 @@ class _Twin:
         if self.failed_at is not None:
             return
         got, cycles, unknown = decode_beats(text, self.layout, self.contract.num_scales,
-                                            self.geo.lanes)
+                                            self.geo.lanes, self.beats)
         tc = time.perf_counter()
         if got.spikes.shape[0] != n_out:
             raise RuntimeError(f"harness wrote {got.spikes.shape[0]} output beats, counted "

@@ -1,8 +1,11 @@
-"""Long co-simulation runs: the streaming array in the long-run harness, chunk by chunk,
-in bounded memory, with a waveform window around the first mismatch.
+"""Long co-simulation runs: an array that streams (the streaming array) in the long-run
+harness, chunk by chunk, in bounded memory, with a waveform window around the first
+mismatch.
 
 :func:`check_chunks` builds (cached) the array inside :mod:`.chunk_harness` and runs the
-long-run testbench (:mod:`.tb_stream_chunks`) on a :class:`StimulusChunks`: the twin's
+long-run testbench (the architecture's
+:attr:`~rvsm.rtl.capabilities.Architecture.long_run_testbench`, :mod:`.tb_stream_chunks`
+for the streaming array) on a :class:`StimulusChunks`: the twin's
 codes and expectation are produced in the simulator's process a chunk at a time, so a
 one-second run (40,000 steps of 250x400) never holds more than a chunk. A progress bar
 follows the steps done.
@@ -26,6 +29,7 @@ import os
 import shutil
 import threading
 from pathlib import Path
+from typing import Any
 
 from rvsm.model.fixed.stimulus import save_stimulus
 from rvsm.model.fixed.stimulus_chunks import StimulusChunks
@@ -33,7 +37,6 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.progress import progress_bar
 from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, get_architecture
-from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.sim.cosim.builds.build_cache import SimBuild, build, new_run_dir
 from rvsm.sim.cosim.builds.code_coverage import read_coverage, summary
 from rvsm.sim.cosim.long_runs.chunk_harness import DEFAULT_DEPTH, clock_inside
@@ -48,7 +51,7 @@ DEFAULT_CHUNK_STEPS = 8
 WINDOW_AFTER = 64
 
 
-def window_cycles(geo: StreamGeometry) -> int:
+def window_cycles(geo: Any) -> int:
     """Cycles the waveform window reaches back before the first mismatch: two frames of
     beats plus the lag (each accumulator of the row is updated twice in it)."""
     return 2 * geo.beats_per_frame + geo.lag
@@ -148,7 +151,7 @@ def check_chunks(
     sb = build(source.contract, sim, root, arch=a, harness=True,
                waves=waves and sim == "verilator", coverage=code_coverage, **resolved)
     run_dir = new_run_dir(work, f"{name}-{sim}")
-    geo = StreamGeometry(source.contract, int(resolved["lanes"]))
+    geo = a.beats.geometry(source.contract, int(resolved["lanes"]))
     try:
         inputs = {**_source_inputs(source, run_dir, chunk_steps),
                   "RVSM_HARNESS_CLOCK": "inside" if clock_inside(sim) else "outside"}
@@ -178,8 +181,7 @@ def check_chunks(
     return result
 
 
-def _window(sb: SimBuild, inputs: dict, run_dir: Path, cycle: int,
-            geo: StreamGeometry) -> dict:
+def _window(sb: SimBuild, inputs: dict, run_dir: Path, cycle: int, geo: Any) -> dict:
     """Re-run up to the window's end with the dump on for the window only."""
     lo = max(0, cycle - window_cycles(geo))
     hi = cycle + WINDOW_AFTER

@@ -47,10 +47,7 @@ from rvsm.rtl.ip.drive import input_stream, threshold_chunks
 from rvsm.rtl.ip.model import run_stream_model
 from rvsm.rtl.ip.register_map import ip_register_map
 from rvsm.rtl.ports import load_ports_json
-from rvsm.rtl.stream.dimensions import StreamGeometry
-from rvsm.rtl.stream.drive import threshold_writes
-from rvsm.rtl.stream.schedule import OutputBeats, check_beats
-from rvsm.sim.cosim.testbenches.tb_common import CLOCK_NS, testbench_arg
+from rvsm.sim.cosim.testbenches.tb_common import CLOCK_NS, beat_stream, testbench_arg
 
 
 def _pauses(rng: random.Random, idle: float):  # noqa: ANN202 - a generator
@@ -113,7 +110,8 @@ async def axis_ip_matches_fixed_twin(dut: object) -> None:
         cfg = {"policy": "stall", "seed": 0, "idle_in": 0.0, "idle_out": 0.0}
     result_path = testbench_arg("result")
     c, timing, prov = stim.contract, ports["timing"], ports["provenance"]
-    geo = StreamGeometry(c, int(timing["lanes"]))
+    stream = beat_stream(ports)  # the streaming array's beats, inside the IP
+    geo = stream.geometry(c, int(timing["lanes"]))
     sched, depth = geo.schedule, int(timing["fifo_depth"])
     rm = ip_register_map(c, geo.lanes, depth, prov["rtl_digest"],
                          prov["design_point_digest"], prov["rvsm_version"])
@@ -150,7 +148,7 @@ async def axis_ip_matches_fixed_twin(dut: object) -> None:
     while await read("STATUS") & busy:
         await ClockCycles(dut.clk, 8)
     await write("THR_ADDR", 0)
-    words = threshold_writes(geo, stim.thresholds)
+    words = stream.threshold_writes(geo, stim.thresholds)
     for _, word in words:
         for reg, value in zip(rm.thr_data_registers(), threshold_chunks(rm, word),
                               strict=True):
@@ -213,7 +211,7 @@ async def axis_ip_matches_fixed_twin(dut: object) -> None:
         off, width = fields[name]
         return [(o[1] >> off) & ((1 << width) - 1) for o in out]
 
-    beats = OutputBeats.from_words(col("row"), col("group"), col("eof"), col("pos"),
+    beats = stream.output_beats.from_words(col("row"), col("group"), col("eof"), col("pos"),
                                    col("neg"), c.num_scales, geo.lanes)
     counters = {name: await read(name) for name in ("IN_BEATS", "OUT_BEATS", "DROPPED")}
     status = await read("STATUS")
@@ -255,7 +253,7 @@ async def axis_ip_matches_fixed_twin(dut: object) -> None:
         result["first_mismatch"] = listed[0] if listed else None
         result["dropped"] = len(model.dropped)
     else:
-        result = check_beats(sched, expected, beats)
+        result = stream.check_beats(sched, expected, beats)
         result["dropped"] = counters["DROPPED"]
         for name, want in (("DROPPED", 0), ("OUT_BEATS", len(all_exp)),
                            ("IN_BEATS", n_in)):

@@ -1,16 +1,19 @@
 """What the cocotb testbenches (:mod:`.tb_parallel`, :mod:`.tb_stream`) share: their inputs,
-reading logic vectors with X/Z, and the clock-and-reset sequence."""
+reading logic vectors with X/Z, the clock-and-reset sequence, and the beat stream of the
+build's architecture (from the registry, by the name its port map records)."""
 
 from __future__ import annotations
 
 import os
+from typing import Any
 
 import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge
 
 from rvsm.model.fixed.contract import ArrayContract
-from rvsm.rtl.stream.dimensions import StreamGeometry
+from rvsm.rtl.capabilities import BeatStream
+from rvsm.rtl.registry import get_architecture
 
 #: Clock period of both testbenches (ns); inputs are driven on the falling edge.
 CLOCK_NS = 10
@@ -50,10 +53,19 @@ async def clock_and_reset(dut: object, idle: tuple[str, ...], clock: bool = True
     dut.rst.value = 0  # type: ignore[attr-defined]
 
 
-def stream_geometry(contract: ArrayContract, ports: dict) -> StreamGeometry:
-    """The streaming array's geometry for ``contract`` with the lanes of the build's port
+def beat_stream(ports: dict) -> BeatStream:
+    """The :class:`~rvsm.rtl.capabilities.BeatStream` of the architecture that made the
+    build whose port map is ``ports`` (its ``arch``, looked up in the registry)."""
+    arch = get_architecture(ports["arch"])
+    if arch.beats is None:
+        raise RuntimeError(f"the {arch.name} architecture does not stream beats")
+    return arch.beats
+
+
+def stream_geometry(contract: ArrayContract, ports: dict) -> Any:
+    """The beat stream's geometry for ``contract`` with the lanes of the build's port
     map ``ports``; refuses a build whose timing is not this contract's."""
-    geo = StreamGeometry(contract, int(ports["timing"]["lanes"]))
+    geo = beat_stream(ports).geometry(contract, int(ports["timing"]["lanes"]))
     if geo.timing() != ports["timing"]:
         raise RuntimeError(f"the build's timing {ports['timing']} is not this contract's "
                            f"{geo.timing()}")

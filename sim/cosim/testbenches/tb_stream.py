@@ -10,8 +10,9 @@ cocotb runs everything from Python, one clock cycle at a time (inputs driven on 
 falling edge): reset; every threshold word through ``thr``; then per segment between
 clears (:meth:`StreamSchedule.segments`) the frames as back-to-back beats, the ``lag``
 flush beats, one idle cycle and one ``clear`` cycle. Every cycle with ``spikes_valid``
-high records one output beat; at the end :func:`~rvsm.rtl.stream.schedule.check_beats`
-(the schedule model's checker) compares positions and spikes with the expectation. The
+high records one output beat; at the end the beat stream's ``check_beats`` (the
+schedule model's checker, :class:`~rvsm.rtl.capabilities.BeatStream` of the build's
+architecture) compares positions and spikes with the expectation. The
 per-cycle Python is a few handle accesses on vectors of a few hundred bits; the result
 reports ``cycles_per_second`` to show whether it or the simulator dominates.
 """
@@ -28,9 +29,8 @@ from cocotb.triggers import FallingEdge
 
 from rvsm.model.fixed.stimulus import load_stimulus
 from rvsm.rtl.ports import load_ports_json
-from rvsm.rtl.stream.drive import threshold_writes
-from rvsm.rtl.stream.schedule import OutputBeats, check_beats, pack_lanes
 from rvsm.sim.cosim.testbenches.tb_common import (
+    beat_stream,
     clock_and_reset,
     logic_bits,
     stream_geometry,
@@ -48,6 +48,7 @@ async def stream_matches_fixed_twin(dut: object) -> None:
     codes = stim.codes.astype(np.int64)
     expected = stim.spikes
     steps, scales, height, width = expected.shape
+    stream = beat_stream(ports)
     geo = stream_geometry(c, ports)
     lanes = geo.lanes
     sched = geo.schedule
@@ -65,7 +66,7 @@ async def stream_matches_fixed_twin(dut: object) -> None:
     t0 = time.perf_counter()
     cycles = 0
     d["thr_we"].value = 1
-    for addr, word in threshold_writes(geo, stim.thresholds):
+    for addr, word in stream.threshold_writes(geo, stim.thresholds):
         d["thr_addr"].value = addr
         d["thr_data"].value = word
         await FallingEdge(clk)
@@ -94,7 +95,7 @@ async def stream_matches_fixed_twin(dut: object) -> None:
             cycles += 1
             record()
             d["clear"].value = 0
-        beats = pack_lanes(sched.input_beats(codes[a:b]), c.adc_bits)
+        beats = stream.pack_lanes(sched.input_beats(codes[a:b]), c.adc_bits)
         d["codes_valid"].value = 1
         for word in beats:
             in_payload.value = word
@@ -107,9 +108,9 @@ async def stream_matches_fixed_twin(dut: object) -> None:
         record()
     stream_seconds = time.perf_counter() - t0
 
-    out = OutputBeats.from_words(got["row"], got["group"], got["last"], got["pos"],
-                                 got["neg"], scales, lanes)
-    result = check_beats(sched, expected, out)
+    out = stream.output_beats.from_words(got["row"], got["group"], got["last"], got["pos"],
+                                         got["neg"], scales, lanes)
+    result = stream.check_beats(sched, expected, out)
     if x_beats:
         result["mismatches"] += len(x_beats)
         result["mismatch_list"].insert(0, {"beat": x_beats[0],

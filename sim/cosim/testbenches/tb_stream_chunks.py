@@ -16,7 +16,8 @@ The twin's process makes each chunk's input beats as a ``$readmemh`` file; per c
 the testbench moves the file to ``chunk_in.hex``, pulses ``start`` and awaits ``done``:
 one trigger, while the simulator runs every beat of the chunk. It then moves
 ``chunk_out.hex`` aside and hands it to the twin's process, which decodes and checks it
-(:class:`~rvsm.rtl.stream.schedule.StreamChecker`) while the simulator runs the next
+(the beat stream's checker, :attr:`~rvsm.rtl.capabilities.BeatStream.checker`) while
+the simulator runs the next
 chunk. Before a clear it flushes the stream with ``lag`` zero beats and pulses
 ``clear``. The thresholds are written first, by the harness (``thr_load``: the twin's
 ``thresholds.hex``, one word per cycle). Memory stays

@@ -1,7 +1,8 @@
 """cocotb 2.x testbench: the streaming array driven by a protocol script, cycle by cycle.
 
 Inputs (environment, or ``+rvsm_<name>=`` plusargs): ``RVSM_SCRIPT`` -- a protocol
-script (:mod:`rvsm.rtl.stream.protocol`: per cycle ``codes`` valid and payload,
+script (the architecture's :class:`~rvsm.rtl.capabilities.ProtocolScripts`,
+``rtl/stream/protocol.py``: per cycle ``codes`` valid and payload,
 ``clear``, a threshold write; the expected output beats and the cycle of each);
 ``RVSM_PORTS`` -- the build's ``<top>.ports.json``; ``RVSM_RESULT`` -- where the JSON
 result goes.
@@ -9,7 +10,7 @@ result goes.
 After reset, every cycle of the script is driven on the falling edge before its rising
 edge (handles written only when their value changes); after each rising edge a
 ``spikes_valid`` cycle records one output beat and the edge it followed.
-:func:`~rvsm.rtl.stream.protocol.check_script` then compares count, order, positions,
+The scripts' ``check`` then compares count, order, positions,
 ``last``, spikes and the cycle of every beat: stalls, clears at any position of a frame
 and threshold writes colliding with reads are checked against the documented rules,
 not only the spikes of a plain stream.
@@ -26,10 +27,10 @@ from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
 from rvsm.rtl.ports import load_ports_json
-from rvsm.rtl.stream.protocol import check_script, load_script
-from rvsm.rtl.stream.schedule import OutputBeats
+from rvsm.rtl.registry import get_architecture
 from rvsm.sim.cosim.testbenches.tb_common import (
     CLOCK_NS,
+    beat_stream,
     clock_and_reset,
     logic_bits,
     stream_geometry,
@@ -40,8 +41,11 @@ from rvsm.sim.cosim.testbenches.tb_common import (
 @cocotb.test()
 async def stream_follows_protocol_script(dut: object) -> None:
     """Drive every cycle of the script; compare every output beat and its cycle."""
-    script = load_script(testbench_arg("script"))
     ports = load_ports_json(testbench_arg("ports"))
+    scripts = get_architecture(ports["arch"]).protocol
+    if scripts is None:
+        raise RuntimeError(f"the {ports['arch']} architecture has no protocol scripts")
+    script = scripts.load(testbench_arg("script"))
     result_path = testbench_arg("result")
     c = script.contract
     geo = stream_geometry(c, ports)
@@ -79,9 +83,10 @@ async def stream_follows_protocol_script(dut: object) -> None:
                 got[name].append((value >> off) & ((1 << width) - 1))
             cycles.append(cyc)
     seconds = time.perf_counter() - t0
-    beats = OutputBeats.from_words(got["row"], got["group"], got["last"], got["pos"],
-                                   got["neg"], c.num_scales, geo.lanes)
-    result = check_script(script, beats, cycles)
+    beats = beat_stream(ports).output_beats.from_words(
+        got["row"], got["group"], got["last"], got["pos"], got["neg"], c.num_scales,
+        geo.lanes)
+    result = scripts.check(script, beats, cycles)
     if x_beats:
         result["mismatches"] += len(x_beats)
         result["mismatch_list"].insert(0, {"beat": x_beats[0], "cycle": cycles[x_beats[0]],
