@@ -66,8 +66,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fixed", metavar="POINT.toml",
                    help="run the bit-accurate fixed-point twin of this design point instead")
     p.add_argument("-o", "--output", required=True, help="output spike file (.h5 or .npz)")
-    p.add_argument("--dat", metavar="FILE.dat", help="also export FSM spikes as camera .dat")
-    p.add_argument("--flip", action="store_true", help="flip vertically in the .dat file")
+    p.add_argument("--dat", metavar="FILE.dat", help="also export FSM spikes as camera .dat "
+                   "(rows bottom-up, as the camera writes them and SpikeCV reads them)")
+    p.add_argument("--flip", action="store_true", help="write the .dat file's rows top-down")
     add_engine_arguments(p)
     add_force_argument(p)
     p.set_defaults(func=run_simulate)
@@ -93,13 +94,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     q = dat_sub.add_parser("export", help=".h5 / .npz (FSM) -> .dat (streamed)")
     q.add_argument("spikes", help=".h5 or .npz spike file")
     q.add_argument("-o", "--output", required=True, help="output .dat")
-    q.add_argument("--flip", action="store_true", help="flip vertically (camera row order)")
+    q.add_argument("--flip", action="store_true", help="rows top-down in the .dat file "
+                   "(default: bottom-up, the camera's order, which SpikeCV reads)")
     add_force_argument(q)
     q.set_defaults(func=run_dat_export)
     q = dat_sub.add_parser("import", help=".dat -> .h5 (streamed) or .npz")
     q.add_argument("dat", help="camera .dat file")
     q.add_argument("--size", required=True, metavar="HxW", help="sensor size, e.g. 250x400")
-    q.add_argument("--flip", action="store_true", help="flip vertically (camera row order)")
+    q.add_argument("--flip", action="store_true", help="rows top-down in the .dat file "
+                   "(default: bottom-up, the camera's order, which SpikeCV reads)")
     q.add_argument("-o", "--output", required=True, help="output .h5 or .npz")
     add_force_argument(q)
     q.set_defaults(func=run_dat_import)
