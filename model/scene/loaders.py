@@ -9,7 +9,8 @@ scene never sits in memory whole:
   brightness as-is (no rescaling); memory-mapped, checked chunk by chunk;
 - image folder: the image files sorted by name, decoded per range; colour is converted
   to grey with the ITU-R 601 luminance (``skimage.color.rgb2gray``) and scaled to 0..255
-  (16-bit images are scaled by 255/65535, float images in [0, 1] by 255);
+  (16-bit images are scaled by 255/65535 at full precision, and the scene's ``notes``
+  say so; float images in [0, 1] by 255);
 - video or animated / multi-page image: decoded in order through ``imageio.v3.imiter``
   (videos need a plugin: ``pip install imageio[ffmpeg]``); a range before the reader's
   position restarts the decoding from the first frame.
@@ -161,6 +162,9 @@ def load_scene(
             f"{path}: unknown scene file type {suffix or '(none)'!r}; use a .npy array, an "
             f"image folder or a video ({', '.join(VIDEO_SUFFIXES[:4])} ...)"
         )
+    notes = tuple(getattr(frames, "notes", ()))
     frames = _fit_size(frames, num_frames, size, str(path))
     name = path.stem if path.suffix else path.name
-    return Scene(name, frames, steps_per_frame, hold, source=text)
+    scene = Scene(name, frames, steps_per_frame, hold, source=text)
+    object.__setattr__(scene, "notes", notes)
+    return scene

@@ -12,7 +12,9 @@ Ground truth for step ``t`` is ``I_t``. A scene's frames come from a
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
+from typing import ClassVar
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -44,6 +46,8 @@ class Scene:
     steps_per_frame: int = DEFAULT_STEPS_PER_FRAME
     hold: bool = False
     source: str | None = None
+    #: what a command says about how the frames were read (16-bit images), one line each
+    notes: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, name: str, frames: np.ndarray | FrameSource,
                  steps_per_frame: int = DEFAULT_STEPS_PER_FRAME, hold: bool = False,
@@ -57,7 +61,8 @@ class Scene:
             raise RvsmError(f"steps_per_frame must be an integer >= 1, got {m!r}")
         if not hold and frames.shape[0] < 2:
             raise RvsmError(
-                f"{name}: linear interpolation needs at least 2 frames, got 1; "
+                f"{name if source is None else source}: linear interpolation needs at "
+                "least 2 frames, got 1; "
                 "use --hold for a still image"
             )
         for key, value in (("name", name), ("frame_source", frames),
@@ -141,21 +146,52 @@ class Scene:
         for t0 in range(0, self.num_steps, block_steps):
             yield t0, min(t0 + block_steps, self.num_steps)
 
+    def digest(self) -> str | None:
+        """The content digest of :attr:`source`
+        (:func:`rvsm.model.scene.digest.scene_digest`: ``builtin:<name>`` or
+        ``sha256:...`` of the file or folder), computed once; ``None`` for a scene made in
+        code."""
+        if self.source is None:
+            return None
+        cached = self.__dict__.get("_digest")
+        if cached is None:
+            from rvsm.model.scene.digest import scene_digest
+
+            cached = scene_digest(self.source)
+            object.__setattr__(self, "_digest", cached)
+        return cached
+
     def meta(self) -> dict:
         """What it takes to load this scene again: goes into spike files' ``meta``.
 
-        ``scene_arg`` (the source, else the name), ``height``, ``width``, ``num_frames``,
-        ``steps_per_frame`` and ``hold``.
+        ``scene_arg`` (a built-in name, a scene file's or folder's absolute path, else the
+        name), ``scene_digest`` (:meth:`digest`, when the scene has a source),
+        ``height``, ``width``, ``num_frames``, ``steps_per_frame`` and ``hold``.
         """
         h, w = self.shape
-        return {
-            "scene_arg": self.source if self.source is not None else self.name,
+        out = {
+            "scene_arg": self._stored_source(),
             "height": h,
             "width": w,
             "num_frames": self.num_frames,
             "steps_per_frame": self.steps_per_frame,
             "hold": self.hold,
         }
+        digest = self.digest()
+        if digest is not None:
+            out["scene_digest"] = digest
+        return out
+
+    def _stored_source(self) -> str:
+        """:attr:`source` as a file's meta keeps it: a path made absolute (the file is read
+        from other folders), a built-in name as it is; the name without a source."""
+        if self.source is None:
+            return self.name
+        from rvsm.model.scene.loaders import is_builtin
+
+        if is_builtin(self.source):
+            return self.source
+        return os.path.abspath(os.path.expanduser(self.source))
 
 
 def interpolate(stack: np.ndarray, f: np.ndarray, a: np.ndarray) -> np.ndarray:

@@ -87,6 +87,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--match", default="gain", choices=MATCH_MODES,
                    help="brightness matching before scoring")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--force", action="store_true", help="score against SCENE even when its "
+                   "content digest differs from the one the file was made from")
     p.set_defaults(func=run_evaluate)
 
     p = sub.add_parser("dat", help="convert FSM spikes to/from the camera's .dat layout")
