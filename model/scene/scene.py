@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterator
-from typing import ClassVar
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
