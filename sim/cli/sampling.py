@@ -226,17 +226,30 @@ def _check_sensor_options(args: argparse.Namespace) -> None:
     """Refuse options of the other sensor (exit 2)."""
     if args.sensor == "dvs":
         given = [f"--{n.replace('_', '-')}" for n in ("phi", "scale_phi", "reset",
-                                                       "thresholds", "fixed", "dat")
+                                                       "thresholds")
                  if getattr(args, n) is not None]
         if given:
-            raise RvsmError(f"{', '.join(given)} do(es) not apply to --sensor dvs (its "
-                            "thresholds are --contrast / --scale-contrast; the fixed-point "
-                            "event twin is not built yet)")
+            raise RvsmError(f"{', '.join(given)} {_verb(given, 'is', 'are')} the spike "
+                            "camera's; --sensor dvs takes its thresholds from --contrast or "
+                            "--scale-contrast")
+        if args.fixed is not None:
+            raise RvsmError("--fixed takes the sensor from the design point ([array] "
+                            "sensor = \"dvs\", written by rvsm config new --sensor dvs); "
+                            "drop --sensor dvs")
+        if args.dat is not None:
+            raise RvsmError("--dat writes the spike camera's one-bit .dat and events have "
+                            "two polarities (ON/OFF); write events with rvsm events export "
+                            "(HDF5 event list, AEDAT4, EVT or CSV)")
     else:
         given = [f"--{n.replace('_', '-')}" for n in ("contrast", "scale_contrast")
                  if getattr(args, n) is not None]
         if given:
-            raise RvsmError(f"{', '.join(given)} apply to --sensor dvs only")
+            raise RvsmError(f"{' and '.join(given)} {_verb(given, 'applies', 'apply')} "
+                            "only to --sensor dvs")
+
+
+def _verb(options: list[str], one: str, several: str) -> str:
+    return one if len(options) == 1 else several
 
 
 def _event_config(args: argparse.Namespace) -> EventConfig:
