@@ -189,7 +189,7 @@ def run_claims(args: argparse.Namespace) -> int:
     result = ec.run_event_claims(scored_size(args.size), ks, args.steps, seed=args.seed,
                                  progress=not args.quiet)
     out = Path(args.output)
-    lines = ec.verdict_lines(result)
+    lines = ec.verdict_table(result)
     write_text_atomic(out / "claims.csv", ec.claims_csv(result))
     write_text_atomic(out / "claims.json", json.dumps(asdict(result), indent=1) + "\n")
     save_figure(ec.claims_figure(result), out / "noise.png")
