@@ -36,6 +36,16 @@ def inputs(tmp_path_factory) -> dict[str, Path]:
     assert main(["config", "new", "--sensor", "dvs", "--size", "16x16",
                  "-o", str(files["dvs_point"])]) == 0
     assert main(["events", "export", str(files["events"]), "-o", str(files["list"])]) == 0
+    files["dsec"] = d / "dsec.h5"  # two events of one pixel in one 25 us step
+    with h5py.File(files["dsec"], "w") as f:
+        f["events/t"] = np.array([0, 30, 40], np.uint32)
+        f["events/x"], f["events/y"] = np.array([1, 2, 2], np.uint16), np.zeros(3, np.uint16)
+        f["events/p"] = np.array([1, 0, 1], np.uint8)
+    files["list_one"] = d / "one.h5"
+    assert main(["events", "export", str(files["events"]), "--scale", "1",
+                 "-o", str(files["list_one"])]) == 0
+    files["reversed"] = d / "reversed.npy"
+    np.save(files["reversed"], np.zeros((3, 16, 16)))
     return files
 
 
@@ -63,10 +73,27 @@ def _cases(i: dict[str, Path]) -> list[tuple[str, list[str]]]:
         ("events export of spikes", ["events", "export", str(i["fsm"]), "-o", "l.h5"]),
         ("events import of spikes", ["events", "import", str(i["fsm"]), "-o", "new/e.h5"]),
         ("events claims, bad --steps", ["events", "claims", "--steps", "1", "-o", "new"]),
+        # events export: every format, refused after -o was checked
+        ("events export AEDAT4 of four scales", ["events", "export", str(i["events"]),
+                                                 "-o", "new/s.aedat4"]),
+        ("events export, no such scale", ["events", "export", str(i["events"]),
+                                          "--scale", "7", "-o", "l.h5"]),
+        ("events export, another scene", ["events", "export", str(i["events"]), "--scene",
+                                          str(i["reversed"]), "-o", "new/l.h5"]),
+        ("events export CSV, no such scale", ["events", "export", str(i["events"]),
+                                              "--scale", "2", "-o", "s.csv"]),
+        # a refusal in the middle of writing: the partial file and its new folder go
+        ("events import, a DSEC step that cannot hold two events",
+         ["events", "import", str(i["dsec"]), "-o", "new/deep/e.h5"]),
+        ("events import of one scale", ["events", "import", str(i["list_one"]),
+                                        "-o", "e.npz"]),
+        ("evaluate, another scene", ["evaluate", str(i["fsm"]), str(i["reversed"])]),
+        ("robustness, bad --steps", ["robustness", "--steps", "0", "-o", "new"]),
+        ("robustness, bad --ks", ["robustness", "--ks", "1,x", "-o", "new"]),
     ]
 
 
-@pytest.mark.parametrize("index", range(12))
+@pytest.mark.parametrize("index", range(21))
 def test_a_refused_run_leaves_nothing(tmp_path, monkeypatch, inputs, capsys, index):
     name, argv = _cases(inputs)[index]
     work = tmp_path / "work"
@@ -101,3 +128,15 @@ def test_an_existing_output_survives_a_refused_rerun(tmp_path, monkeypatch, inpu
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
     with h5py.File(tmp_path / "s.h5") as f:
         assert np.asarray(f.attrs["shape"])[1] == 1  # still the FSM run's file
+
+
+def test_blosc_without_hdf5plugin_is_an_environment_failure(tmp_path, monkeypatch, inputs,
+                                                            capsys):
+    """--compression blosc without hdf5plugin: exit 3 naming the package, nothing left."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setitem(__import__("sys").modules, "hdf5plugin", None)  # not importable
+    code = main(["events", "export", str(inputs["events"]), "--compression", "blosc",
+                 "-o", "l.h5"])
+    err = capsys.readouterr().err
+    assert code == 3 and "pip install hdf5plugin" in err and "gzip" in err
+    assert list(tmp_path.iterdir()) == []
