@@ -35,6 +35,10 @@ import numpy as np
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.frames import CHUNK_BYTES, ContentCheck, check_layout
 
+#: File suffixes read as images (an image folder's frames, a single image).
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".gif", ".webp", ".pgm",
+                  ".ppm")
+
 
 def to_grey(img: np.ndarray, source: str) -> np.ndarray:
     """One image (H, W) / (H, W, C) of any dtype as grey ``(H, W) float64`` in 0..255."""

@@ -23,18 +23,18 @@ Every user-fixable problem raises :class:`RvsmError` with a one-line message.
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.scene.file_frames import DecodedStream, ImageFiles, NpyFrames
+from rvsm.model.scene.digest import scene_digest
+from rvsm.model.scene.file_frames import IMAGE_SUFFIXES, DecodedStream, ImageFiles, NpyFrames
 from rvsm.model.scene.frames import FrameSource, FrameWindow
 from rvsm.model.scene.library import SCENE_NAMES, builtin_scene
 from rvsm.model.scene.scene import DEFAULT_STEPS_PER_FRAME, Scene
 
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".gif", ".webp", ".pgm",
-                  ".ppm")
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mov", ".mkv", ".webm", ".m4v", ".mpg", ".mpeg", ".wmv")
 
 _SIZE_RE = re.compile(r"^\s*(\d+)\s*[xX*,]\s*(\d+)\s*$")
@@ -165,6 +165,7 @@ def load_scene(
     notes = tuple(getattr(frames, "notes", ()))
     frames = _fit_size(frames, num_frames, size, str(path))
     name = path.stem if path.suffix else path.name
-    scene = Scene(name, frames, steps_per_frame, hold, source=text)
+    scene = Scene(name, frames, steps_per_frame, hold, source=text).describe_source(
+        os.path.abspath(path), functools.partial(scene_digest, path))
     object.__setattr__(scene, "notes", notes)
     return scene

@@ -12,8 +12,7 @@ Ground truth for step ``t`` is ``I_t``. A scene's frames come from a
 
 from __future__ import annotations
 
-import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -149,17 +148,21 @@ class Scene:
     def digest(self) -> str | None:
         """The content digest of :attr:`source`
         (:func:`rvsm.model.scene.digest.scene_digest`: ``builtin:<name>`` or
-        ``sha256:...`` of the file or folder), computed once; ``None`` for a scene made in
-        code."""
-        if self.source is None:
-            return None
-        cached = self.__dict__.get("_digest")
-        if cached is None:
-            from rvsm.model.scene.digest import scene_digest
+        ``sha256:...`` of the file or folder), computed once, when the loader that made
+        the scene gave one (:meth:`describe_source`); ``None`` for a scene made in code."""
+        digest = self.__dict__.get("_digest")
+        if callable(digest):
+            digest = digest()
+            object.__setattr__(self, "_digest", digest)
+        return digest
 
-            cached = scene_digest(self.source)
-            object.__setattr__(self, "_digest", cached)
-        return cached
+    def describe_source(self, stored: str, digest: str | Callable[[], str]) -> Scene:
+        """Set what a file's meta keeps of the source: ``stored`` (a built-in name, a
+        file's absolute path) and its ``digest`` (or a function computing it on first
+        use); returns the scene. Called by the loaders, which know what the source is."""
+        object.__setattr__(self, "_stored_source", stored)
+        object.__setattr__(self, "_digest", digest)
+        return self
 
     def meta(self) -> dict:
         """What it takes to load this scene again: goes into spike files' ``meta``.
@@ -170,7 +173,8 @@ class Scene:
         """
         h, w = self.shape
         out = {
-            "scene_arg": self._stored_source(),
+            "scene_arg": self.__dict__.get("_stored_source",
+                                           self.name if self.source is None else self.source),
             "height": h,
             "width": w,
             "num_frames": self.num_frames,
@@ -181,18 +185,6 @@ class Scene:
         if digest is not None:
             out["scene_digest"] = digest
         return out
-
-    def _stored_source(self) -> str:
-        """:attr:`source` as a file's meta keeps it: a path made absolute (the file is read
-        from other folders), a built-in name as it is; the name without a source."""
-        if self.source is None:
-            return self.name
-        from rvsm.model.scene.loaders import is_builtin
-
-        if is_builtin(self.source):
-            return self.source
-        return os.path.abspath(os.path.expanduser(self.source))
-
 
 def interpolate(stack: np.ndarray, f: np.ndarray, a: np.ndarray) -> np.ndarray:
     """``(1 - a) stack[f] + a stack[f+1]`` along axis 0, exactly as SPEC section 1 writes it.
