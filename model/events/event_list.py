@@ -273,7 +273,9 @@ def open_event_list(path: str | os.PathLike) -> SpikeSource:
             return v.decode() if isinstance(v, bytes | np.bytes_) else str(v)
 
         if text("format") != EVENT_LIST_FORMAT:
-            raise RvsmError(f"{p} is not an rvsm event list (format {text('format')!r})")
+            raise RvsmError(f"{p} is not an rvsm event list (format {text('format')!r}) nor "
+                            "in DSEC's layout (events/t, x, y, p), which rvsm events import "
+                            "also reads")
         if "selected_scale" in attrs:
             raise RvsmError(f"{p} holds scale {int(attrs['selected_scale'])} alone of the "
                             f"{int(attrs['sensor_num_scales'])} scales of its sensor "

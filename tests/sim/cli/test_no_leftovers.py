@@ -140,3 +140,15 @@ def test_blosc_without_hdf5plugin_is_an_environment_failure(tmp_path, monkeypatc
     err = capsys.readouterr().err
     assert code == 3 and "pip install hdf5plugin" in err and "gzip" in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_aedat4_without_faery_is_an_environment_failure(tmp_path, monkeypatch, inputs,
+                                                        capsys):
+    """An AEDAT4 export without faery: exit 3 naming the package, nothing left."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setitem(__import__("sys").modules, "faery", None)  # not importable
+    code = main(["events", "export", str(inputs["events"]), "--scale", "0",
+                 "-o", "s.aedat4"])
+    err = capsys.readouterr().err
+    assert code == 3 and "pip install faery" in err
+    assert list(tmp_path.iterdir()) == []
