@@ -25,6 +25,12 @@ class PartialFile:
 
     def __init__(self, target: str | os.PathLike) -> None:
         self.target = Path(target)
+        #: folders this file created, innermost first (removed again by an abort)
+        self._made: list[Path] = []
+        folder = self.target.parent
+        while not folder.exists() and folder != folder.parent:
+            self._made.append(folder)
+            folder = folder.parent
         try:
             self.target.parent.mkdir(parents=True, exist_ok=True)
             fd, tmp = tempfile.mkstemp(prefix=f".{self.target.stem}.",
@@ -47,9 +53,15 @@ class PartialFile:
         self.path = None
 
     def abort(self) -> None:
-        """Remove the temporary file (nothing happens after a commit)."""
+        """Remove the temporary file and the folders it created, when empty (nothing
+        happens after a commit)."""
         if self.path is not None:
             self.path.unlink(missing_ok=True)
+            for folder in self._made:
+                try:
+                    folder.rmdir()
+                except OSError:  # not empty (another output went there) or gone
+                    break
         self.path = None
 
 

@@ -14,7 +14,8 @@ import os
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.scene.loaders import IMAGE_SUFFIXES, is_builtin
+from rvsm.model.scene.file_frames import IMAGE_SUFFIXES
+from rvsm.model.scene.library import SCENE_NAMES
 
 __all__ = ["scene_digest"]
 
@@ -30,7 +31,7 @@ def _feed(digest: hashlib._Hash, path: Path) -> None:
 def scene_digest(scene: str | os.PathLike) -> str:
     """``builtin:<name>`` or ``sha256:<24 hex digits>`` of the file or folder's content;
     :class:`RvsmError` when the path cannot be read."""
-    if is_builtin(scene):
+    if os.fspath(scene) in SCENE_NAMES:  # a built-in scene (loaders.is_builtin)
         return f"builtin:{os.fspath(scene)}"
     path = Path(scene)
     digest = hashlib.sha256()

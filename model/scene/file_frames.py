@@ -15,6 +15,13 @@ equal image sizes, then NaN/infinity and negative brightness with the same one-l
 frames are then decoded again when a run reads them. Grey conversion (:func:`to_grey`):
 colour through the ITU-R 601 luminance (``skimage.color.rgb2gray``) scaled to 0..255,
 16-bit images scaled by 255/65535, float images in [0, 1] by 255.
+
+**16-bit images keep their precision**: the brightness is a float, so a 16-bit value
+``v`` becomes ``v * 255 / 65535`` in the model's 8-bit units, fractions kept (no rounding
+to 256 levels). Pillow, imageio's PNG reader, decodes a 16-bit *colour* PNG (or grey
+with alpha) to 8 bits; such files are decoded with ``pypng`` instead
+(:func:`read_raw_image`). A source made of 16-bit images says so in :attr:`notes`, which
+the command line prints.
 """
 
 from __future__ import annotations
@@ -27,6 +34,10 @@ import numpy as np
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.frames import CHUNK_BYTES, ContentCheck, check_layout
+
+#: File suffixes read as images (an image folder's frames, a single image).
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".gif", ".webp", ".pgm",
+                  ".ppm")
 
 
 def to_grey(img: np.ndarray, source: str) -> np.ndarray:
@@ -64,10 +75,43 @@ def _float_to_8bit(img: np.ndarray) -> np.ndarray:
     return img
 
 
-def read_image(path: Path) -> np.ndarray:
-    """One image file as grey ``(H, W) float64`` (the first page of a multi-page one)."""
+def png16_planes(path: Path) -> int:
+    """The planes of a 16-bit colour or grey-with-alpha PNG (2, 3 or 4), which Pillow
+    would decode to 8 bits; 0 for any other file."""
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(26)
+    except OSError:
+        return 0
+    if len(head) < 26 or not head.startswith(b"\x89PNG\r\n\x1a\n") or head[24] != 16:
+        return 0
+    return {2: 3, 4: 2, 6: 4}.get(head[25], 0)
+
+
+def _read_png16(path: Path, planes: int) -> np.ndarray:
+    """A 16-bit colour PNG as ``(H, W, planes) uint16``, through ``pypng``."""
+    try:
+        import png
+    except ImportError:  # pragma: no cover - a declared dependency
+        raise RvsmError(f"{path}: a 16-bit colour PNG needs pypng (pip install pypng); "
+                        "Pillow would read it as 8-bit") from None
+    try:
+        width, height, rows, _ = png.Reader(filename=str(path)).asDirect()
+        img = np.vstack([np.asarray(row, dtype=np.uint16) for row in rows])
+    except Exception as exc:  # noqa: BLE001 - any decoder failure is a bad file
+        raise RvsmError(f"{path}: cannot read image ({type(exc).__name__}); "
+                        "use PNG/JPEG/TIFF files") from None
+    return img.reshape(height, width, planes)
+
+
+def read_raw_image(path: Path) -> np.ndarray:
+    """One image file's pixels as decoded (any dtype; the first page of a multi-page one):
+    16-bit colour PNGs at 16 bits (:func:`png16_planes`), the rest through imageio."""
     import imageio.v3 as iio
 
+    planes = png16_planes(path)
+    if planes:
+        return _read_png16(path, planes)
     try:
         with warnings.catch_warnings():  # imageio's plugin probing warns on bad files
             warnings.simplefilter("ignore")
@@ -77,7 +121,20 @@ def read_image(path: Path) -> np.ndarray:
                         "use PNG/JPEG/TIFF files") from None
     if img.ndim == 4 or (img.ndim == 3 and img.shape[-1] not in (1, 2, 3, 4)):
         img = img[0]  # multi-page / animated: first page
-    return to_grey(img, str(path))
+    return img
+
+
+def read_image(path: Path) -> np.ndarray:
+    """One image file as grey ``(H, W) float64`` (the first page of a multi-page one)."""
+    return to_grey(read_raw_image(path), str(path))
+
+
+def depth_note(dtype: np.dtype, source: str) -> tuple[str, ...]:
+    """The note a source of images of ``dtype`` gives (16-bit: how they are read)."""
+    if np.dtype(dtype) != np.uint16:
+        return ()
+    return (f"{source}: 16-bit images, read at full precision: brightness = value x "
+            "255/65535 in the model's 8-bit units, fractions kept",)
 
 
 def _frames_per_chunk(frame_shape: tuple[int, int, int], itemsize: int) -> int:
@@ -140,7 +197,10 @@ class ImageFiles:
 
     def __init__(self, files: Sequence[Path], folder: Path) -> None:
         self.files = list(files)
-        first = read_image(self.files[0])
+        raw = read_raw_image(self.files[0])
+        #: what the command line says about these frames (16-bit images)
+        self.notes = depth_note(raw.dtype, str(folder))
+        first = to_grey(raw, str(self.files[0]))
         check = ContentCheck(str(folder))
         check.update(first)
         for f in self.files[1:]:
@@ -187,7 +247,9 @@ class DecodedStream:
         check = ContentCheck(str(self.path))
         shape: tuple[int, ...] | None = None
         count = 0
-        for frame in self._frames():
+        #: what the command line says about these frames (16-bit images)
+        self.notes: tuple[str, ...] = ()
+        for frame in self._frames(first_dtype=True):
             if shape is None:
                 shape = frame.shape
             elif frame.shape != shape:
@@ -210,14 +272,24 @@ class DecodedStream:
         """``(F, H, W)``."""
         return self._shape  # type: ignore[return-value]
 
-    def _frames(self) -> Iterator[np.ndarray]:
-        """Every frame of the file as grey ``(H, W) float64``; one-line errors."""
+    def _frames(self, first_dtype: bool = False) -> Iterator[np.ndarray]:
+        """Every frame of the file as grey ``(H, W) float64``; one-line errors. With
+        ``first_dtype``, the first frame's depth sets :attr:`notes`."""
         import imageio.v3 as iio
 
+        planes = png16_planes(self.path)
+        if planes:  # a 16-bit colour PNG: one frame, at 16 bits
+            if first_dtype:
+                self.notes = depth_note(np.uint16, str(self.path))
+            yield to_grey(_read_png16(self.path, planes), str(self.path))
+            return
         try:
             with warnings.catch_warnings():  # imageio's plugin probing warns on bad files
                 warnings.simplefilter("ignore")
                 for frame in iio.imiter(self.path):
+                    if first_dtype:
+                        self.notes = depth_note(np.asarray(frame).dtype, str(self.path))
+                        first_dtype = False
                     yield to_grey(frame, str(self.path))
         except RvsmError:
             raise

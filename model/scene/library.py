@@ -500,7 +500,7 @@ def builtin_scene(
     require_memory(RENDER_WORKING_ARRAYS * 8 * min(RENDER_BATCH, num_frames) * size[0] * size[1],
                    f"rendering scene {name!r} at {size[0]}x{size[1]}", "ask for a smaller --size")
     return Scene(name, RenderedFrames(name, size, num_frames), steps_per_frame, hold,
-                 source=name)
+                 source=name).describe_source(name, f"builtin:{name}")
 
 
 def black_scene(size: tuple[int, int], num_steps: int) -> Scene:

@@ -9,7 +9,8 @@ scene never sits in memory whole:
   brightness as-is (no rescaling); memory-mapped, checked chunk by chunk;
 - image folder: the image files sorted by name, decoded per range; colour is converted
   to grey with the ITU-R 601 luminance (``skimage.color.rgb2gray``) and scaled to 0..255
-  (16-bit images are scaled by 255/65535, float images in [0, 1] by 255);
+  (16-bit images are scaled by 255/65535 at full precision, and the scene's ``notes``
+  say so; float images in [0, 1] by 255);
 - video or animated / multi-page image: decoded in order through ``imageio.v3.imiter``
   (videos need a plugin: ``pip install imageio[ffmpeg]``); a range before the reader's
   position restarts the decoding from the first frame.
@@ -22,18 +23,18 @@ Every user-fixable problem raises :class:`RvsmError` with a one-line message.
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.scene.file_frames import DecodedStream, ImageFiles, NpyFrames
+from rvsm.model.scene.digest import scene_digest
+from rvsm.model.scene.file_frames import IMAGE_SUFFIXES, DecodedStream, ImageFiles, NpyFrames
 from rvsm.model.scene.frames import FrameSource, FrameWindow
 from rvsm.model.scene.library import SCENE_NAMES, builtin_scene
 from rvsm.model.scene.scene import DEFAULT_STEPS_PER_FRAME, Scene
 
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".gif", ".webp", ".pgm",
-                  ".ppm")
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mov", ".mkv", ".webm", ".m4v", ".mpg", ".mpeg", ".wmv")
 
 _SIZE_RE = re.compile(r"^\s*(\d+)\s*[xX*,]\s*(\d+)\s*$")
@@ -161,6 +162,10 @@ def load_scene(
             f"{path}: unknown scene file type {suffix or '(none)'!r}; use a .npy array, an "
             f"image folder or a video ({', '.join(VIDEO_SUFFIXES[:4])} ...)"
         )
+    notes = tuple(getattr(frames, "notes", ()))
     frames = _fit_size(frames, num_frames, size, str(path))
     name = path.stem if path.suffix else path.name
-    return Scene(name, frames, steps_per_frame, hold, source=text)
+    scene = Scene(name, frames, steps_per_frame, hold, source=text).describe_source(
+        os.path.abspath(path), functools.partial(scene_digest, path))
+    object.__setattr__(scene, "notes", notes)
+    return scene

@@ -12,8 +12,9 @@ Ground truth for step ``t`` is ``I_t``. A scene's frames come from a
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -44,6 +45,8 @@ class Scene:
     steps_per_frame: int = DEFAULT_STEPS_PER_FRAME
     hold: bool = False
     source: str | None = None
+    #: what a command says about how the frames were read (16-bit images), one line each
+    notes: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, name: str, frames: np.ndarray | FrameSource,
                  steps_per_frame: int = DEFAULT_STEPS_PER_FRAME, hold: bool = False,
@@ -57,7 +60,8 @@ class Scene:
             raise RvsmError(f"steps_per_frame must be an integer >= 1, got {m!r}")
         if not hold and frames.shape[0] < 2:
             raise RvsmError(
-                f"{name}: linear interpolation needs at least 2 frames, got 1; "
+                f"{name if source is None else source}: linear interpolation needs at "
+                "least 2 frames, got 1; "
                 "use --hold for a still image"
             )
         for key, value in (("name", name), ("frame_source", frames),
@@ -141,22 +145,46 @@ class Scene:
         for t0 in range(0, self.num_steps, block_steps):
             yield t0, min(t0 + block_steps, self.num_steps)
 
+    def digest(self) -> str | None:
+        """The content digest of :attr:`source`
+        (:func:`rvsm.model.scene.digest.scene_digest`: ``builtin:<name>`` or
+        ``sha256:...`` of the file or folder), computed once, when the loader that made
+        the scene gave one (:meth:`describe_source`); ``None`` for a scene made in code."""
+        digest = self.__dict__.get("_digest")
+        if callable(digest):
+            digest = digest()
+            object.__setattr__(self, "_digest", digest)
+        return digest
+
+    def describe_source(self, stored: str, digest: str | Callable[[], str]) -> Scene:
+        """Set what a file's meta keeps of the source: ``stored`` (a built-in name, a
+        file's absolute path) and its ``digest`` (or a function computing it on first
+        use); returns the scene. Called by the loaders, which know what the source is."""
+        object.__setattr__(self, "_stored_source", stored)
+        object.__setattr__(self, "_digest", digest)
+        return self
+
     def meta(self) -> dict:
         """What it takes to load this scene again: goes into spike files' ``meta``.
 
-        ``scene_arg`` (the source, else the name), ``height``, ``width``, ``num_frames``,
-        ``steps_per_frame`` and ``hold``.
+        ``scene_arg`` (a built-in name, a scene file's or folder's absolute path, else the
+        name), ``scene_digest`` (:meth:`digest`, when the scene has a source),
+        ``height``, ``width``, ``num_frames``, ``steps_per_frame`` and ``hold``.
         """
         h, w = self.shape
-        return {
-            "scene_arg": self.source if self.source is not None else self.name,
+        out = {
+            "scene_arg": self.__dict__.get("_stored_source",
+                                           self.name if self.source is None else self.source),
             "height": h,
             "width": w,
             "num_frames": self.num_frames,
             "steps_per_frame": self.steps_per_frame,
             "hold": self.hold,
         }
-
+        digest = self.digest()
+        if digest is not None:
+            out["scene_digest"] = digest
+        return out
 
 def interpolate(stack: np.ndarray, f: np.ndarray, a: np.ndarray) -> np.ndarray:
     """``(1 - a) stack[f] + a stack[f+1]`` along axis 0, exactly as SPEC section 1 writes it.

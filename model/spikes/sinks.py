@@ -2,7 +2,11 @@
 
 A sink has ``begin(shape, meta)`` with ``shape = (T, S, H, W)``, ``write(t0, spikes)``
 with ``spikes (B, S, H, W) int8`` for steps ``t0 .. t0 + B - 1`` (called in step order),
-``finish(meta)`` on success and ``abort()`` on failure. Besides the ones here (an array,
+``finish(meta)`` on success and ``abort()`` on failure (also after a ``begin`` that
+failed half-way). A sink that can refuse a run (a file format that cannot hold its shape)
+also has ``check(shape, meta)``, which raises before anything is opened: :class:`TeeSink`
+checks every sink before it begins any, so a refused output leaves no other output's
+partial file behind. Besides the ones here (an array,
 counters, several at once), :class:`rvsm.model.spikes.h5.H5SpikeWriter` and
 :class:`rvsm.model.spikes.dat.DatWriter` write files.
 """
@@ -81,9 +85,24 @@ class TeeSink:
     def __init__(self, *sinks: SpikeSink | None) -> None:
         self.sinks = [s for s in sinks if s is not None]
 
-    def begin(self, shape, meta) -> None:
+    def check(self, shape, meta) -> None:
+        """Every sink's ``check`` (those that have one), before any is opened."""
         for s in self.sinks:
-            s.begin(shape, meta)
+            check = getattr(s, "check", None)
+            if check is not None:
+                check(shape, meta)
+
+    def begin(self, shape, meta) -> None:
+        """Check every sink, then begin each; a ``begin`` that fails aborts the sinks
+        already begun (and itself) before the error goes on."""
+        self.check(shape, meta)
+        for i, s in enumerate(self.sinks):
+            try:
+                s.begin(shape, meta)
+            except BaseException:
+                for begun in self.sinks[:i + 1]:
+                    begun.abort()
+                raise
 
     def write(self, t0, spikes) -> None:
         for s in self.sinks:
@@ -114,8 +133,8 @@ def fill_sink(
     ``progress`` is an optional bar (``update(steps)``, ``close()``), closed either way."""
     num_steps = shape[0]
     try:
-        sink.begin(shape, meta)
         try:
+            sink.begin(shape, meta)
             for t0 in range(0, num_steps, chunk_steps):
                 t1 = min(t0 + chunk_steps, num_steps)
                 sink.write(t0, produce(t0, t1))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -118,7 +119,8 @@ class SceneRequest:
       250x400;
     - with a design point, the point's size follows the scene (:meth:`load_for_point`);
     - ``rvsm evaluate`` takes every option not given from the spike file's meta
-      (:meth:`from_args` with ``meta``): the scene as the spikes were made.
+      (:meth:`from_args` with ``meta``): the scene as the spikes were made, checked
+      against the meta's ``scene_digest`` (``expected_digest``) unless ``force``.
     """
 
     source: str
@@ -126,6 +128,8 @@ class SceneRequest:
     frames: int | None = None
     steps_per_frame: int = DEFAULT_STEPS_PER_FRAME
     hold: bool = False
+    expected_digest: str | None = None
+    force: bool = False
 
     @classmethod
     def from_args(cls, args: argparse.Namespace, meta: dict | None = None) -> SceneRequest:
@@ -136,6 +140,9 @@ class SceneRequest:
         if source is None:
             raise RvsmError("the spike file's meta does not name its scene; pass SCENE "
                             "explicitly")
+        expected = meta.get("scene_digest")
+        if args.scene is None:
+            _check_stored_scene(str(source), expected)
         size = parse_size_arg(args.size)
         try:
             if size is None and "height" in meta:
@@ -147,7 +154,9 @@ class SceneRequest:
             hold = bool(meta.get("hold", False)) if args.hold is None else args.hold
         except (KeyError, TypeError, ValueError) as exc:
             raise RvsmError(f"the spike file's meta is incomplete or malformed: {exc}") from None
-        return cls(str(source), size, frames, steps_per_frame, hold)
+        return cls(str(source), size, frames, steps_per_frame, hold,
+                   None if expected is None else str(expected),
+                   bool(getattr(args, "force", False)))
 
     def load(self, default_size: tuple[int, int] | None = None) -> Scene:
         """The scene by the rule; ``default_size`` (``(H, W)``) renders a built-in scene
@@ -157,8 +166,18 @@ class SceneRequest:
         size = self.size
         if size is None and is_builtin(self.source):
             size = default_size
-        return load_scene(self.source, size=size, num_frames=self.frames,
-                          steps_per_frame=self.steps_per_frame, hold=self.hold)
+        scene = load_scene(self.source, size=size, num_frames=self.frames,
+                           steps_per_frame=self.steps_per_frame, hold=self.hold)
+        for note in scene.notes:
+            print(f"rvsm: note: {note}", file=sys.stderr)
+        if self.expected_digest is not None and not self.force:
+            got = scene.digest()
+            if got != self.expected_digest:
+                raise RvsmError(
+                    f"scene {self.source!r} (digest {got}) is not the scene the file was "
+                    f"made from (digest {self.expected_digest}); pass that scene as "
+                    "SCENE, or --force to use this one anyway")
+        return scene
 
     def load_for_point(self, point: DesignPoint) -> tuple[DesignPoint, Scene]:
         """``(point, scene)``: the scene by the rule (a built-in one at the point's size),
@@ -167,6 +186,19 @@ class SceneRequest:
 
         scene = self.load(default_size=point.shape)
         return fit_point(scene, point), scene
+
+
+def _check_stored_scene(source: str, digest: str | None) -> None:
+    """Refuse, suggesting SCENE, a scene file named by a spike file's meta that is gone."""
+    from pathlib import Path
+
+    from rvsm.model.scene.loaders import is_builtin
+
+    if is_builtin(source) or Path(source).expanduser().exists():
+        return
+    which = f" (content digest {digest})" if digest else ""
+    raise RvsmError(f"the file was made from scene {source}, which no longer exists; pass "
+                    f"that scene as SCENE{which}")
 
 
 def positive_or_default(value: int | None, option: str, default: int | None) -> int | None:

@@ -6,39 +6,80 @@ import argparse
 import json
 from pathlib import Path
 
-from rvsm.model.events.event_list import EventListWriter, open_event_list
+import numpy as np
+
+from rvsm.model.events.config import DEFAULT_CONTRAST
+from rvsm.model.events.event_list import (
+    COMPRESSIONS,
+    STEP_US,
+    EventListWriter,
+    is_event_list,
+    open_event_list,
+)
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.sensors.files import open_spikes
 from rvsm.model.spikes.files import copy_source
 from rvsm.model.spikes.h5 import H5SpikeWriter, is_h5_path
 from rvsm.model.spikes.npz import save_spikes
-from rvsm.sim.cli.args import SceneRequest, add_force_argument, add_scene_arguments
+from rvsm.sim.cli.args import (
+    SceneRequest,
+    add_force_argument,
+    add_scene_arguments,
+    parse_size_arg,
+)
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.studies.event_claims import DEFAULT_KS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``events export`` and ``events import``."""
-    p = sub.add_parser("events", help="event files (--sensor dvs) to/from HDF5 event lists",
+    p = sub.add_parser("events", help="event files (--sensor dvs) to/from event lists, "
+                       "AEDAT4, EVT and CSV",
                        description="Convert the events of `rvsm simulate --sensor dvs` to "
                        "an HDF5 event list (t in microseconds at 40 kHz, x, y, polarity, "
-                       "scale; DSEC-style names, docs/events.md) and back.")
+                       "scale; DSEC's names, gzip: no filter plugin), to AEDAT4, EVT 3 or "
+                       "CSV (one scale), and HDF5 event lists (ours or DSEC's layout) back "
+                       "(docs/events.md).")
     act = p.add_subparsers(dest="events_command", metavar="ACTION", required=True)
-    q = act.add_parser("export", help="event file (.h5/.npz) -> HDF5 event list (streamed)",
-                       description="Write an event file as an HDF5 event list with the "
-                       "references the sensor captured at step 0 (regenerated from the "
-                       "scene of the file's meta; SCENE and the scene options override it).")
+    q = act.add_parser("export", help="event file (.h5/.npz) -> HDF5 event list, AEDAT4, "
+                       "EVT 3 or CSV (streamed)",
+                       description="Write an event file as an HDF5 event list (-o FILE.h5) "
+                       "with the references the sensor captured at step 0 (regenerated "
+                       "from the scene of the file's meta, checked by its digest; SCENE "
+                       "and the scene options override it), or one scale of it as AEDAT4 "
+                       "(.aedat4), EVT 3 (.raw) or CSV (.csv), written by faery.")
     q.add_argument("events", help="event file from rvsm simulate --sensor dvs")
     add_scene_arguments(q, positional=False)
     q.add_argument("--scene", dest="scene", default=None,
                    help="the scene the events were made from (default: the file's meta)")
-    q.add_argument("-o", "--output", required=True, help="output event list (.h5)")
+    q.add_argument("-o", "--output", required=True,
+                   help="output: .h5 (HDF5 event list), .aedat4, .raw (EVT 3) or .csv")
+    q.add_argument("--scale", type=int, default=None, metavar="K",
+                   help="write scale K alone (0-based): one sensor, for tools that ignore "
+                   "the scale column; required for .aedat4/.raw/.csv of a multi-scale model")
+    q.add_argument("--compression", choices=COMPRESSIONS, default="gzip",
+                   help="HDF5 event list: gzip (default) or none need no filter plugin in "
+                   "any reader; lzf is h5py's own filter (other readers need a plugin); "
+                   "blosc needs the hdf5plugin package to write and to read")
     add_force_argument(q)
     q.set_defaults(func=run_export)
-    q = act.add_parser("import", help="HDF5 event list -> event file (.h5 streamed, or .npz)")
-    q.add_argument("events", help="HDF5 event list (rvsm events export)")
+    q = act.add_parser("import", help="HDF5 event list (ours or DSEC's layout) -> event "
+                       "file (.h5 streamed, or .npz)",
+                       description="Read an HDF5 event list back into an event file: one "
+                       "written by rvsm events export, or one in DSEC's layout (events/t, "
+                       "x, y, p; ms_to_idx; t_offset), read as a plain DVS with steps of "
+                       "--step-us microseconds.")
+    q.add_argument("events", help="HDF5 event list (rvsm events export, or DSEC's layout)")
     q.add_argument("-o", "--output", required=True, help="output event file (.h5 or .npz)")
+    q.add_argument("--size", default=None, metavar="HxW",
+                   help="DSEC layout: the sensor size (default: the file's height/width "
+                   "attributes, else the largest x and y + 1)")
+    q.add_argument("--step-us", type=int, default=STEP_US, metavar="US",
+                   help=f"DSEC layout: microseconds a step (default {STEP_US}, 40 kHz)")
+    q.add_argument("--contrast", type=float, default=None,
+                   help="DSEC layout: the sensor's contrast threshold, for rvsm evaluate "
+                   f"(default {DEFAULT_CONTRAST:g}, assumed)")
     add_force_argument(q)
     q.set_defaults(func=run_import)
     q = act.add_parser("claims", help="SPEC section 7's claims: a verdict table and figures",
@@ -61,41 +102,73 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run_export(args: argparse.Namespace) -> int:
-    """``rvsm events export``."""
+    """``rvsm events export``: an HDF5 event list, or one scale as AEDAT4, EVT 3 or CSV."""
     from rvsm.model.events.reconstruction import capture_references, config_from_meta
+    from rvsm.model.events.sensor_files import SENSOR_FORMATS, SensorFileWriter, sensor_format
 
-    if not is_h5_path(args.output):
-        raise RvsmError(f"-o expects an .h5 event list, got {args.output!r}")
-    check_outputs([Output(args.output, "-o", "event list")], [args.events], args.force)
+    one_sensor = sensor_format(args.output)
+    if not (is_h5_path(args.output) or one_sensor):
+        raise RvsmError(f"-o expects an .h5 event list or a {', '.join(SENSOR_FORMATS)} "
+                        f"file, got {args.output!r}")
+    if one_sensor and args.compression != "gzip":
+        raise RvsmError(f"--compression applies to HDF5 event lists; {one_sensor} files "
+                        "are written with their own")
+    check_outputs([Output(args.output, "-o", PLAIN if one_sensor else "event list")],
+                  [args.events], args.force)
     with open_spikes(args.events) as source:
         meta = dict(source.meta)
         if meta.get("kind") != "events":
             raise RvsmError(f"{args.events} holds spikes, not events: export events of "
                             "rvsm simulate --sensor dvs (spikes go to .dat with rvsm dat)")
-        config = config_from_meta(meta)
-        refs = getattr(source, "references", None)
-        if refs is None:
-            scene = SceneRequest.from_args(args, meta).load()
-            refs = capture_references(scene, config)
-        copy_source(source, EventListWriter(args.output, refs, config.contrasts), meta)
+        if one_sensor:
+            writer = SensorFileWriter(args.output, args.scale)
+        else:
+            config = config_from_meta(meta)
+            writer = EventListWriter(args.output, np.zeros(source.shape[1:]),
+                                     config.contrasts, args.compression, args.scale)
+            writer.check(source.shape, meta)  # refuse before the scene is read
+            refs = getattr(source, "references", None)
+            if refs is None:
+                scene = SceneRequest.from_args(args, meta).load()
+                refs = capture_references(scene, config)
+            writer.references = np.asarray(refs, dtype=np.float64)
+        copy_source(source, writer, meta)
         t, s, h, w = source.shape
-    print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w} as an event list")
+    what = (f"{one_sensor}, scale {args.scale or 0}" if one_sensor else
+            f"an event list ({args.compression}"
+            f"{'' if args.scale is None else f', scale {args.scale} alone'})")
+    print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w} as {what}")
     return 0
 
 
 def run_import(args: argparse.Namespace) -> int:
-    """``rvsm events import``."""
-    check_outputs([Output(args.output, "-o", "event file")], [args.events], args.force)
+    """``rvsm events import``: an ``rvsm-events`` list, or a file in DSEC's layout."""
+    from rvsm.model.events.dsec import is_dsec_layout, open_dsec_events
+
+    check_outputs([Output(args.output, "-o", "spike file")], [args.events], args.force)
     if not (is_h5_path(args.output) or args.output.endswith(".npz")):
         raise RvsmError(f"-o expects a .h5 or .npz path, got {args.output!r}")
-    with open_event_list(args.events) as source:
+    dsec = not is_event_list(args.events) and is_dsec_layout(args.events)
+    given = [o for o, v in (("--size", args.size), ("--contrast", args.contrast),
+                            ("--step-us", None if args.step_us == STEP_US else 1)) if v]
+    if given and not dsec:
+        raise RvsmError(f"{', '.join(given)} apply only to a file in DSEC's layout; "
+                        f"{args.events} is not one")
+    if dsec:
+        source = open_dsec_events(args.events, parse_size_arg(args.size), args.step_us,
+                                  DEFAULT_CONTRAST if args.contrast is None else args.contrast)
+    else:
+        source = open_event_list(args.events)
+    with source:
         meta = dict(source.meta)
         if is_h5_path(args.output):
             copy_source(source, H5SpikeWriter(args.output), meta)
         else:
             save_spikes(args.output, source.read(0, source.num_steps), meta)
         t, s, h, w = source.shape
-    print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}")
+    how = (f" (DSEC layout, {meta['step_us']} us a step, contrast "
+           f"{meta['contrast']:g} assumed)" if dsec else "")
+    print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}{how}")
     return 0
 
 
@@ -117,7 +190,7 @@ def run_claims(args: argparse.Namespace) -> int:
     result = ec.run_event_claims(scored_size(args.size), ks, args.steps, seed=args.seed,
                                  progress=not args.quiet)
     out = Path(args.output)
-    lines = ec.verdict_lines(result)
+    lines = ec.verdict_table(result)
     write_text_atomic(out / "claims.csv", ec.claims_csv(result))
     write_text_atomic(out / "claims.json", json.dumps(asdict(result), indent=1) + "\n")
     save_figure(ec.claims_figure(result), out / "noise.png")

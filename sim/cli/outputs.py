@@ -119,7 +119,11 @@ def _hdf5_kind(path: Path) -> str:
         return "HDF5 file"
     try:
         with h5py.File(path, "r") as f:
-            return "spike file" if "spikes" in f else "HDF5 file"
+            if "spikes" in f:
+                return "spike file"
+            fmt = f.attrs.get("format", b"")
+            fmt = fmt.decode() if isinstance(fmt, bytes) else str(fmt)
+            return "event list" if fmt == "rvsm-events" else "HDF5 file"
     except Exception:  # unreadable HDF5: still an HDF5 file, not ours to judge here
         return "HDF5 file"
 
@@ -199,8 +203,14 @@ def _check_replace(target: Path, option: str, kind: str, force: bool) -> None:
     if have == FOLDER:
         raise RvsmError(f"{option} {target} is a folder; give a file name")
     if not force and not _compatible(have, kind):
-        raise RvsmError(f"{option} {target} exists and holds a {have}, not a {kind}; "
+        raise RvsmError(f"{option} {target} exists and holds {_a(have)}, not {_a(kind)}; "
                         "choose another name, or pass --force to replace it")
+
+
+def _a(kind: str) -> str:
+    """``kind`` with its indefinite article, by sound ("an HDF5 file", "an event list")."""
+    return f"{'an' if kind[:1].lower() in 'aeio' or kind.startswith(('HDF', 'SQL')) else 'a'}" \
+        f" {kind}"
 
 
 def _check_file(out: Output, inputs: Sequence[Path], force: bool) -> None:

@@ -76,8 +76,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fixed", metavar="POINT.toml",
                    help="run the bit-accurate fixed-point twin of this design point instead")
     p.add_argument("-o", "--output", required=True, help="output spike file (.h5 or .npz)")
-    p.add_argument("--dat", metavar="FILE.dat", help="also export FSM spikes as camera .dat")
-    p.add_argument("--flip", action="store_true", help="flip vertically in the .dat file")
+    p.add_argument("--dat", metavar="FILE.dat", help="also export FSM spikes as camera .dat "
+                   "(rows bottom-up, as the camera writes them and SpikeCV reads them)")
+    p.add_argument("--flip", action="store_true", help="write the .dat file's rows top-down")
     add_engine_arguments(p)
     add_force_argument(p)
     p.set_defaults(func=run_simulate)
@@ -96,6 +97,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--match", default="gain", choices=MATCH_MODES,
                    help="brightness matching before scoring")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--force", action="store_true", help="score against SCENE even when its "
+                   "content digest differs from the one the file was made from")
     p.set_defaults(func=run_evaluate)
 
     p = sub.add_parser("dat", help="convert FSM spikes to/from the camera's .dat layout")
@@ -103,13 +106,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     q = dat_sub.add_parser("export", help=".h5 / .npz (FSM) -> .dat (streamed)")
     q.add_argument("spikes", help=".h5 or .npz spike file")
     q.add_argument("-o", "--output", required=True, help="output .dat")
-    q.add_argument("--flip", action="store_true", help="flip vertically (camera row order)")
+    q.add_argument("--flip", action="store_true", help="rows top-down in the .dat file "
+                   "(default: bottom-up, the camera's order, which SpikeCV reads)")
     add_force_argument(q)
     q.set_defaults(func=run_dat_export)
     q = dat_sub.add_parser("import", help=".dat -> .h5 (streamed) or .npz")
     q.add_argument("dat", help="camera .dat file")
     q.add_argument("--size", required=True, metavar="HxW", help="sensor size, e.g. 250x400")
-    q.add_argument("--flip", action="store_true", help="flip vertically (camera row order)")
+    q.add_argument("--flip", action="store_true", help="rows top-down in the .dat file "
+                   "(default: bottom-up, the camera's order, which SpikeCV reads)")
     q.add_argument("-o", "--output", required=True, help="output .h5 or .npz")
     add_force_argument(q)
     q.set_defaults(func=run_dat_import)
@@ -224,11 +229,13 @@ def run_simulate(args: argparse.Namespace) -> int:
 
 def _check_sensor_options(args: argparse.Namespace, sensor: Sensor) -> None:
     """Refuse options of the other sensor (exit 2)."""
-    options = _FLOAT_OPTIONS[sensor]
-    given = [f"--{n.replace('_', '-')}" for n in options.refused
-             if getattr(args, n) is not None]
-    if given:
-        raise RvsmError(f"{', '.join(given)} {options.refusal}")
+    for names, message in _FLOAT_OPTIONS[sensor].refusals:
+        given = [f"--{n.replace('_', '-')}" for n in names if getattr(args, n) is not None]
+        if given:
+            listed = " and ".join(given) if len(given) == 2 else ", ".join(given)
+            one = len(given) == 1
+            raise RvsmError(message.format(options=listed, are="is" if one else "are",
+                                           applies="applies" if one else "apply"))
 
 
 def _event_config(args: argparse.Namespace, scene: Scene) -> EventConfig:
@@ -300,16 +307,22 @@ class _FloatOptions:
     the options it refuses and what the refusal says."""
 
     config: Callable[[argparse.Namespace, Scene], SamplerConfig | EventConfig]
-    refused: tuple[str, ...]
-    refusal: str
+    #: groups of options it refuses, each with its message (``{options}`` the ones given,
+    #: ``{are}`` / ``{applies}`` the verb in their number)
+    refusals: tuple[tuple[tuple[str, ...], str], ...]
 
 
 #: Each sensor's float options (``rvsm simulate`` without ``--fixed``).
 _FLOAT_OPTIONS: dict[Sensor, _FloatOptions] = {
-    SPIKE_CAMERA: _FloatOptions(_float_config, ("contrast", "scale_contrast"),
-                                "apply to --sensor dvs only"),
-    EVENT_SENSOR: _FloatOptions(
-        _event_config, ("phi", "scale_phi", "reset", "thresholds", "fixed", "dat"),
-        "do(es) not apply to --sensor dvs (its thresholds are --contrast / "
-        "--scale-contrast; the fixed-point event twin is not built yet)"),
+    SPIKE_CAMERA: _FloatOptions(_float_config, (
+        (("contrast", "scale_contrast"), "{options} {applies} only to --sensor dvs"),)),
+    EVENT_SENSOR: _FloatOptions(_event_config, (
+        (("phi", "scale_phi", "reset", "thresholds"),
+         "{options} {are} the spike camera's; --sensor dvs takes its thresholds from "
+         "--contrast or --scale-contrast"),
+        (("fixed",), "--fixed takes the sensor from the design point ([array] sensor = "
+                     "\"dvs\", written by rvsm config new --sensor dvs); drop --sensor dvs"),
+        (("dat",), "--dat writes the spike camera's one-bit .dat and events have two "
+                   "polarities (ON/OFF); write events with rvsm events export (HDF5 event "
+                   "list, AEDAT4, EVT or CSV)"))),
 }

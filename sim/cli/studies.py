@@ -129,8 +129,9 @@ def cmd_robustness(args: argparse.Namespace) -> int:
     write_text_atomic(out / "robustness.json", json.dumps(result.rows, indent=1) + "\n")
     save_figure(robustness.robustness_figure(result), out / "fig8.png")
     verdict = claims.robustness_claim(result)
-    write_text_atomic(out / "verdict.md", f"claim 4 {'holds' if verdict['holds'] else 'fails'}: "
-                      f"{verdict['detail']}\n")
+    line = f"claim 4 {verdict['verdict']}: {verdict['detail']}"
+    write_text_atomic(out / "verdict.md", line + "\n")
+    print(line)
     print(f"wrote {out / 'robustness.csv'}, robustness.json, fig8.png "
           f"({result.seconds:.0f} s)")
     return 0

@@ -133,7 +133,8 @@ def robustness_figure(result: RobustnessResult) -> Figure:
         ax.set_title(f"{title}  (black {h}x{w}, T={result.num_steps})", fontsize=9)
         ax.set_xlabel("noise intensity k")
         ax.set_ylabel(ylabel, fontsize=8)
-        ax.set_yscale("log", nonpositive="mask")
+        if any(y > 0 for line in ax.get_lines() for y in line.get_ydata()):
+            ax.set_yscale("log", nonpositive="mask")  # nothing to show on a log axis else
         ax.grid(alpha=0.3)
         ax.legend(fontsize=6)
     fig.tight_layout()

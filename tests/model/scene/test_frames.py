@@ -97,7 +97,7 @@ def test_builtin_scene_is_lazy_and_equals_the_whole_render() -> None:
     assert isinstance(lazy.frame_source, RenderedFrames)
     eager = Scene("coin", render_frames("coin", size, count), 7)
     _assert_same_brightness(lazy, eager)
-    assert lazy.meta() == {**eager.meta(), "scene_arg": "coin"}
+    assert lazy.meta() == {**eager.meta(), "scene_arg": "coin", "scene_digest": "builtin:coin"}
     assert lazy == builtin_scene("coin", size, count, steps_per_frame=7)
 
 

@@ -173,3 +173,43 @@ def test_corrupt_image_file_is_one_clear_error(tmp_path):
     (tmp_path / "bad.gif").write_bytes(b"GIF89a")
     with pytest.raises(RvsmError, match="corrupt or truncated"):
         load_scene(str(tmp_path / "bad.gif"))
+
+
+def test_a_one_frame_file_is_named_with_its_suffix(tmp_path):
+    """Issue 33: the one-frame error named ``one:`` (the scene's name), not the file."""
+    np.save(tmp_path / "one.npy", np.zeros((1, 4, 8)))
+    with pytest.raises(RvsmError, match=r"one\.npy: linear interpolation needs at least 2"):
+        load_scene(str(tmp_path / "one.npy"))
+    assert load_scene(str(tmp_path / "one.npy"), hold=True).num_steps == 10
+
+
+def test_16_bit_png_folders_are_read_at_16_bits_and_say_so(tmp_path):
+    """Issue 33: a 16-bit PNG folder was read as 8-bit without a word. Grey and colour
+    16-bit PNGs keep their precision (value x 255/65535, fractions kept) and the scene's
+    notes say how they were read."""
+    import imageio.v3 as iio
+    import png
+    from skimage.color import rgb2gray
+
+    values = (np.arange(6 * 8).reshape(6, 8) * 1361 + 7).astype(np.uint16)
+    grey, colour = tmp_path / "grey", tmp_path / "colour"
+    grey.mkdir()
+    colour.mkdir()
+    rgb = np.stack([values, values[::-1], values[:, ::-1]], axis=-1)
+    for i in range(2):
+        iio.imwrite(grey / f"{i}.png", values + i)
+        with open(colour / f"{i}.png", "wb") as handle:  # 16-bit RGB (Pillow reads 8 bits)
+            png.Writer(8, 6, greyscale=False, bitdepth=16).write(
+                handle, (rgb + i).reshape(6, 8 * 3).tolist())
+    g = load_scene(str(grey))
+    assert np.array_equal(g.frame_range(0, 2), np.stack([values, values + 1]) * (255 / 65535))
+    c = load_scene(str(colour))
+    want = np.stack([rgb2gray(rgb + i) * 255.0 for i in range(2)])
+    assert np.allclose(c.frame_range(0, 2), want, rtol=0, atol=1e-9)
+    assert not np.allclose(c.frame_range(0, 1), np.round(c.frame_range(0, 1)))  # not 8-bit
+    for scene in (g, c):
+        assert len(scene.notes) == 1 and "16-bit" in scene.notes[0]
+    np.save(tmp_path / "s.npy", np.zeros((2, 4, 8), np.uint8))
+    assert load_scene(str(tmp_path / "s.npy")).notes == ()
+    iio.imwrite(tmp_path / "eight.png", values.astype(np.uint8))
+    assert load_scene(str(tmp_path / "eight.png"), hold=True).notes == ()

@@ -69,3 +69,37 @@ def test_events_export_import(tmp_path, capsys):
     code, _, err = _run(capsys, "events", "export", spikes, "-o", tmp_path / "x.h5")
     assert code == 2 and "holds spikes" in err
     assert _run(capsys, "events", "export", ev, "-o", tmp_path / "x.npz")[0] == 2
+
+
+def test_refusals_say_true_things_in_good_english(tmp_path, capsys):
+    """Issue 33's words: grammar, articles, and the true reason for --dat and --fixed."""
+    out = tmp_path / "e.h5"
+    for extra, words in (
+            (["--contrast", "0.3"], "--contrast applies only to --sensor dvs"),
+            (["--contrast", "0.3", "--scale-contrast", "1"],
+             "--contrast and --scale-contrast apply only to --sensor dvs"),
+            (["--sensor", "dvs", "--phi", "3"], "--phi is the spike camera's"),
+            (["--sensor", "dvs", "--dat", str(tmp_path / "e.dat")],
+             "events have two polarities (ON/OFF); write events with rvsm events export"),
+            (["--sensor", "dvs", "--fixed", str(tmp_path / "p.toml")],
+             "--fixed takes the sensor from the design point")):
+        code, _, err = _run(capsys, "simulate", "flyball", *SMALL, *extra, "-o", out)
+        assert code == 2 and words in err, (extra, err)
+        assert "not built yet" not in err
+    assert not list(tmp_path.iterdir())
+
+
+def test_an_existing_list_is_replaced_and_another_h5_named_with_its_article(tmp_path,
+                                                                           capsys):
+    events, lst = tmp_path / "e.h5", tmp_path / "list.h5"
+    assert _run(capsys, "simulate", "flyball", *SMALL, "--sensor", "dvs", "--model", "fsm",
+                "--engine", "numpy", "-o", events)[0] == 0
+    for _ in range(2):  # re-running the export replaces its own list without --force
+        code, out, err = _run(capsys, "events", "export", events, "-o", lst)
+        assert code == 0, err
+    import h5py
+
+    with h5py.File(tmp_path / "other.h5", "w") as f:
+        f["x"] = np.zeros(3)
+    code, _, err = _run(capsys, "events", "export", events, "-o", tmp_path / "other.h5")
+    assert code == 2 and "holds an HDF5 file, not an event list" in err

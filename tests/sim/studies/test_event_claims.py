@@ -12,6 +12,7 @@ from rvsm.sim.studies.event_claims import (
     claims_csv,
     judge,
     run_event_claims,
+    verdict_table,
 )
 
 
@@ -52,9 +53,16 @@ def test_small_run_and_cli(tmp_path: Path, capsys) -> None:
     assert main(["events", "claims", "--size", "16x16", "--ks", "1,20", "--steps", "30",
                  "--quiet", "-o", str(out)]) == 0
     text = capsys.readouterr().out
-    assert text.count("claim ") == 3
+    printed = text.splitlines()[:5]  # the table docs/events.md promises, printed
+    for table in (verdict_table(r), printed):
+        assert table[0] == "| claim | rule | verdict | figures |" and len(table) == 2 + 3
+        for n, row in enumerate(table[2:], 1):
+            assert row.startswith(f"| {n}. ") and row.count(" | ") == 3
+            assert ("| **holds** |" in row) != ("| **fails** |" in row)
+    assert not any(line.startswith("|") for line in text.splitlines()[5:])
+    table = printed
     data = json.loads((out / "claims.json").read_text())
     assert {"noise", "flicker", "recon"} <= set(data)
     assert (out / "noise.png").stat().st_size > 0
-    assert (out / "verdict.md").read_text().count("claim ") == 3
+    assert (out / "verdict.md").read_text().splitlines() == table
     assert main(["events", "claims", "--steps", "1", "-o", str(tmp_path / "x")]) == 2
