@@ -16,10 +16,10 @@ an architecture's name or imports its package:
 * its mutation sites (:class:`MutationSites`, ``rvsm mutate``);
 * its formal harnesses (:attr:`Architecture.formal`, ``rvsm formal``);
 * its wrappers: the interfaces an architecture is offered with (``--interface axis``)
-  are registered beside it (:func:`rvsm.rtl.registry.register`).
+  are registered beside it (:func:`rvsm.rtl.architectures.registry.register`).
 
-The registry (:mod:`rvsm.rtl.registry`) lists them; every command, the co-simulation and
-the FPGA flow look an architecture up there once and pass the value on.
+The registry (:mod:`rvsm.rtl.architectures.registry`) lists them; every command, the
+co-simulation and the FPGA flow look an architecture up there once and pass the value on.
 """
 
 from __future__ import annotations

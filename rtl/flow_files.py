@@ -69,7 +69,7 @@ def provenance(contract: ArrayContract, arch: str, options: Mapping[str, int], t
             "design_point_digest": design_point_digest(contract),
             "rtl_digest": rtl_digest(contract, arch, dict(options)),
             "arch": arch, "options": dict(options), "top": top,
-            "command": command or "rvsm.rtl.verilog.write_outputs (library call)"}
+            "command": command or "rvsm.rtl.architectures.verilog.write_outputs (library call)"}
 
 
 def header(prov: Mapping, comment: str = "//") -> str:

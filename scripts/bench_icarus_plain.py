@@ -30,7 +30,7 @@ import numpy as np
 from rvsm.model.fixed.stimulus_chunks import open_stimulus_chunks
 from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.stream.drive import threshold_writes
-from rvsm.sim.cosim.long_runs.chunk_harness import (
+from rvsm.sim.cosim.builds.chunk_harness import (
     HARNESS_TOP,
     HarnessLayout,
     encode_input_beats,

@@ -15,7 +15,7 @@ which runs cocotb and the twin). Cases:
   simulator's share (cycles over the seconds the testbench waited for it) and the same
   run replayed by plain ``vvp`` without cocotb (``scripts/bench_icarus_plain.py``): the
   harness's Icarus build simulates a yosys-rewritten netlist and makes its own clock
-  (``sim/cosim/long_runs/icarus_netlist.py``, ``chunk_harness.py``; docs/long-runs.md);
+  (``sim/cosim/builds/icarus_netlist.py``, ``chunk_harness.py``; docs/long-runs.md);
 * ``one-second`` (unless ``--quick``): 250x400, P=40, Verilator, 40,000 steps of a
   4,001-frame scene: wall time including build (target <= 60 min), peak RSS (<= 4 GB);
 * ``simulate`` (unless ``--quick``): ``rvsm simulate`` of that scene to ``.h5``: peak

@@ -6,7 +6,7 @@ kernels cached on disk per CPU (``__pycache__`` beside each module). A fresh clo
 install has none, so the first run of each engine spends a minute or more compiling
 before its first step. :func:`warm_kernels` runs each engine path a user reaches from the
 CLI once on a tiny scene, in this process, so the cache holds every kernel. A kernel that
-still compiles later says so (:mod:`rvsm.sim.kernel_cache`).
+still compiles later says so (:mod:`rvsm.model.infra.compile_notice`).
 """
 
 from __future__ import annotations

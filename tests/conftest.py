@@ -33,9 +33,9 @@ from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint, default_design_point
 from rvsm.model.fixed.weights import model_contract as weights_model_contract
 
-# The one-line notice of a numba compile (rvsm.sim.kernel_cache) would add a line to the
+# The one-line notice of a numba compile (rvsm.model.infra.compile_notice) would add a line to the
 # stderr a test checks whenever a kernel is not yet cached: off for the suite and its
-# children; tests/sim/test_kernel_cache.py turns it on where it is the subject.
+# children; tests/model/infra/test_compile_notice.py turns it on where it is the subject.
 os.environ["RVSM_COMPILE_NOTICE"] = "0"
 
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-from rvsm.rtl.registry import ARCHITECTURES, WRAPPERS
+from rvsm.rtl.architectures.registry import ARCHITECTURES, WRAPPERS
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The packages that define architectures (the registry imports them; nothing in sim may).
@@ -111,7 +111,7 @@ def _sources() -> dict[str, tuple[Path, tuple[str, ...]]]:
         out[module] = (path, allowed)
     for path in sorted((ROOT / "rtl").rglob("*.py")):
         module = _module(path, "rvsm.rtl", ROOT / "rtl")
-        if module == "rvsm.rtl.registry" or any(
+        if module == "rvsm.rtl.architectures.registry" or any(
                 module == p or module.startswith(p + ".") for p in ARCHITECTURE_PACKAGES):
             continue
         out[module] = (path, ARCHITECTURE_PACKAGES)  # rtl may import them; not name them

@@ -39,6 +39,8 @@ from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.architectures.registry import DEFAULT_ARCHITECTURE, get_architecture
+from rvsm.rtl.architectures.verilog import strip_zero_memory_init
 from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.fpga.camera import state_memory
 from rvsm.rtl.fpga.devices import Device, get_device
@@ -52,9 +54,7 @@ from rvsm.rtl.fpga.report import (
     parse_yosys_stat,
 )
 from rvsm.rtl.fpga.tool_logs import follower
-from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.toolchain import Progress, find_tool, kill_all, run_tool
-from rvsm.rtl.verilog import strip_zero_memory_init
 
 __all__ = [
     "MEMORIES",
@@ -152,7 +152,7 @@ def synthesise(
     """Harness ``component``, write its netlist and run ``synth_ecp5 -abc9`` in ``work_dir``.
 
     A Verilog netlist leaves out all-zero memory initialisers
-    (:func:`~rvsm.rtl.verilog.strip_zero_memory_init`, the rule of every generated
+    (:func:`~rvsm.rtl.architectures.verilog.strip_zero_memory_init`, the rule of every generated
     Verilog: no array relies on power-up memory contents). ``memory`` (:data:`MEMORIES`):
     ``"dp16kd"`` elaborates with ``platform=ECP5_PLATFORM``, so state-memory banks are
     DP16KD instances with the output register on
@@ -255,7 +255,7 @@ def run_fpga(
 
     ``point`` is the sensor (its height and width give the camera arithmetic and the
     state memory); ``size`` (H, W) overrides the size of the array actually built;
-    ``arch`` names a registered architecture (:mod:`rvsm.rtl.registry`), ``lanes``
+    ``arch`` names a registered architecture (:mod:`rvsm.rtl.architectures.registry`), ``lanes``
     its option (``None``: not given); ``build`` replaces the architecture's component by
     ``build(contract, lanes)`` (e.g. an IP wrapper around the array; ``arch`` still
     names the report's architecture). ``memory``: see :func:`synthesise`.

@@ -165,7 +165,7 @@ STREAM = Architecture(
     formal={**{group: stream_check(group) for group in PROPERTY_GROUPS},
             "equivalence": stream_equivalence, "window": window_lemma, "sums": sum_lemma,
             "composed": composed_equivalence},
-    long_run_testbench="rvsm.sim.cosim.testbenches.tb_stream_chunks",
+    long_run_testbench="rvsm.sim.cosim.long_runs.tb_stream_chunks",
     beats=STREAM_BEATS,
     protocol=ProtocolScripts(
         testbench="rvsm.sim.cosim.testbenches.tb_stream_protocol",

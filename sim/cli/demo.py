@@ -7,7 +7,7 @@ from pathlib import Path
 
 from rvsm.sim.cli.args import SceneRequest, add_force_argument
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
-from rvsm.sim.cosim import SIMULATORS
+from rvsm.sim.cosim.builds.cocotb_adapter import SIMULATORS
 from rvsm.sim.studies.main_job import (
     DEMO_MODELS,
     DEMO_RTL_LANES,

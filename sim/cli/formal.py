@@ -119,7 +119,7 @@ def _formal(args: argparse.Namespace) -> int:
 
 def _formal_plan(args: argparse.Namespace) -> int:
     """``rvsm formal --plan PLAN.toml``: every run of the plan (:mod:`rvsm.sim.formal.plan`)."""
-    from rvsm.rtl.registry import ARCHITECTURES
+    from rvsm.rtl.architectures.registry import ARCHITECTURES
     from rvsm.sim.formal.plan import load_formal_plan
     from rvsm.sim.formal.plan_run import run_formal_plan
 

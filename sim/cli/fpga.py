@@ -71,8 +71,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
+    from rvsm.rtl.architectures.registry import get_architecture
     from rvsm.rtl.fpga.flow import build_component, run_fpga, run_fpga_seeds
-    from rvsm.rtl.registry import get_architecture
     from rvsm.sim.cli.rtl import command_architecture
 
     arch, options = command_architecture(args)  # the IP with --interface axis

@@ -14,6 +14,7 @@ import signal
 import sys
 from types import ModuleType
 
+from rvsm.model.infra.compile_notice import install_compile_notice
 from rvsm.model.infra.errors import RvsmError, ToolError, interrupt_behind
 from rvsm.sim.cli import (
     demo,
@@ -30,12 +31,17 @@ from rvsm.sim.cli import (
     sweep,
     verify,
 )
-from rvsm.sim.kernel_cache import install_compile_notice
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
 #: co-simulation, formal checks, FPGA timing and area, paper studies, the demo, design sweeps.
 FAMILIES: tuple[ModuleType, ...] = (sampling, events, scenes, fixed, rtl, verify, regress,
                                     formal, mutate, fpga, studies, demo, sweep)
+
+
+#: Commands that run numba kernels: a kernel compiling in them says so (first run).
+COMPILING_COMMANDS = frozenset({"simulate", "demo", "table", "robustness", "cost", "profile",
+                                "evaluate", "stimulus", "events", "verify", "regress",
+                                "sweep", "dat"})
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -113,7 +119,8 @@ def _run(args: argparse.Namespace) -> int:
     """``args.func(args)`` with every failure mapped to its exit status."""
     try:
         # a kernel that compiles (a first run) says so in one line before the wait
-        install_compile_notice(getattr(args, "command", None))
+        if getattr(args, "command", None) in COMPILING_COMMANDS:
+            install_compile_notice()
         return int(args.func(args) or 0)
     except KeyboardInterrupt as exc:
         return _interrupted(exc)

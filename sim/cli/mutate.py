@@ -7,8 +7,8 @@ import json
 import sys
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.architectures.registry import ARCHITECTURES
 from rvsm.rtl.capabilities import Architecture
-from rvsm.rtl.registry import ARCHITECTURES
 from rvsm.sim.cli.args import parse_size_arg
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 

@@ -9,9 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.capabilities import Architecture, Option
-from rvsm.rtl.flow_files import DEFAULT_CLOCK_MHZ
-from rvsm.rtl.registry import (
+from rvsm.rtl.architectures.registry import (
     ARCHITECTURES,
     DEFAULT_ARCHITECTURE,
     INTERFACES,
@@ -19,11 +17,13 @@ from rvsm.rtl.registry import (
     WRAPPERS,
     get_architecture,
 )
+from rvsm.rtl.capabilities import Architecture, Option
+from rvsm.rtl.flow_files import DEFAULT_CLOCK_MHZ
 from rvsm.sim.cli.args import add_force_argument, sized_contract
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 
 if TYPE_CHECKING:
-    from rvsm.rtl.verilog import GeneratedVerilog
+    from rvsm.rtl.architectures.verilog import GeneratedVerilog
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -121,7 +121,7 @@ def command_architecture(args: argparse.Namespace) -> tuple[Architecture, dict[s
 
 
 def _verilog(args: argparse.Namespace) -> int:
-    from rvsm.rtl.verilog import (
+    from rvsm.rtl.architectures.verilog import (
         OUTPUT_SUFFIXES,
         icarus_lint,
         verilator_lint,
@@ -181,7 +181,7 @@ def arch_text(name: str, options: dict[str, int]) -> str:
 
 
 def _top_arg(text: str) -> str:
-    from rvsm.rtl.verilog import check_top
+    from rvsm.rtl.architectures.verilog import check_top
 
     try:
         return check_top(text)

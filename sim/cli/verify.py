@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING
 
 from rvsm.model.fixed.stimulus import Stimulus
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.architectures.registry import ARCHITECTURES, NATIVE, WRAPPERS, architectures_with
 from rvsm.rtl.capabilities import Architecture
-from rvsm.rtl.registry import ARCHITECTURES, NATIVE, WRAPPERS, architectures_with
 from rvsm.sim.cli.args import SceneRequest, add_scene_arguments, parse_size_arg
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 from rvsm.sim.cli.rtl import (
@@ -28,7 +28,7 @@ from rvsm.sim.cli.rtl import (
     arch_text,
     command_architecture,
 )
-from rvsm.sim.cosim import SIMULATORS
+from rvsm.sim.cosim.builds.cocotb_adapter import SIMULATORS
 from rvsm.sim.cosim.run_point import RunPoint
 
 if TYPE_CHECKING:

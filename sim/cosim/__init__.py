@@ -1,12 +1,15 @@
 """Co-simulation: the generated Verilog on Icarus / Verilator against the fixed twin.
 
-Split by concern: :mod:`.builds` (cocotb's runner, the verified build cache, code
-coverage), :mod:`.testbenches` (one cocotb testbench per way of driving an architecture),
-:mod:`.long_runs` (the long-run harness and its twin process). Beside them,
-:mod:`.run_point` holds a design point parsed once, :mod:`.testbench_run` runs one
-testbench on one stimulus file, :mod:`.protocol_run` and
-:mod:`.axis_run` the protocol scripts and the AXI IP, and :mod:`.verify` is ``rvsm verify``.
-"""
+Split by concern:
 
-#: HDL simulators the runner can build for (``--sim`` of ``rvsm verify`` and the demo).
-SIMULATORS: tuple[str, ...] = ("icarus", "verilator")
+- :mod:`.builds`: cocotb's runner behind an adapter (and ``SIMULATORS``), run in a child
+  process, one verified cached build per key, the long-run harness's Verilog and its
+  Icarus netlist, one testbench run on one stimulus file, and Verilator's code coverage;
+- :mod:`.testbenches`: one cocotb testbench per way of driving an architecture;
+- :mod:`.long_runs`: long runs in that harness, and the twin's process beside the
+  simulator.
+
+Beside them: :mod:`.run_point` (a design point parsed once, its contract built once),
+:mod:`.protocol_run` and :mod:`.axis_run` (protocol scripts, the AXI IP), and
+:mod:`.verify` (``rvsm verify``). The sub-packages import nothing from this level.
+"""

@@ -17,10 +17,10 @@ from pathlib import Path
 
 from rvsm.model.fixed.stimulus import Stimulus, save_stimulus
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.architectures.registry import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.capabilities import Architecture
-from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.sim.cosim.builds.build_cache import build, new_run_dir
-from rvsm.sim.cosim.testbench_run import run_cocotb
+from rvsm.sim.cosim.builds.testbench_run import run_cocotb
 from rvsm.sim.cosim.verify import DEFAULT_WORK
 
 __all__ = ["AXIS_POLICIES", "axis_verify"]

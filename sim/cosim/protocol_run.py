@@ -17,12 +17,16 @@ from pathlib import Path
 from typing import Any
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.architectures.registry import (
+    DEFAULT_ARCHITECTURE,
+    architectures_with,
+    get_architecture,
+)
 from rvsm.rtl.capabilities import Architecture, ProtocolScripts
-from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, architectures_with, get_architecture
 from rvsm.sim.cosim.builds.build_cache import build, new_run_dir
 from rvsm.sim.cosim.builds.cocotb_adapter import check_simulator
+from rvsm.sim.cosim.builds.testbench_run import run_cocotb
 from rvsm.sim.cosim.run_point import RunPoint
-from rvsm.sim.cosim.testbench_run import run_cocotb
 
 __all__ = ["check_script_rtl", "protocol_scripts", "protocol_verify"]
 

@@ -28,13 +28,17 @@ from rvsm.model.fixed.stimulus_chunks import StimulusChunks
 from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.scene import Scene
+from rvsm.rtl.architectures.registry import (
+    DEFAULT_ARCHITECTURE,
+    architectures_with,
+    get_architecture,
+)
 from rvsm.rtl.capabilities import Architecture
-from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, architectures_with, get_architecture
 from rvsm.sim.cosim.builds.build_cache import SimBuild, build, new_run_dir
 from rvsm.sim.cosim.builds.cocotb_adapter import check_simulator
+from rvsm.sim.cosim.builds.testbench_run import run_testbench
 from rvsm.sim.cosim.long_runs.long_run import DEFAULT_CHUNK_STEPS, check_chunks
 from rvsm.sim.cosim.run_point import RunPoint
-from rvsm.sim.cosim.testbench_run import run_testbench
 
 #: The testbenches ``rvsm verify --harness`` chooses: per cycle from Python, or the
 #: long-run harness (the simulator runs the cycles; streaming array only); ``auto``
@@ -83,7 +87,7 @@ def check_stimulus(
 ) -> dict:
     """Drive the RTL of ``stim.contract`` with ``stim`` and compare every spike.
 
-    ``arch`` names the architecture (:mod:`rvsm.rtl.registry`, default the
+    ``arch`` names the architecture (:mod:`rvsm.rtl.architectures.registry`, default the
     streaming array), ``options`` its options (e.g. ``lanes``).
 
     Each call gets its own run folder ``work_dir/runs/<name>-<sim>-<time>-<pid>-<random>``

@@ -41,8 +41,8 @@ from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.model.scene.loaders import parse_size
+from rvsm.rtl.architectures.registry import ARCHITECTURES, DEFAULT_ARCHITECTURE
 from rvsm.rtl.capabilities import Architecture
-from rvsm.rtl.registry import ARCHITECTURES, DEFAULT_ARCHITECTURE
 from rvsm.sim.formal.runner import available_checks
 from rvsm.sim.sweep.spec import parse_base_point, toml_tables
 

@@ -25,10 +25,10 @@ from typing import Any
 
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.formal_harness import FormalHarness, Property, property_at
 from rvsm.rtl.mutations import check_mutation
-from rvsm.rtl.registry import get_architecture
 from rvsm.sim.formal.sby import MODES, SOLVERS, SbyResult, check_tools, run_sby
 
 __all__ = ["CHECK_ORDER", "CheckResult", "Counterexample", "FormalReport",

@@ -22,8 +22,8 @@ import numpy as np
 
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.widths import unsigned_max
+from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.capabilities import Architecture
-from rvsm.rtl.registry import get_architecture
 
 __all__ = ["COSIM_CHECKS", "RUNNING_WRITES", "CosimCheck", "stimulus"]
 

@@ -21,9 +21,9 @@ from pathlib import Path
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.capabilities import Architecture, MutationSites, require_spike_sensor
 from rvsm.rtl.mutations import Mutation
-from rvsm.rtl.registry import get_architecture
 from rvsm.sim.cosim.run_point import RunPoint
 from rvsm.sim.mutate.checks import COSIM_CHECKS
 

@@ -46,8 +46,8 @@ from rvsm.model.fixed.point_toml import design_point_toml
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.model.scene.loaders import is_builtin, parse_size
-from rvsm.rtl.registry import ARCHITECTURES, DEFAULT_ARCHITECTURE, architectures_with
-from rvsm.sim.cosim import SIMULATORS
+from rvsm.rtl.architectures.registry import ARCHITECTURES, DEFAULT_ARCHITECTURE, architectures_with
+from rvsm.sim.cosim.builds.cocotb_adapter import SIMULATORS
 from rvsm.sim.cosim.verify import HARNESSES
 from rvsm.sim.sweep.spec import parse_base_point, toml_tables
 

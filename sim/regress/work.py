@@ -50,7 +50,7 @@ class RegressionWork:
     def run(self) -> dict[str, Any]:
         """The run's record (never raises for a tool failure: ``status`` is ``"error"``)."""
         from rvsm.model.fixed.point_toml import parse_design_point
-        from rvsm.rtl.registry import get_architecture
+        from rvsm.rtl.architectures.registry import get_architecture
         from rvsm.sim.cosim.protocol_run import protocol_verify
         from rvsm.sim.cosim.run_point import RunPoint
         from rvsm.sim.cosim.verify import random_verify, verify

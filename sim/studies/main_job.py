@@ -22,7 +22,7 @@ from rvsm.model.sampling.config import SamplerConfig
 from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.scene import Scene
 from rvsm.model.spikes.npz import save_spikes
-from rvsm.sim.kernel_cache import compile_float_engine
+from rvsm.sim.studies.timing import compile_float_engine
 
 DEMO_SCENE = "flyball"
 DEMO_MODELS = ("fsm", "dog4", "gauss4")
@@ -139,7 +139,7 @@ def run_rtl_demo(
     """
     from rvsm.model.fixed.design_point import default_design_point
     from rvsm.model.fixed.point_toml import save_design_point
-    from rvsm.rtl.verilog import write_outputs
+    from rvsm.rtl.architectures.verilog import write_outputs
     from rvsm.sim.cosim.verify import verify
 
     point = default_design_point().with_size(*size)

@@ -23,8 +23,8 @@ from rvsm.model.sampling.config import DEFAULT_PHI, SamplerConfig
 from rvsm.model.sampling.twin import sample
 from rvsm.model.scene import library as scene_library
 from rvsm.model.scene.scene import Scene
-from rvsm.sim.kernel_cache import compile_float_engine
 from rvsm.sim.studies.labels import column_label, method_label
+from rvsm.sim.studies.timing import compile_float_engine
 
 TABLE_MODELS: tuple[str, ...] = MODEL_NAMES
 FIG6_CLEAN: tuple[str, ...] = ("fsm", "gauss1", "dog3")

@@ -3,7 +3,7 @@
 One build per :func:`build_key` (RTL, simulator, top, tracing, flags, C++ optimisation,
 tool versions) is cached under ``build_root/<sim>-<digest>-<top>[-trace]-<key>/``,
 checked by checksum before each use and reused by every stimulus
-(:func:`rvsm.sim.cosim.testbench_run.run_testbench`), so a Verilator compile is paid once.
+(:func:`rvsm.sim.cosim.builds.testbench_run.run_testbench`), so a Verilator compile is paid once.
 Icarus builds always include the FST dump module; Verilator builds get ``--trace-fst``
 only when waves are asked for (a second cached build), since tracing doubles the C++. A
 build happens in a private folder renamed into place when done; the Verilog of a
@@ -12,7 +12,7 @@ contract already generated for another build is reused; each run gets a fresh fo
 :mod:`rvsm.sim.cosim.builds.cocotb_adapter`.
 
 What is built for a contract (architecture, default top, Verilog writer, testbench) comes
-from the architecture registry (:mod:`rvsm.rtl.registry`) through one function,
+from the architecture registry (:mod:`rvsm.rtl.architectures.registry`) through one function,
 :func:`cosim_design`; which testbench runs a build is the architecture's to say
 (:attr:`~rvsm.rtl.capabilities.Architecture.testbench`, or
 :attr:`~rvsm.rtl.capabilities.Architecture.long_run_testbench` inside the long-run
@@ -39,21 +39,25 @@ from pathlib import Path
 
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.rtl.architectures.registry import (
+    DEFAULT_ARCHITECTURE,
+    architectures_with,
+    get_architecture,
+)
+from rvsm.rtl.architectures.verilog import GeneratedVerilog, write_outputs
 from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.ports import load_ports_json
-from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, architectures_with, get_architecture
 from rvsm.rtl.rtl_digest import rtl_digest
 from rvsm.rtl.toolchain import ToolFailure, run_tool
-from rvsm.rtl.verilog import GeneratedVerilog, write_outputs
-from rvsm.sim.cosim.builds.cocotb_adapter import build_args, check_simulator, cocotb_build, cxx_opt
-from rvsm.sim.cosim.long_runs.chunk_harness import (
+from rvsm.sim.cosim.builds.chunk_harness import (
     HARNESS_TOP,
     HARNESS_VERSION,
     HarnessLayout,
     clock_inside,
     harness_verilog,
 )
-from rvsm.sim.cosim.long_runs.icarus_netlist import (
+from rvsm.sim.cosim.builds.cocotb_adapter import build_args, check_simulator, cocotb_build, cxx_opt
+from rvsm.sim.cosim.builds.icarus_netlist import (
     ICARUS_NETLIST_VERSION,
     YOSYS_SCRIPT,
     write_icarus_netlist,

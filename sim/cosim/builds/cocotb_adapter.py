@@ -45,9 +45,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.rtl.architectures.verilog import verilator_env
 from rvsm.rtl.toolchain import ToolFailure, run_tool
-from rvsm.rtl.verilog import verilator_env
-from rvsm.sim.cosim import SIMULATORS
 from rvsm.sim.cosim.builds.cocotb_job import safe_path
 
 __all__ = ["LONG_RUN_CXX_OPT", "VERILATOR_BUILD_ARGS", "VERILATOR_CXX_OPT", "build_args",
@@ -69,6 +68,9 @@ VERILATOR_CXX_OPT = "-O0"
 LONG_RUN_CXX_OPT = "-O2"
 #: Both simulators' time unit and precision.
 TIMESCALE = ("1ns", "1ps")
+
+#: HDL simulators the runner can build for (``--sim`` of ``rvsm verify`` and the demo).
+SIMULATORS: tuple[str, ...] = ("icarus", "verilator")
 
 
 def check_simulator(sim: str) -> None:

@@ -56,7 +56,7 @@ from rvsm.model.fixed.stimulus_chunks import open_stimulus_chunks
 from rvsm.model.infra.errors import ToolError
 from rvsm.rtl.capabilities import BeatStream
 from rvsm.rtl.ports import load_ports_json
-from rvsm.sim.cosim.long_runs.chunk_harness import (
+from rvsm.sim.cosim.builds.chunk_harness import (
     STAMP_BITS,
     HarnessLayout,
     decode_output_beats,

@@ -35,13 +35,13 @@ from rvsm.model.fixed.stimulus import save_stimulus
 from rvsm.model.fixed.stimulus_chunks import StimulusChunks
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.progress import progress_bar
+from rvsm.rtl.architectures.registry import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.capabilities import Architecture
-from rvsm.rtl.registry import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.sim.cosim.builds.build_cache import SimBuild, build, new_run_dir
+from rvsm.sim.cosim.builds.chunk_harness import DEFAULT_DEPTH, clock_inside
 from rvsm.sim.cosim.builds.code_coverage import read_coverage, summary
-from rvsm.sim.cosim.long_runs.chunk_harness import DEFAULT_DEPTH, clock_inside
+from rvsm.sim.cosim.builds.testbench_run import run_cocotb
 from rvsm.sim.cosim.long_runs.chunk_twin import start_twin
-from rvsm.sim.cosim.testbench_run import run_cocotb
 
 __all__ = ["DEFAULT_CHUNK_STEPS", "check_chunks", "window_cycles"]
 

@@ -12,8 +12,8 @@ from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge
 
 from rvsm.model.fixed.contract import ArrayContract
+from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.capabilities import BeatStream
-from rvsm.rtl.registry import get_architecture
 
 #: Clock period of both testbenches (ns); inputs are driven on the falling edge.
 CLOCK_NS = 10

@@ -26,8 +26,8 @@ import numpy as np
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
+from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.ports import load_ports_json
-from rvsm.rtl.registry import get_architecture
 from rvsm.sim.cosim.testbenches.tb_common import (
     CLOCK_NS,
     beat_stream,

@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rvsm.rtl.registry import get_architecture
+from rvsm.rtl.architectures.registry import get_architecture
 
 
 @pytest.mark.parametrize(("model", "acc_bits"), [("fsm", 6), ("dog2", 7), ("gauss2", 12),

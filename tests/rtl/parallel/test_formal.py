@@ -8,9 +8,9 @@ import dataclasses
 
 import pytest
 
+from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.formal_harness import property_at
 from rvsm.rtl.parallel.harnesses import ParallelProperties
-from rvsm.rtl.registry import get_architecture
 from rvsm.sim.formal.sby import run_sby
 
 ASSERTS = {"valid.latency", "receptive.sum", "saturation.high_rail", "saturation.low_rail",

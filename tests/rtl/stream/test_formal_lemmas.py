@@ -11,8 +11,8 @@ import dataclasses
 
 import pytest
 
+from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.formal_harness import property_at
-from rvsm.rtl.registry import get_architecture
 from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.formal_lemmas import (
     ComposedEquivalence,

@@ -13,9 +13,9 @@ import pytest
 
 from rvsm.model.fixed.design_point import DesignPoint, default_design_point
 from rvsm.model.fixed.point_toml import save_design_point
-from rvsm.rtl.registry import get_architecture
+from rvsm.rtl.architectures.registry import get_architecture
+from rvsm.rtl.architectures.verilog import strip_zero_memory_init, write_outputs
 from rvsm.rtl.stream.dimensions import StreamGeometry
-from rvsm.rtl.verilog import strip_zero_memory_init, write_outputs
 from rvsm.sim.cli import main
 
 STREAM_TOP = get_architecture("stream").default_top
@@ -61,7 +61,7 @@ def test_ports_follow_the_signature(generated: tuple[Path, DesignPoint]) -> None
 
 
 def test_verilator_lint_clean(generated: tuple[Path, DesignPoint]) -> None:
-    from rvsm.rtl.verilog import verilator_lint
+    from rvsm.rtl.architectures.verilog import verilator_lint
 
     out, _ = generated
     verilator_lint(out / f"{STREAM_TOP}.v", STREAM_TOP)
@@ -87,7 +87,7 @@ def test_cli_rejects_lanes_not_dividing(tmp_path: Path,
 @pytest.mark.parametrize("lanes", [20, 40])
 def test_full_sensor_verilog(tmp_path: Path, lanes: int) -> None:
     """250x400 dog4 default point: figures printed (target < 60 s, < 10 MB)."""
-    from rvsm.rtl.verilog import verilator_lint
+    from rvsm.rtl.architectures.verilog import verilator_lint
 
     t0 = time.perf_counter()
     paths, gen = write_outputs(DesignPoint().contract(), tmp_path, "stream", lanes=lanes)
@@ -105,7 +105,7 @@ def test_stats_report_state_memories_as_memory_bits(
     """``--stats`` keeps memories as memories: exactly the state bits of the geometry
     (accumulators, thresholds, line buffer), one memory per bank and kind, plus the line
     buffer; no flip-flop stands for a memory word."""
-    from rvsm.rtl.verilog import yosys_stats
+    from rvsm.rtl.architectures.verilog import yosys_stats
 
     out, point = generated
     geo = StreamGeometry(point.contract(), 2)

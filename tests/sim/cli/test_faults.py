@@ -100,7 +100,7 @@ WORK = [
     "rvsm.model.fixed.twin.simulate_fixed", "rvsm.sim.cli.sampling.open_spikes",
     "rvsm.sim.cli.sampling.dat_source",
     "rvsm.sim.cli.scenes.render_frames", "rvsm.model.fixed.stimulus.make_stimulus",
-    "rvsm.rtl.verilog.write_outputs", "rvsm.sim.cosim.verify.verify",
+    "rvsm.rtl.architectures.verilog.write_outputs", "rvsm.sim.cosim.verify.verify",
     "rvsm.sim.studies.table.run_table", "rvsm.sim.studies.robustness.run_robustness",
     "rvsm.sim.sweep.run.run_sweep", "rvsm.sim.sweep.report.write_report",
     "rvsm.sim.cli.demo.run_float_demo", "rvsm.model.fixed.point_toml.save_design_point",
@@ -460,7 +460,7 @@ def test_a_full_resolution_stream_array_reaches_the_output_check(tmp_path, capsy
     point = tmp_path / "p.toml"
     assert _run(capsys, "config", "new", "-o", point)[0] == 0  # 250x400: fine when streamed
     monkeypatch.setattr(outputs.os, "access", lambda *a, **k: False)
-    monkeypatch.setattr("rvsm.rtl.verilog.write_outputs", WORK_REFUSED)
+    monkeypatch.setattr("rvsm.rtl.architectures.verilog.write_outputs", WORK_REFUSED)
     code, _, err = _run(capsys, "verilog", point, "--arch", "stream", "-o", tmp_path / "rtl")
     assert code == 3 and "choose a writable location" in _one_line(err)
 

@@ -67,7 +67,7 @@ def test_a_missing_simulator_is_a_tool_error(tmp_path: Path, monkeypatch) -> Non
 def test_verilator_exposes_only_the_top_level_ports(tmp_path: Path) -> None:
     """cocotb's ``--public-flat-rw``, then our build arguments and control file (cocotb's
     order): the named top-level ports, and nothing else, are registered for VPI."""
-    from rvsm.rtl.verilog import verilator_env
+    from rvsm.rtl.architectures.verilog import verilator_env
 
     try:
         env = verilator_env()

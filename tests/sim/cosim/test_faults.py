@@ -31,7 +31,7 @@ from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.fixed.point_toml import save_design_point
 from rvsm.model.infra.errors import RvsmError, ToolError
 from rvsm.sim.cosim.builds.build_cache import build, build_key
-from rvsm.sim.cosim.testbench_run import run_testbench
+from rvsm.sim.cosim.builds.testbench_run import run_testbench
 from tests.conftest import default_signals
 
 RVSM = str(Path(sys.executable).parent / "rvsm")

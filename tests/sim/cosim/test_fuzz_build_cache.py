@@ -12,8 +12,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from rvsm.model.fixed.design_point import default_design_point
+from rvsm.rtl.architectures.verilog import write_outputs
 from rvsm.rtl.ports import load_ports_json
-from rvsm.rtl.verilog import write_outputs
 from rvsm.sim.cosim.builds.build_cache import _build_files, _cached, _checksums, cosim_design
 from tests.fuzzing import corrupted, damaged_copy, fuzz_settings, reader_outcome
 from tests.model.fixed.test_fuzz_point_toml import TOML_VALUES

@@ -1,4 +1,4 @@
-"""The long-run harness's Icarus netlist (:mod:`rvsm.sim.cosim.long_runs.icarus_netlist`) and the
+"""The long-run harness's Icarus netlist (:mod:`rvsm.sim.cosim.builds.icarus_netlist`) and the
 harness's own clock: the text passes, the build that uses them, and the oracle: a tiny
 array through the rewritten netlist agrees with the fixed twin spike for spike, at the
 same clock cycles as Verilator (which builds the original Verilog, clocked by cocotb).
@@ -20,8 +20,8 @@ from rvsm.model.fixed.stimulus import Stimulus
 from rvsm.model.fixed.stimulus_chunks import StimulusChunks
 from rvsm.rtl.toolchain import find_tool, run_tool
 from rvsm.sim.cosim.builds.build_cache import cosim_design
-from rvsm.sim.cosim.long_runs.chunk_harness import HarnessLayout, clock_inside, harness_verilog
-from rvsm.sim.cosim.long_runs.icarus_netlist import (
+from rvsm.sim.cosim.builds.chunk_harness import HarnessLayout, clock_inside, harness_verilog
+from rvsm.sim.cosim.builds.icarus_netlist import (
     group_enables,
     merge_clocked,
     write_icarus_netlist,

@@ -1,4 +1,4 @@
-"""The long-run harness (:mod:`rvsm.sim.cosim.long_runs.chunk_harness`, :mod:`.long_run`)
+"""The long-run harness (:mod:`rvsm.sim.cosim.builds.chunk_harness`, :mod:`.long_run`)
 against the fixed twin, on both simulators: equal verdicts to the per-cycle testbench, clears, a
 wrong expectation found at its step with a waveform window around it, and the CLI.
 """
@@ -21,7 +21,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.loaders import load_scene
 from rvsm.rtl.stream.schedule import pack_lanes
 from rvsm.sim.cli import main
-from rvsm.sim.cosim.long_runs.chunk_harness import (
+from rvsm.sim.cosim.builds.chunk_harness import (
     decode_output_beats,
     encode_input_beats,
     encode_threshold_writes,

@@ -8,7 +8,7 @@ import pytest
 from amaranth.hdl import Fragment
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.registry import ARCHITECTURES, DEFAULT_ARCHITECTURE, get_architecture
+from rvsm.rtl.architectures.registry import ARCHITECTURES, DEFAULT_ARCHITECTURE, get_architecture
 
 
 def test_registry_names_the_default_and_refuses_unknown_names() -> None:

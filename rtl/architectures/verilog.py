@@ -1,5 +1,5 @@
 """Verilog generation, port map, Verilator lint and yosys synthesis statistics, for every
-registered architecture (:mod:`rvsm.rtl.registry`).
+registered architecture (:mod:`rvsm.rtl.architectures.registry`).
 
 * :func:`generate_verilog` converts an architecture's component with Amaranth's bundled
   (WebAssembly) yosys, ``emit_src=False`` (no source-location attributes), and leaves
@@ -38,6 +38,7 @@ from amaranth.lib import wiring
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError, ToolError
+from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.flow_files import (
     DEFAULT_CLOCK_MHZ,
@@ -49,7 +50,6 @@ from rvsm.rtl.flow_files import (
     verilator_waivers,
 )
 from rvsm.rtl.ports import verilog_ports
-from rvsm.rtl.registry import get_architecture
 from rvsm.rtl.toolchain import ToolFailure, run_tool
 
 __all__ = [

@@ -10,7 +10,7 @@ import numba
 import numpy as np
 import pytest
 
-from rvsm.sim import kernel_cache
+from rvsm.model.infra import compile_notice as kernel_cache
 
 
 @pytest.fixture
@@ -18,7 +18,7 @@ def notice(monkeypatch: pytest.MonkeyPatch) -> Iterator[io.StringIO]:
     monkeypatch.setenv("RVSM_COMPILE_NOTICE", "1")
     kernel_cache.remove_compile_notice()
     said = io.StringIO()
-    assert kernel_cache.install_compile_notice("simulate", said)
+    assert kernel_cache.install_compile_notice(said)
     yield said
     kernel_cache.remove_compile_notice()
 
@@ -47,9 +47,12 @@ def test_a_compiled_kernel_called_again_says_nothing(notice: io.StringIO) -> Non
     assert notice.getvalue() == ""
 
 
-def test_only_commands_that_run_kernels_and_not_when_off(
+def test_off_with_the_variable_and_only_for_commands_that_run_kernels(
         monkeypatch: pytest.MonkeyPatch) -> None:
+    from rvsm.sim.cli.main import COMPILING_COMMANDS
+
     kernel_cache.remove_compile_notice()
-    assert not kernel_cache.install_compile_notice("verilog")
     monkeypatch.setenv("RVSM_COMPILE_NOTICE", "0")
-    assert not kernel_cache.install_compile_notice("simulate")
+    assert not kernel_cache.install_compile_notice()
+    assert {"simulate", "demo", "table"} <= COMPILING_COMMANDS
+    assert not {"verilog", "formal", "fpga", "config"} & COMPILING_COMMANDS

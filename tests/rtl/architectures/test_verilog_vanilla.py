@@ -16,8 +16,8 @@ import pytest
 
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.fixed.point_toml import save_design_point
+from rvsm.rtl.architectures.verilog import OUTPUT_SUFFIXES, verilator_env
 from rvsm.rtl.flow_files import LINT_WAIVER_RULES, design_point_digest
-from rvsm.rtl.verilog import OUTPUT_SUFFIXES, verilator_env
 from rvsm.sim.cli import main
 
 #: name -> (size, model, rvsm verilog arguments, top): tiny streaming arrays at P = 1 and

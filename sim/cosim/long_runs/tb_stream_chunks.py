@@ -47,8 +47,8 @@ from cocotb.triggers import FallingEdge, RisingEdge
 
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.rtl.ports import load_ports_json
-from rvsm.sim.cosim.long_runs.chunk_harness import CLOCK_NS as HARNESS_CLOCK_NS
-from rvsm.sim.cosim.long_runs.chunk_harness import HarnessLayout
+from rvsm.sim.cosim.builds.chunk_harness import CLOCK_NS as HARNESS_CLOCK_NS
+from rvsm.sim.cosim.builds.chunk_harness import HarnessLayout
 from rvsm.sim.cosim.long_runs.chunk_twin import connect
 from rvsm.sim.cosim.testbenches.tb_common import CLOCK_NS, clock_and_reset, testbench_arg
 

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from rvsm.model.fixed.design_point import default_design_point
+from rvsm.rtl.architectures.verilog import write_outputs
 from rvsm.rtl.parallel.array import RvsmArray
-from rvsm.rtl.verilog import write_outputs
 
 
 @pytest.fixture(scope="module")
@@ -45,7 +45,7 @@ def test_files_ports_and_no_src(generated: tuple[Path, object]) -> None:
 
 
 def test_verilator_lint_clean(generated: tuple[Path, object]) -> None:
-    from rvsm.rtl.verilog import verilator_lint
+    from rvsm.rtl.architectures.verilog import verilator_lint
 
     out, _ = generated
     verilator_lint(out / "rvsm_array.v")
@@ -53,7 +53,7 @@ def test_verilator_lint_clean(generated: tuple[Path, object]) -> None:
 
 @pytest.mark.skipif(shutil.which("yosys") is None, reason="apt-get install yosys")
 def test_yosys_stats(generated: tuple[Path, object], capsys: pytest.CaptureFixture) -> None:
-    from rvsm.rtl.verilog import yosys_stats
+    from rvsm.rtl.architectures.verilog import yosys_stats
 
     out, point = generated
     c = point.contract()
