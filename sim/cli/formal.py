@@ -19,6 +19,14 @@ from rvsm.sim.cli.rtl import add_arch_arguments, command_architecture
 MAX_FORMAL_PIXELS = 64
 
 
+def _check_names() -> str:
+    """Every registered architecture's formal checks, from the registry (``--help``)."""
+    from rvsm.rtl.architectures.registry import ARCHITECTURES
+
+    return "; ".join(f"{name}: {', '.join(a.formal)}" for name, a in ARCHITECTURES.items()
+                     if a.formal)
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``formal`` sub-command."""
     p = sub.add_parser(
@@ -46,9 +54,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="prove (k-induction), bmc (bounded) or cover (reachability); "
                    "default prove for a provable harness, else bmc")
     p.add_argument("--check", action="extend", nargs="+", metavar="NAME",
-                   help="run only these checks (parallel: properties; stream: protocol, state, "
-                   "thresholds, tail, equivalence); default every "
-                   "check the architecture registers")
+                   help=f"run only these checks ({_check_names()}); default every check "
+                   "the architecture registers")
     p.add_argument("--solver", choices=("yices", "z3"), default="yices",
                    help="smtbmc's SMT solver (default yices: much faster on the streaming "
                    "array's memories; z3 for a second opinion)")

@@ -273,3 +273,10 @@ def check_outputs(outputs: Iterable[Output | None | str], inputs: Iterable[str |
         if key in seen:
             raise RvsmError(f"{out.option} and {seen[key]} name the same file {out.path}")
         seen[key] = out.option
+
+
+def default_results(plan: str | os.PathLike) -> Path:
+    """Where a plan's or sweep's results database goes when ``-o`` is not given:
+    ``build/<plan name>.sqlite`` in the current folder, never beside the plan (which may
+    sit in the source tree); its coverage folder goes beside the database."""
+    return Path("build") / f"{Path(plan).stem}.sqlite"

@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
+from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs, default_results
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -22,7 +22,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("plan", help="regression plan TOML (examples in regressions/)")
     p.add_argument("-o", "--output", default=None,
-                   help="results database (default PLAN.sqlite beside the plan)")
+                   help="results database (default build/PLAN.sqlite, with its coverage "
+                   "folder beside it: nothing is written beside the plan)")
     p.add_argument("--workers", type=int, default=None,
                    help="local Dask worker processes (default: one per core; 0 = in this "
                    "process, no Dask)")
@@ -33,7 +34,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="write JUnit XML, one test case per run")
     p.add_argument("--work", default="build/regress",
                    help="work folder: shared build cache and one folder per run")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress bar (the same word as rvsm verify, fpga, table...)")
+    p.add_argument("--no-progress", dest="quiet", action="store_true",
+                   help=argparse.SUPPRESS)  # the old name of --quiet
     p.add_argument("--force", action="store_true",
                    help="replace an existing output of another kind (never an input)")
     p.set_defaults(func=_regress)
@@ -45,7 +49,7 @@ def _regress(args: argparse.Namespace) -> int:
 
     if args.workers is not None and args.workers < 0:
         raise RvsmError(f"--workers must be >= 0, got {args.workers}")
-    db = Path(args.output) if args.output else Path(args.plan).with_suffix(".sqlite")
+    db = Path(args.output) if args.output else default_results(args.plan)
     outputs = [Output(db, "-o", "SQLite database"), Output(args.work, "--work", FOLDER)]
     if args.junit:
         outputs.append(Output(args.junit, "--junit", PLAIN))
@@ -53,7 +57,7 @@ def _regress(args: argparse.Namespace) -> int:
     plan = load_plan(args.plan)
     print(f"regression {plan.name}: {len(plan.runs)} run(s) -> {db}", flush=True)
     s = run_regression(plan, db, args.work, workers=args.workers, scheduler=args.scheduler,
-                       junit=args.junit, progress=not args.no_progress)
+                       junit=args.junit, progress=not args.quiet)
     print(f"{len(s.rows)} run(s): {s.count('pass')} pass, {s.count('fail')} fail, "
           f"{s.count('error')} error ({s.ran} ran now, {s.skipped} already done)")
     for r in s.rows:

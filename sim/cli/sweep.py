@@ -12,7 +12,7 @@ import argparse
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
+from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs, default_results
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -31,8 +31,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("path", nargs="?", metavar="FILE",
                    help="the sweep file (run) or the results database (report)")
     p.add_argument("-o", "--output", default=None,
-                   help="run: results database (default SWEEP.sqlite beside the sweep "
-                   "file); report: output folder (default RESULTS-report)")
+                   help="run: results database (default build/SWEEP.sqlite: nothing is "
+                   "written beside the sweep file); report: output folder (default "
+                   "RESULTS-report)")
     p.add_argument("--workers", type=int, default=None,
                    help="local Dask worker processes (default: one per core; 0 = in this "
                    "process, no Dask)")
@@ -42,7 +43,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "network you do not control; see docs/design-space.md)")
     p.add_argument("--force", action="store_true",
                    help="replace an existing output of another kind (never an input)")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress bar (the same word as rvsm verify, fpga, table...)")
+    p.add_argument("--no-progress", dest="quiet", action="store_true",
+                   help=argparse.SUPPRESS)  # the old name of --quiet
     p.add_argument("--tolerance", type=float, default=0.1,
                    help="report: PSNR cost bound in dB for the recommendation (default 0.1)")
     p.add_argument("--fits", default=None, metavar="DEVICE[,DEVICE]",
@@ -89,7 +93,7 @@ def _run(args: argparse.Namespace, sweep_file: str) -> int:
 
     if args.workers is not None and args.workers < 0:
         raise RvsmError(f"--workers must be >= 0, got {args.workers}")
-    db = Path(args.output) if args.output else Path(sweep_file).with_suffix(".sqlite")
+    db = Path(args.output) if args.output else default_results(sweep_file)
     check_outputs([Output(db, "-o", "SQLite database")], [sweep_file], args.force)
     spec = load_sweep(sweep_file)
     print(f"sweep {sweep_file}: {len(spec.designs)} design point(s) x "
@@ -97,7 +101,7 @@ def _run(args: argparse.Namespace, sweep_file: str) -> int:
           f"{len(spec.run.seeds)} seed(s) at {spec.run.size[0]}x{spec.run.size[1]}, "
           f"{spec.run.steps} steps -> {db}")
     summary = run_sweep(spec, db, workers=args.workers, scheduler=args.scheduler,
-                        progress=not args.no_progress)
+                        progress=not args.quiet)
     print(summary.format())
     for e in summary.errors[:10]:
         print(f"  failed: {e}")

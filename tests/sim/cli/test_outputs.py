@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import errno
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -141,3 +142,20 @@ def test_folder_outputs_may_hold_their_sub_folders(tmp_path):
     (out / "rtl").write_text("x")
     with pytest.raises(RvsmError, match="rtl exists and is not a folder"):
         check_outputs([Output(out, "-o", FOLDER, (("rtl", FOLDER),))])
+
+
+def test_plans_and_sweeps_write_nothing_beside_themselves() -> None:
+    """``rvsm regress regressions/smoke.toml`` wrote smoke.sqlite and smoke-coverage/ into
+    the source tree (issue 34): the default database is build/<name>.sqlite in the current
+    folder; --quiet is the progress switch's one name (--no-progress still parses)."""
+    from rvsm.sim.cli.main import build_parser
+    from rvsm.sim.cli.outputs import default_results
+
+    plan = Path("regressions") / "smoke.toml"
+    assert default_results(plan) == Path("build") / "smoke.sqlite"
+    assert plan.parent not in default_results(plan).parents
+    parser = build_parser()
+    for command in (["regress", str(plan)], ["sweep", "sweeps/example.toml"]):
+        assert parser.parse_args([*command, "--quiet"]).quiet
+        assert parser.parse_args([*command, "--no-progress"]).quiet
+        assert not parser.parse_args(command).quiet
