@@ -107,7 +107,11 @@ def _check(contract: ArrayContract, lanes: int, fifo_depth: int) -> None:
 
 def _describe(dut: RvsmAxisIp) -> dict:
     geo = dut.geometry
-    timing = {**geo.timing(), "fifo_depth": dut.fifo_depth,
+    # one latency: the IP's (the top-level "latency" of ports.json); the array's inside it
+    # keeps its own name
+    array = geo.timing()
+    timing = {**array, "latency": dut.latency, "array_latency": array["latency"],
+              "fifo_depth": dut.fifo_depth,
               "release_cycles": dut.RELEASE_CYCLES, "init_cycles": dut.init_cycles,
               "full_rate_depth": dut.FULL_RATE_DEPTH}
     return {"timing": timing, "bank_sizes": geo.bank_sizes, "state_bits": geo.state_bits,

@@ -69,3 +69,31 @@ def test_verify_interface_refusals(tmp_path: Path, capsys: pytest.CaptureFixture
     assert "--interface axis only" in capsys.readouterr().err
     assert main(["verify", "--interface", "axis", "--work", work]) == 2
     assert "needs SCENE" in capsys.readouterr().err
+
+
+def test_printed_timing_and_ports_json_agree_with_simulation(
+        tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """``rvsm verilog --interface axis`` prints the pixel-to-spike delay back to back, and
+    ``ports.json`` has one latency: both as amaranth.sim measures them (issue 34: the text
+    said lag + 4 where lag + 5 cycles were measured; ports.json had two latencies)."""
+    import numpy as np
+
+    from rvsm.model.fixed.design_point import DesignPoint
+    from rvsm.rtl.ip.drive import simulate_ip
+
+    point = _point(tmp_path)
+    out = tmp_path / "ip"
+    assert main(["verilog", str(point), "--size", "8x8", "--lanes", "2", "--interface",
+                 "axis", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    said = int(re.search(r"(\d+) cycles after beat p when beats come back to back",
+                         text).group(1))
+    meta = json.loads((out / "rvsm_axis_ip.ports.json").read_text())
+    contract = DesignPoint().with_size(8, 8).contract()
+    codes = np.random.default_rng(0).integers(0, 1 << contract.adc_bits, (2, 8, 8))
+    run = simulate_ip(contract, 2, codes, np.ones((contract.num_scales, 8, 8), np.int64))
+    lag = run.dut.geometry.lag
+    measured = {run.out[p][0] - run.accepted[p] for p in range(len(run.out))}
+    assert measured == {said}, (measured, said)
+    assert said == lag + meta["timing"]["release_cycles"]
+    assert meta["latency"] == meta["timing"]["latency"] == run.dut.latency
