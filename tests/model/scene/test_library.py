@@ -7,6 +7,7 @@ import pytest
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene import library as lib
+from rvsm.model.scene import renderers
 
 SMALL = (40, 64)
 
@@ -26,7 +27,7 @@ def test_default_render(name: str) -> None:
     f = lib.render_frames(name)
     assert f.shape == (41, 250, 400) and f.dtype == np.float64
     assert not f.flags.writeable
-    assert f.min() >= lib.BRIGHT_MIN - 1e-9 and f.max() <= lib.BRIGHT_MAX + 1e-9
+    assert f.min() >= renderers.BRIGHT_MIN - 1e-9 and f.max() <= renderers.BRIGHT_MAX + 1e-9
     assert f.std() > 15.0  # real texture, not a flat field
     assert np.median(np.abs(np.diff(f[0], axis=1))) > 0.5  # structure within a frame
     diff = np.abs(np.diff(f, axis=0))
@@ -81,12 +82,12 @@ def test_rendering_in_ranges_equals_the_whole_render(name: str) -> None:
     renderer batches of any length and start (no renderer couples frames)."""
     size, count = (30, 44), 37
     lib._BATCHES.clear()
-    whole = lib._to_brightness(
-        np.broadcast_to(lib._RENDERERS[name](lib._Grid(size, count)), (count, *size)))
+    whole = renderers.to_brightness(
+        np.broadcast_to(renderers.RENDERERS[name](renderers.Grid(size, count)), (count, *size)))
     np.testing.assert_array_equal(lib.render_frames(name, size, count), whole)
     for batch in (1, 5):
-        parts = [lib._to_brightness(np.broadcast_to(
-            lib._RENDERERS[name](lib._Grid(size, min(batch, count - f0), first=f0)),
+        parts = [renderers.to_brightness(np.broadcast_to(
+            renderers.RENDERERS[name](renderers.Grid(size, min(batch, count - f0), first=f0)),
             (min(batch, count - f0), *size))) for f0 in range(0, count, batch)]
         np.testing.assert_array_equal(np.concatenate(parts), whole)
     lazy = lib.RenderedFrames(name, size, count)
