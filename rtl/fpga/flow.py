@@ -17,6 +17,11 @@ Each tool's full log is kept in ``yosys.log`` / ``nextpnr.log`` beside its produ
 Expected run times come from :func:`expected_synthesis_seconds` and
 :func:`expected_pnr_seconds`, fits to runs on a 2-core machine (rough: a shared machine
 is slower).
+
+Why one module of about 490 lines: it is one flow, read top to bottom (tools, scripts,
+their expected times, one run, best of N seeds) around one private job (:class:`_Job`)
+that both entry points share; its parts elsewhere (harness, tool logs, report, devices,
+memory) are modules of their own.
 """
 
 from __future__ import annotations
