@@ -5,10 +5,11 @@ Amaranth 0.5 writes a memory's initial contents into its RTLIL one net at a time
 ``$meminit_v2`` cell), all-zero contents included, as one constant that yosys then
 parses in a time that grows faster than its length; it has no public switch to leave
 them out. At sensor size (250x400 dog4, P=40: 7.2 Mbit of accumulators and line buffer,
-all zero, and 6.8 Mbit of thresholds at the top rail) those two steps were three
-quarters of the Verilog generation's CPU time. :func:`convert_verilog` gives the same
-Verilog as ``amaranth.back.verilog.convert`` followed by
-:func:`~rvsm.rtl.verilog.strip_zero_memory_init`, without either:
+all zero, and 6.8 Mbit of thresholds at the top rail) those two steps were two thirds
+of the Verilog generation's CPU time (45-53 s before, 14.6-15.5 s after, the same window
+on a loaded 2-core machine: ``scripts/bench_rtl.py --only verilog``).
+:func:`convert_verilog` gives the same Verilog as ``amaranth.back.verilog.convert``
+followed by :func:`~rvsm.rtl.verilog.strip_zero_memory_init`, without either:
 
 1. every :class:`~amaranth.lib.memory.Memory` is elaborated through Amaranth's documented
    platform override (:meth:`MemoryCells.get_memory`) as an
@@ -103,7 +104,8 @@ class MemoryCells:
         """``text`` (Amaranth's RTLIL of the design elaborated with this platform) with
         each ``$mem`` instance written as Amaranth writes a memory, without the
         initialiser of an all-zero one; the memories' declarations first in their
-        modules, in order, as Amaranth places them."""
+        modules, in the order of the instances (Amaranth's order, as long as no memory of
+        the module was left to Amaranth)."""
         starts = [(m.start(), m[1]) for m in re.finditer(r"^module (\S+)$", text, re.M)]
         declarations: dict[str, list[str]] = {}
 
