@@ -1,4 +1,5 @@
-"""Ladder sums and event rule, one loop (scripts/gen_orbit_kernels.py wrote it).
+"""Ladder sums and event rule, one loop (written by python -m
+rvsm.model.sampling.kernel_generator; do not edit).
 
 ``ladder_events_S(pairs, pr, ring, w, width, thr, ref, ev, y)``: every scale's receptive
 sum of padded row ``pr`` exactly as

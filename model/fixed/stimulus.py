@@ -17,24 +17,19 @@ testbench (:mod:`rvsm.sim.cosim.testbenches.tb_parallel`) drives the RTL from it
 
 A testbench loads it with :func:`load_stimulus`, configures the RTL from ``contract`` and
 ``thresholds``, drives ``codes`` step by step (pulsing ``clear`` before the listed steps)
-and compares every spike.
+and compares every spike. This module is the format: :class:`Stimulus`, its writers and
+its opener. :func:`open_stimulus` reads ``codes`` and ``spikes`` lazily, a range of steps
+at a time (:class:`~.stimulus_reader.MemberArray`), and checks every member before use
+(:mod:`.stimulus_validation`).
 
 **Long runs, bounded memory.** :func:`write_stimulus` (``rvsm stimulus``) makes the file a
-chunk of steps at a time: the ``codes`` member from the scene's brightness (+ dark
-current) through the ADC, then the ``spikes`` member from the fused fixed twin, each
-deflated into its zip member as it is made, so memory does not grow with the number of
-steps; the arrays are those of :func:`make_stimulus` + :func:`save_stimulus` (same codes,
-spikes, thresholds and ``meta``). :func:`open_stimulus` reads a file lazily: ``codes``
-and ``spikes`` are :class:`MemberArray` s, inflated a range of steps at a time (a
-sequential read never inflates a byte twice) and checked as they are read; every other
-member is small and read whole. The format is unchanged (a zip of ``.npy`` members, any
-deflate level or stored): files from before still load. Members are deflated at level
-:data:`COMPRESS_LEVEL` (``np.savez_compressed`` uses 6): measured on 4,000 steps of
-250x400 dog4, level 1 deflates codes at 86 MB/s (level 6: 16 MB/s) and spikes at 362
-MB/s (97 MB/s) for files 1.2x larger; inflating runs at 196 (codes) and 677 (spikes)
-MB/s whatever the level. An uncompressed archive (memory-mappable) would be 9x larger
-(2.4 GB for those 4,000 steps, 24 GB per second of camera time), and reading is far from
-the bottleneck (the long-run harness consumes about 20 MB/s).
+chunk of steps at a time: ``codes`` from the scene's brightness (+ dark current) through
+the ADC, then ``spikes`` from the fused fixed twin, each deflated into its zip member as
+it is made; the arrays are those of :func:`make_stimulus` + :func:`save_stimulus`. Any
+deflate level (or stored) reads: files from before still load. Members are deflated at
+level :data:`COMPRESS_LEVEL` (``np.savez_compressed`` uses 6): on 4,000 steps of 250x400
+dog4, level 1 deflates codes at 86 MB/s (level 6: 16) and spikes at 362 MB/s (97) for
+files 1.2x larger (2.4 GB uncompressed for those steps, 24 GB per second of camera time).
 """
 
 from __future__ import annotations
@@ -42,7 +37,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
-import threading
 import zipfile
 import zlib
 from collections.abc import Callable, Iterable, Iterator
@@ -52,11 +46,21 @@ from pathlib import Path
 import numpy as np
 import numpy.lib.format as npformat
 
-from rvsm.model.fixed.contract import SENSORS, ArrayContract
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
+from rvsm.model.fixed.stimulus_reader import MemberArray
+from rvsm.model.fixed.stimulus_validation import (
+    MEMBER_DIMS,
+    check_c_order,
+    checked_arrays,
+    first_inconsistency,
+    member_contract,
+    member_meta,
+    member_text,
+    value_check,
+)
 from rvsm.model.fixed.twin import simulate_fixed
-from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.atomic import atomic_path
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.integrity import verify_npz
@@ -117,8 +121,8 @@ class Stimulus:
                        f"a stimulus of {self.num_steps} steps read whole",
                        "replay it in the long-run harness (--harness chunk), which reads "
                        "it a chunk of steps at a time")
-        return dataclasses.replace(self, codes=_whole(self.codes, np.uint16),
-                                   spikes=_whole(self.spikes, np.int8))
+        return dataclasses.replace(self, codes=np.asarray(self.codes, dtype=np.uint16),
+                                   spikes=np.asarray(self.spikes, dtype=np.int8))
 
     def step_ranges(self, chunk_steps: int = IO_CHUNK_STEPS) -> Iterator[tuple[int, int, bool]]:
         """``(t0, t1, clear)``: consecutive ranges of at most ``chunk_steps`` steps, never
@@ -154,42 +158,10 @@ class Stimulus:
         return dataclasses.replace(self, spikes=spikes)
 
     def first_inconsistency(self) -> str | None:
-        """Where the file's parts disagree with each other, or None: the point's contract
-        against ``contract``; the expected ``spikes`` against what ``contract.run`` gives
-        from ``codes``, ``thresholds`` and ``clear_before`` (the first step, scale, row and
-        column that differ). Costs one fixed-twin run of the stimulus, chunk by chunk
-        (bounded memory: a lazy stimulus is read a chunk of steps at a time)."""
-        c = self.contract
-        if self.point is not None:
-            try:
-                from_point = self.point.with_size(c.height, c.width).contract()
-            except (RvsmError, ValueError, TypeError) as exc:
-                return f"its design point cannot make a contract ({exc})"
-            if from_point != c:
-                return "its design point and its contract disagree"
-        want_shape = (self.num_steps, c.num_scales, c.height, c.width)
-        if tuple(self.spikes.shape) != want_shape:
-            return (f"expected spikes have shape {tuple(self.spikes.shape)}, the codes need "
-                    f"{want_shape}")
-        if self.thresholds.shape != want_shape[1:]:
-            return f"thresholds have shape {self.thresholds.shape}, need {want_shape[1:]}"
-        bad_clear = [t for t in self.clear_before if not 0 <= t < max(self.num_steps, 1)]
-        if bad_clear:
-            return f"clear_before step {bad_clear[0]} is outside 0..{self.num_steps - 1}"
-        count, first = 0, None
-        for t0, _, want in self.expected_chunks():
-            got = np.asarray(self.spikes[t0:t0 + len(want)])
-            diff = np.argwhere(want != got)
-            count += len(diff)
-            if diff.size and first is None:
-                b, sc, y, x = (int(v) for v in diff[0])
-                first = (t0 + b, sc, y, x, int(got[b, sc, y, x]), int(want[b, sc, y, x]))
-        if first is None:
-            return None
-        t, sc, y, x, have, want_v = first
-        return (f"{count} expected spikes do not follow from its codes, thresholds and "
-                f"contract; the first at step {t}, scale {sc}, row {y}, column {x} (file "
-                f"{have}, contract {want_v})")
+        """Where the file's parts disagree with each other, or None
+        (:func:`~.stimulus_validation.first_inconsistency`: one fixed-twin run of the
+        stimulus, chunk by chunk)."""
+        return first_inconsistency(self)
 
     def first_steps(self, steps: int) -> Stimulus:
         """The same stimulus cut to its first ``steps`` steps (clears beyond them dropped;
@@ -217,151 +189,6 @@ def step_ranges(num_steps: int, clear_before: Iterable[int], chunk_steps: int
 def _head(arr, steps: int):
     """The first ``steps`` steps of an array or a :class:`MemberArray` (still lazy)."""
     return arr.head(steps) if isinstance(arr, MemberArray) else arr[:steps]
-
-
-def _whole(arr, dtype) -> np.ndarray:
-    """``arr`` in memory as ``dtype``."""
-    return np.asarray(arr, dtype=dtype)
-
-
-class MemberArray:
-    """An ``.npy`` member of a zip archive (a stimulus file's ``codes`` or ``spikes``),
-    read a range of its first axis at a time: ``a[t0:t1]`` inflates only those steps.
-
-    Reading forward continues where the last read stopped (a sequential pass inflates
-    the member once); reading backward restarts the member. ``check(chunk, t0)`` checks
-    every range read (the values a stimulus file may hold). ``np.asarray(a)`` reads it
-    whole (refused when it would not fit in memory). Safe to read from one thread at a
-    time (a lock serialises reads).
-    """
-
-    def __init__(self, path: str | os.PathLike, member: str, shape: tuple[int, ...],
-                 dtype: np.dtype, data_offset: int,
-                 check: Callable[[np.ndarray, int], None] | None = None) -> None:
-        self.path = Path(path)
-        self.member = member
-        self.shape = tuple(int(v) for v in shape)
-        self.dtype = np.dtype(dtype)
-        self.data_offset = int(data_offset)
-        self.check = check
-        self._row = int(np.prod(self.shape[1:], dtype=np.int64)) * self.dtype.itemsize
-        self._lock = threading.Lock()
-        self._archive: zipfile.ZipFile | None = None
-        self._handle = None
-        self._pos = 0
-
-    @property
-    def ndim(self) -> int:
-        """Number of dimensions."""
-        return len(self.shape)
-
-    @property
-    def size(self) -> int:
-        """Number of elements."""
-        return int(np.prod(self.shape, dtype=np.int64))
-
-    @property
-    def nbytes(self) -> int:
-        """Bytes of the whole array."""
-        return self.size * self.dtype.itemsize
-
-    def __len__(self) -> int:
-        return self.shape[0]
-
-    def __repr__(self) -> str:
-        return f"MemberArray({str(self.path)!r}, {self.member!r}, {self.shape}, {self.dtype})"
-
-    def head(self, steps: int) -> MemberArray:
-        """The first ``steps`` entries, still read on demand."""
-        steps = max(0, min(int(steps), self.shape[0]))
-        return MemberArray(self.path, self.member, (steps, *self.shape[1:]), self.dtype,
-                           self.data_offset, self.check)
-
-    def __getitem__(self, key):
-        rest = ()
-        if isinstance(key, tuple):
-            key, rest = (key[0], key[1:]) if key else (slice(None), ())
-        if isinstance(key, slice):
-            start, stop, step = key.indices(self.shape[0])
-            out = self.read(start, max(start, stop))[::step] if step > 0 else \
-                np.asarray(self)[key]
-        elif isinstance(key, (int, np.integer)):
-            k = int(key) + (self.shape[0] if key < 0 else 0)
-            if not 0 <= k < self.shape[0]:
-                raise IndexError(f"index {key} out of range for {self.shape[0]} steps")
-            out = self.read(k, k + 1)[0]
-        else:
-            out = np.asarray(self)[key]
-        return out[rest] if rest else out
-
-    def __array__(self, dtype=None, copy=None):
-        require_memory(self.nbytes, f"{self.path}: {self.member!r} {self.shape}",
-                       "read it a range of steps at a time")
-        out = self.read(0, self.shape[0])
-        return out if dtype is None else out.astype(dtype, copy=False)
-
-    def read(self, t0: int, t1: int) -> np.ndarray:
-        """Entries ``t0 .. t1 - 1`` of the first axis, a new array."""
-        if not 0 <= t0 <= t1 <= self.shape[0]:
-            raise RvsmError(f"{self.path}: steps {t0}..{t1} outside 0..{self.shape[0]}")
-        out = np.empty((t1 - t0, *self.shape[1:]), dtype=self.dtype)
-        if out.nbytes:
-            with self._lock:
-                try:
-                    self._seek(t0)
-                    self._fill(memoryview(out.reshape(-1).view(np.uint8)))
-                except (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError,
-                        NotImplementedError, RuntimeError) as exc:
-                    self.close()
-                    raise RvsmError(f"{self.path} is corrupt: member {self.member!r} of the "
-                                    f"stimulus file cannot be read ({exc})") from None
-                self._pos = t1
-        if self.check is not None:
-            self.check(out, t0)
-        return out
-
-    def _seek(self, t0: int) -> None:
-        if self._handle is None or t0 < self._pos:
-            self.close()
-            self._archive = zipfile.ZipFile(self.path)
-            self._handle = self._archive.open(self.member)
-            self._skip(self.data_offset)
-            self._pos = 0
-        self._skip((t0 - self._pos) * self._row)
-        self._pos = t0
-
-    def _skip(self, nbytes: int) -> None:
-        while nbytes > 0:
-            got = self._handle.read(min(nbytes, 1 << 20))
-            if not got:
-                raise EOFError(f"{nbytes} bytes missing")
-            nbytes -= len(got)
-
-    def _fill(self, view: memoryview) -> None:
-        done = 0
-        while done < len(view):
-            got = self._handle.readinto(view[done:])
-            if not got:
-                raise EOFError(f"{len(view) - done} bytes missing")
-            done += got
-
-    def close(self) -> None:
-        """Close the open member (reads open it again)."""
-        if self._handle is not None:
-            self._handle.close()
-        if self._archive is not None:
-            self._archive.close()
-        self._handle = self._archive = None
-        self._pos = 0
-
-    def __getstate__(self) -> dict:
-        state = dict(self.__dict__)
-        state.update(_lock=None, _archive=None, _handle=None, _pos=0)
-        return state
-
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state)
-        self._lock = threading.Lock()
 
 
 def _check_steps(scene: Scene, num_steps: int | None) -> Scene:
@@ -566,11 +393,6 @@ def load_stimulus(path: str | os.PathLike) -> Stimulus:
     return open_stimulus(path).loaded()
 
 
-_MEMBER_DIMS = {"codes": 3, "thresholds": 3, "spikes": 4, "weights": None,
-                "half_widths": None, "contract": 0, "point": 0, "meta": 0,
-                "clear_before": None}
-
-
 def open_stimulus(path: str | os.PathLike) -> Stimulus:
     """Open a stimulus file lazily: its ``codes`` and ``spikes`` are
     :class:`MemberArray` s read a range of steps at a time (and checked as they are
@@ -581,7 +403,7 @@ def open_stimulus(path: str | os.PathLike) -> Stimulus:
     p = Path(path)
     if not p.is_file():
         raise RvsmError(f"stimulus file {p} does not exist")
-    check_npz_members(p, _MEMBER_DIMS, lazy=LAZY_KEYS)
+    check_npz_members(p, MEMBER_DIMS, lazy=LAZY_KEYS)
     verify_npz(p, "stimulus file")
     try:
         with zipfile.ZipFile(p) as archive:
@@ -605,125 +427,17 @@ def open_stimulus(path: str | os.PathLike) -> Stimulus:
         raise
     except (OSError, ValueError, zipfile.BadZipFile, EOFError, zlib.error) as exc:
         raise RvsmError(f"{p} is not a readable stimulus file: {exc}") from None
-    contract = _contract(arrays["contract"], str(p))
-    point_text = _text(arrays["point"], "point", str(p))
+    contract = member_contract(arrays["contract"], str(p))
+    point_text = member_text(arrays["point"], "point", str(p))
     point = parse_design_point(point_text, str(p)) if point_text else None
-    try:
-        meta = json.loads(_text(arrays["meta"], "meta", str(p)))
-    except json.JSONDecodeError as exc:
-        raise RvsmError(f"{p}: 'meta' is not valid JSON ({exc})") from None
-    if not isinstance(meta, dict):
-        raise RvsmError(f"{p}: 'meta' must be a JSON object")
+    meta = member_meta(arrays["meta"], str(p))
     for k in LAZY_KEYS:
         layout = arrays[k]
-        if layout.fortran_order and len(layout.shape) > 1:
-            raise RvsmError(f"{p}: {k!r} is stored in Fortran order; rvsm stimulus files "
-                            f"are C-ordered (write it again with save_stimulus)")
+        check_c_order(k, layout.fortran_order, layout.shape, str(p))
         arrays[k] = MemberArray(p, f"{k}.npy", layout.shape, layout.dtype, layout.offset,
-                                _value_check(k, contract, str(p)))
-    codes, thresholds, spikes, clears = _arrays(arrays, contract, str(p))
+                                value_check(k, contract, str(p)))
+    codes, thresholds, spikes, clears = checked_arrays(arrays, contract, str(p))
     return Stimulus(codes=codes, thresholds=thresholds, spikes=spikes, contract=contract,
                     point=point, meta=meta, clear_before=clears)
 
 
-def _value_check(name: str, c: ArrayContract, source: str
-                 ) -> Callable[[np.ndarray, int], None]:
-    """The check of every range of ``codes`` or ``spikes`` read from a file."""
-    top = unsigned_max(c.adc_bits)
-
-    def codes(chunk: np.ndarray, t0: int) -> None:
-        if chunk.size and (int(chunk.min()) < 0 or int(chunk.max()) > top):
-            raise RvsmError(f"{source}: codes outside the {c.adc_bits}-bit ADC range")
-
-    def spikes(chunk: np.ndarray, t0: int) -> None:
-        if chunk.size and (int(chunk.min()) < -1 or int(chunk.max()) > 1):
-            raise RvsmError(f"{source}: expected spikes must lie in {{-1, 0, 1}}")
-
-    return codes if name == "codes" else spikes
-
-
-#: Bounds a stimulus file's contract must keep (what the RTL generator takes).
-_CONTRACT_LIMITS = {"height": (1, 1 << 16), "width": (1, 1 << 16), "adc_bits": (1, 16),
-                    "shift": (0, 62), "accumulator_bits": (2, 62)}
-_RESETS = ("zero", "subtract")
-
-
-def _text(value: np.ndarray, name: str, source: str) -> str:
-    """A 0-d string member's text."""
-    if value.ndim != 0 or value.dtype.kind not in "US":
-        raise RvsmError(f"{source}: {name!r} must be a text scalar, got {value.dtype} "
-                        f"{value.shape}")
-    return str(value)
-
-
-def _contract(value: np.ndarray, source: str) -> ArrayContract:
-    """The file's ``contract`` member, checked field by field."""
-    try:
-        raw = json.loads(_text(value, "contract", source))
-    except json.JSONDecodeError as exc:
-        raise RvsmError(f"{source}: 'contract' is not valid JSON ({exc})") from None
-    fields = {f.name for f in dataclasses.fields(ArrayContract)}
-    if not isinstance(raw, dict) or set(raw) - fields or \
-            fields - {"reset", "sensor"} - set(raw):
-        raise RvsmError(f"{source}: 'contract' must be an object with the fields "
-                        f"{', '.join(sorted(fields))}")
-    for name, (lo, hi) in _CONTRACT_LIMITS.items():
-        v = raw[name]
-        if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
-            raise RvsmError(f"{source}: contract {name} must be an integer in {lo}..{hi}, "
-                            f"got {v!r}")
-    if not isinstance(raw["signed"], bool) or raw.get("reset", "zero") not in _RESETS:
-        raise RvsmError(f"{source}: contract signed must be true/false and reset one of "
-                        f"{_RESETS}")
-    if raw.get("sensor", "spike") not in SENSORS:
-        raise RvsmError(f"{source}: contract sensor must be one of {SENSORS}, got "
-                        f"{raw.get('sensor')!r}")
-    raw["weights"] = _kernels(raw["weights"], source)
-    return ArrayContract(**raw)
-
-
-def _kernels(value: object, source: str) -> tuple:
-    """Integer kernels: 1 to 4 odd square matrices of integers below 2**31 in size."""
-    ok = isinstance(value, list) and 1 <= len(value) <= 4
-    kernels = []
-    for k in value if ok else ():
-        n = len(k) if isinstance(k, list) else 0
-        ok = ok and n % 2 == 1 and n <= 63 and all(
-            isinstance(row, list) and len(row) == n and all(
-                isinstance(v, int) and not isinstance(v, bool) and abs(v) < 1 << 31
-                for v in row) for row in k)
-        if ok:
-            kernels.append(tuple(tuple(int(v) for v in row) for row in k))
-    if not ok:
-        raise RvsmError(f"{source}: contract weights must be 1 to 4 odd square matrices of "
-                        f"integers")
-    return tuple(kernels)
-
-
-def _arrays(arrays: dict, c: ArrayContract, source: str) -> tuple:
-    """``codes``, ``thresholds``, ``spikes`` and ``clear_before`` checked against the
-    contract (shapes, integer dtypes, value ranges: those of a :class:`MemberArray` as
-    it is read)."""
-    codes, thresholds, spikes = arrays["codes"], arrays["thresholds"], arrays["spikes"]
-    for name, arr in (("codes", codes), ("thresholds", thresholds), ("spikes", spikes)):
-        if arr.dtype.kind not in "iu":
-            raise RvsmError(f"{source}: {name!r} must hold integers, got {arr.dtype}")
-    t = codes.shape[0] if codes.ndim == 3 else -1
-    want = {"codes": (t, c.height, c.width), "thresholds": (c.num_scales, c.height, c.width),
-            "spikes": (t, c.num_scales, c.height, c.width)}
-    for name, arr in (("codes", codes), ("thresholds", thresholds), ("spikes", spikes)):
-        if tuple(arr.shape) != want[name]:
-            raise RvsmError(f"{source}: {name!r} has shape {tuple(arr.shape)}, the contract needs "
-                            f"{want[name]}")
-    if not isinstance(codes, MemberArray):
-        _value_check("codes", c, source)(codes, 0)
-    top = unsigned_max(c.threshold_bits)
-    if thresholds.size and (int(thresholds.min()) < 0 or int(thresholds.max()) > top):
-        raise RvsmError(f"{source}: thresholds outside 0..{top}")
-    if not isinstance(spikes, MemberArray):
-        _value_check("spikes", c, source)(spikes, 0)
-        spikes = spikes.astype(np.int8)
-    clears = arrays.get("clear_before", np.zeros(0, np.int64))
-    if clears.dtype.kind not in "iu" or clears.ndim != 1:
-        raise RvsmError(f"{source}: 'clear_before' must be a 1-d integer array")
-    return codes, thresholds.astype(np.int64), spikes, tuple(int(v) for v in clears)

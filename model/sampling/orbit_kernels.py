@@ -1,4 +1,5 @@
-"""Unrolled orbit sums for numba (written by scripts/gen_orbit_kernels.py; do not edit).
+"""Unrolled orbit sums for numba (written by python -m
+rvsm.model.sampling.kernel_generator; do not edit).
 
 ``scale_sum_L(pairs, pr, w, width, out)``: ``out[x]`` = the receptive sum of padded row
 ``pr`` for one scale of half-width ``L`` with orbit weights ``w``, where

@@ -2,12 +2,16 @@
 registered architecture (:mod:`rvsm.rtl.architectures.registry`).
 
 * :func:`generate_verilog` converts an architecture's component with Amaranth's bundled
-  (WebAssembly) yosys, ``emit_src=False`` (no source-location attributes), and leaves
-  out all-zero memory initialisers (:func:`strip_zero_memory_init`: no array relies on
-  memory contents at power-up; the streaming array's accumulators read as zero in the
-  first frame after reset or ``clear``, line-buffer rows outside the frame are masked
-  and thresholds must be loaded; at sensor size those ``initial`` blocks were most of
-  the file).
+  (WebAssembly) yosys, ``emit_src=False`` (no source-location attributes), without
+  all-zero memory initialisers (no array relies on memory contents at power-up; the
+  streaming array's accumulators read as zero in the first frame after reset or
+  ``clear``, line-buffer rows outside the frame are masked and thresholds are written
+  to the top rail or loaded; at sensor size those ``initial`` blocks were most of the
+  file): its memories become yosys ``$mem`` cells whose all-zero contents are never
+  built (:func:`~rvsm.rtl.verilog_memories.convert_verilog`, the same text as
+  Amaranth's converter followed by :func:`strip_zero_memory_init`, in a third of the
+  time at sensor size); the text rule :func:`strip_zero_memory_init` still removes the
+  ``initial`` blocks of any memory left to Amaranth.
 * :func:`write_outputs` writes ``<top>.v`` (a provenance header and ``timescale`` first),
   ``<top>.ports.json`` (architecture, top, latency, the architecture's timing and
   memories, ports, ``provenance``), ``<top>.ports.md`` (the port map, with flat-vector
@@ -32,7 +36,6 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from amaranth.back import verilog as amaranth_verilog
 from amaranth.lib import wiring
 
 from rvsm.model.fixed.contract import ArrayContract
@@ -51,6 +54,7 @@ from rvsm.rtl.flow_files import (
 )
 from rvsm.rtl.ports import verilog_ports
 from rvsm.rtl.toolchain import ToolFailure, run_tool
+from rvsm.rtl.verilog_memories import convert_verilog
 
 __all__ = [
     "OUTPUT_SUFFIXES",
@@ -89,8 +93,8 @@ class GeneratedVerilog:
     seconds: float
 
 
-_ZERO_INIT = re.compile(
-    r"^[ \t]*initial begin\n(?:[ \t]*\\?[\w$.]+ ?\[\d+\] = \d+'h0+;\n)+[ \t]*end\n",
+_ZERO_INIT = re.compile(  # yosys writes a word of up to 32 bits in decimal, wider in hex
+    r"^[ \t]*initial begin\n(?:[ \t]*\\?[\w$.]+ ?\[\d+\] = \d+'[hd]0+;\n)+[ \t]*end\n",
     re.MULTILINE)
 
 
@@ -99,7 +103,9 @@ def strip_zero_memory_init(text: str) -> tuple[str, int]:
 
     The documented rule for leaving out all-zero memory initialisers (no array relies on
     power-up memory contents): only blocks made entirely of all-zero memory-word
-    assignments are removed, so any non-zero initial contents stay.
+    assignments are removed, so any non-zero initial contents stay. One regular
+    expression pass, linear in the text (0.06 s on the 5.8 MB of a 250x400 P=40 array
+    converted by Amaranth alone).
     """
     return _ZERO_INIT.subn("", text)
 
@@ -118,7 +124,7 @@ def generate_verilog(
     top = check_top(top or a.default_top)
     t0 = time.perf_counter()
     dut = a.component(contract, **a.resolve(options)) if component is None else component
-    text = amaranth_verilog.convert(dut, name=top, emit_src=False, ports=verilog_ports(dut))
+    text = convert_verilog(dut, top, verilog_ports(dut))
     text, _ = strip_zero_memory_init(text)
     return GeneratedVerilog(text, top, dut.latency, time.perf_counter() - t0)
 

@@ -47,7 +47,7 @@ from amaranth.hdl import Array, Cat, Const, Module, Mux, Signal
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.rtl.capabilities import require_spike_sensor
 from rvsm.rtl.formal_harness import ElaborateAfter, FormalHarness, Property
-from rvsm.rtl.linear_form import linear_form
+from rvsm.rtl.linear_form import linear_forms
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.array import RvsmArray, accumulator_index, receptive_taps
 from rvsm.rtl.receptive_sum import weighted_sum
@@ -142,7 +142,8 @@ class StreamSumLemma(FormalHarness):
       position, scale and lane, that register-free expression, with the window cells
       outside the array at 0, and the parallel array's :func:`weighted_sum` over
       :func:`receptive_taps` (the expression :class:`RvsmArray` builds) are the same
-      linear form in the pixels' codes modulo ``2**W`` (:func:`linear_form`).
+      linear form in the pixels' codes modulo ``2**W`` (:func:`linear_forms`, read from
+      the netlist of those expressions).
     """
 
     provable = False
@@ -210,27 +211,35 @@ class StreamSumLemma(FormalHarness):
         flat = _Unregistered(m, None, geo.LEVELS_PER_STAGE, name="flat")
         direct, _ = geo.stage_q_sums(flat, {cell: flat.timed(code, 1)
                                             for cell, code in cells.items()})
-        cell_leaf = {id(sig): cell for cell, sig in cells.items()}
-        pix_leaf = {id(pix[y][x]): (y, x) for y in range(h) for x in range(w)}
-        failures = []
+        leaves = {("cell", *cell): sig for cell, sig in cells.items()}
+        leaves.update({("pixel", y, x): pix[y][x] for y in range(h) for x in range(w)})
+        values = []  # per scale: the lanes' stream sums, then every position's parallel sum
         for s in range(c.num_scales):
             lo, hi = c.sum_range(s)
-            width = geo.sum_bits(s)
-            stream_form = [linear_form(direct[i][s].value, cell_leaf) for i in range(p)]
+            values += [direct[i][s].value for i in range(p)]
             for a in range(geo.beats_per_frame):
                 for i in range(p):
                     y, x = a // g_count, (a % g_count) * p + i
                     taps = receptive_taps(c, s, y, x)
-                    par = linear_form(weighted_sum([pix[yy][xx] for (yy, xx), _ in taps],
-                                                   [wt for _, wt in taps], lo, hi),
-                                      pix_leaf)
+                    values.append(weighted_sum([pix[yy][xx] for (yy, xx), _ in taps],
+                                               [wt for _, wt in taps], lo, hi))
+        forms = iter(linear_forms(values, leaves))  # one netlist of them all
+        failures = []
+        for s in range(c.num_scales):
+            width = geo.sum_bits(s)
+            stream_form = [next(forms) for _ in range(p)]
+            for a in range(geo.beats_per_frame):
+                for i in range(p):
+                    y, x = a // g_count, (a % g_count) * p + i
+                    par = next(forms)
                     st = stream_form[i]
                     # the window lemma's map: cell (d, j) holds pixel (y+d-r, x-i+j-r)
                     coefs: dict[tuple[int, int], int] = {}
-                    for (d, j), coef in st.coefs.items():
+                    for (_, d, j), coef in st.coefs.items():
                         yy, xx = y + d - r, x - i + j - r
                         if 0 <= yy < h and 0 <= xx < w:
                             coefs[(yy, xx)] = coef
+                    par_coefs = {(yy, xx): coef for (_, yy, xx), coef in par.coefs.items()}
                     where = f"scale {s}, position {a} (row {y}, column {x}), lane {i}"
                     for name, f in (("stream", st), ("parallel", par)):
                         if f.bits is not None and f.bits < width:
@@ -241,8 +250,8 @@ class StreamSumLemma(FormalHarness):
                         failures.append(("sums.linear_forms", (
                             f"{where}: constant {st.const} in the stream's sum, "
                             f"{par.const} in the parallel array's")))
-                    for pixel in sorted(set(coefs) | set(par.coefs)):
-                        cs, cp = coefs.get(pixel, 0), par.coefs.get(pixel, 0)
+                    for pixel in sorted(set(coefs) | set(par_coefs)):
+                        cs, cp = coefs.get(pixel, 0), par_coefs.get(pixel, 0)
                         if cs != cp:
                             failures.append(("sums.linear_forms", (
                                 f"{where}: pixel {pixel} has weight {cs} in the stream's "

@@ -18,7 +18,6 @@ import pytest
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.fixed.point_toml import design_point_toml
 from rvsm.model.fixed.stimulus import (
-    MemberArray,
     Stimulus,
     load_stimulus,
     make_stimulus,
@@ -27,6 +26,7 @@ from rvsm.model.fixed.stimulus import (
     write_stimulus,
 )
 from rvsm.model.fixed.stimulus_chunks import StimulusChunks, open_stimulus_chunks
+from rvsm.model.fixed.stimulus_reader import MemberArray
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.versions import with_versions
 from rvsm.model.scene.loaders import load_scene

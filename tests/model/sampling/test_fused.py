@@ -1,6 +1,5 @@
 """The fused numba float sampler against the numpy reference engine: identical spikes."""
 
-import sys
 from pathlib import Path
 
 import numba
@@ -11,6 +10,7 @@ from rvsm.model.kernels.filtering import receptive_field_sums
 from rvsm.model.kernels.orbits import kernel_orbits, orbit_receptive_sums
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES, model_spec
 from rvsm.model.noise.sensor import NoiseParams
+from rvsm.model.sampling import kernel_generator
 from rvsm.model.sampling.config import SamplerConfig
 from rvsm.model.sampling.fused import filter_frames, view_spans
 from rvsm.model.sampling.twin import sample, stream_float
@@ -116,15 +116,22 @@ def test_orbit_sums_match_the_numpy_order_and_the_filter():
 
 
 def test_generated_orbit_kernels_are_up_to_date():
-    sys.path.insert(0, str(ROOT / "scripts"))
-    try:
-        import gen_orbit_kernels
-    finally:
-        sys.path.pop(0)
     text = (ROOT / "model" / "sampling" / "orbit_kernels.py").read_text()
-    assert text == gen_orbit_kernels.generate()
+    assert text == kernel_generator.generate()
     text = (ROOT / "model" / "events" / "ladder_kernels.py").read_text()
-    assert text == gen_orbit_kernels.generate_events()
+    assert text == kernel_generator.generate_events()
+
+
+def test_kernel_generator_writes_both_files(tmp_path):
+    """``python -m rvsm.model.sampling.kernel_generator`` writes what the test above
+    compares, under the package folder it is given."""
+    for folder in ("sampling", "events"):
+        (tmp_path / folder).mkdir()
+    written = kernel_generator.write_kernels(tmp_path)
+    assert written == [tmp_path / "sampling" / "orbit_kernels.py",
+                       tmp_path / "events" / "ladder_kernels.py"]
+    assert written[0].read_text() == kernel_generator.generate()
+    assert written[1].read_text() == kernel_generator.generate_events()
 
 
 def test_bad_engine_and_chunking_are_refused():

@@ -62,3 +62,16 @@ def test_yosys_stats(generated: tuple[Path, object], capsys: pytest.CaptureFixtu
     assert st["flip_flops"] >= 6 * (c.accumulator_bits + c.threshold_bits)
     assert st["cells"] > st["flip_flops"]
     assert st["memories"] == 0 and st["memory_bits"] == 0  # its state is flip-flops
+
+
+def test_strip_removes_decimal_and_hex_zero_words_only() -> None:
+    """yosys writes a word of up to 32 bits in decimal (``32'd0``), a wider one in hex:
+    both all-zero blocks go, a block with any non-zero word stays whole."""
+    from rvsm.rtl.architectures.verilog import strip_zero_memory_init
+
+    text = ("  initial begin\n    a[0] = 32'd0;\n    a[1] = 32'd0;\n  end\n"
+            "  initial begin\n    b[0] = 40'h0000000000;\n  end\n"
+            "  initial begin\n    c[0] = 4'd0;\n    c[1] = 4'd3;\n  end\n")
+    stripped, n = strip_zero_memory_init(text)
+    assert n == 2
+    assert stripped == "  initial begin\n    c[0] = 4'd0;\n    c[1] = 4'd3;\n  end\n"

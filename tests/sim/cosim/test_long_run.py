@@ -167,7 +167,8 @@ def test_replay_of_a_stimulus_file_in_the_long_run_harness(
     time (never whole: ``MemberArray.__array__`` is refused), with ``--steps`` and
     ``--recompute-expected`` passed to the testbench in its spec; a wrong spike is a bad
     stimulus (2) found chunk by chunk before any simulator runs."""
-    from rvsm.model.fixed.stimulus import MemberArray, save_stimulus
+    from rvsm.model.fixed.stimulus import save_stimulus
+    from rvsm.model.fixed.stimulus_reader import MemberArray
 
     c = default_design_point().with_size(6, 8).contract()
     stim = _random_stimulus(dataclasses.replace(c, weights=c.weights[:2]), 20, 4,

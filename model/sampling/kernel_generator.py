@@ -1,11 +1,13 @@
-#!/usr/bin/env python3
-"""Write ``model/sampling/orbit_kernels.py``: the per-half-width orbit sums and the ladder
-sums (every scale of a ``1..S`` ladder in one pass), unrolled for numba; and
-``model/events/ladder_kernels.py``: the ladder sums with the event rule of every scale in
-the same loop, for one output row or two a pass (the RVSM-DVS fused engine's step).
+"""The generator of the unrolled numba kernels: :func:`generate` is the source of
+``model/sampling/orbit_kernels.py`` (the per-half-width orbit sums and the ladder sums,
+every scale of a ``1..S`` ladder in one pass), :func:`generate_events` that of
+``model/events/ladder_kernels.py`` (the ladder sums with the event rule of every scale in
+the same loop, for one output row or two a pass: the RVSM-DVS fused engine's step).
 
-Run ``python scripts/gen_orbit_kernels.py`` after changing the orbit order in
-``model/kernels/orbits.py``; ``tests/model/sampling/test_fused.py`` checks the file is up to date.
+Run ``python -m rvsm.model.sampling.kernel_generator`` after changing the orbit order in
+``model/kernels/orbits.py`` (it rewrites both files);
+``tests/model/sampling/test_fused.py`` checks that they are up to date. Text only: it
+imports neither kernel module, so it runs whatever state they are in.
 """
 
 from __future__ import annotations
@@ -14,8 +16,11 @@ import re
 import sys
 from pathlib import Path
 
+from rvsm.model.infra.atomic import write_text_atomic
+
 MAX_HALF = 4
-HEADER = '''"""Unrolled orbit sums for numba (written by scripts/gen_orbit_kernels.py; do not edit).
+HEADER = '''"""Unrolled orbit sums for numba (written by python -m
+rvsm.model.sampling.kernel_generator; do not edit).
 
 ``scale_sum_L(pairs, pr, w, width, out)``: ``out[x]`` = the receptive sum of padded row
 ``pr`` for one scale of half-width ``L`` with orbit weights ``w``, where
@@ -121,7 +126,8 @@ def ladder_sum(scales: int) -> list[str]:
     return lines
 
 
-EVENTS_HEADER = '''"""Ladder sums and event rule, one loop (scripts/gen_orbit_kernels.py wrote it).
+EVENTS_HEADER = '''"""Ladder sums and event rule, one loop (written by python -m
+rvsm.model.sampling.kernel_generator; do not edit).
 
 ``ladder_events_S(pairs, pr, ring, w, width, thr, ref, ev, y)``: every scale's receptive
 sum of padded row ``pr`` exactly as
@@ -207,11 +213,27 @@ def generate_events() -> str:
     return "\n".join(out).rstrip("\n") + "\n"
 
 
+#: The generated files, relative to the ``rvsm.model`` package folder, and their sources.
+TARGETS = {("sampling", "orbit_kernels.py"): generate,
+           ("events", "ladder_kernels.py"): generate_events}
+#: The ``rvsm.model`` package folder.
+MODEL_DIR = Path(__file__).resolve().parents[1]
+
+
+def write_kernels(model_dir: str | Path = MODEL_DIR) -> list[Path]:
+    """Write every file of :data:`TARGETS` under ``model_dir`` (the ``rvsm.model``
+    package folder by default), atomically; their paths."""
+    written = []
+    for parts, source in TARGETS.items():
+        target = Path(model_dir).joinpath(*parts)
+        write_text_atomic(target, source())
+        written.append(target)
+    return written
+
+
 def main() -> None:
-    root = Path(__file__).resolve().parent.parent
-    for target, text in ((root / "model" / "sampling" / "orbit_kernels.py", generate()),
-                         (root / "model" / "events" / "ladder_kernels.py", generate_events())):
-        target.write_text(text)
+    """``python -m rvsm.model.sampling.kernel_generator``: rewrite the generated files."""
+    for target in write_kernels():
         print(f"wrote {target}", file=sys.stderr)
 
 
