@@ -13,7 +13,7 @@ at the next edge, for memory targets that register their enables; 0 in reset).
 from __future__ import annotations
 
 import numpy as np
-from amaranth.hdl import Module, Mux, ResetSignal, unsigned
+from amaranth.hdl import Module, Mux, ResetSignal, Signal, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -53,8 +53,10 @@ class InputStage(wiring.Component):
             taken = ~self.clear  # a stalled cycle repeats the last beat
         m.d.sync += [self.ctl.advance.eq(taken), self.ctl.clear.eq(self.clear)]
         m.d.comb += self.ctl.advance_next.eq(Mux(ResetSignal(), 0, taken))
+        beat = Signal.like(self.beat, name="codes_r", reset_less=True)  # datapath
         with m.If(self.codes.valid & ~self.clear):
-            m.d.sync += self.beat.eq(self.codes.payload.as_value())
+            m.d.sync += beat.eq(self.codes.payload.as_value())
+        m.d.comb += self.beat.eq(beat)
         return m
 
     @staticmethod
