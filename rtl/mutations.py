@@ -28,34 +28,37 @@ class Mutation:
 
 
 #: Every mutation, by name.
-_ARRAY = "rtl/stream/array.py"
+_INPUT = "rtl/stream/input_stage.py"
+_WINDOW = "rtl/stream/window_stage.py"
+_STATE = "rtl/stream/state_stage.py"
+_OUTPUT = "rtl/stream/output_stage.py"
 _CELL = "rtl/parallel/pixel_cell.py"
 MUTATIONS: dict[str, Mutation] = {m.name: m for m in (
-    Mutation("stream.threshold_off_by_one", "stream", _ARRAY,
+    Mutation("stream.threshold_off_by_one", "stream", _OUTPUT,
              "fire +1 when the total exceeds the threshold (> instead of >=)"),
-    Mutation("stream.no_saturation", "stream", _ARRAY,
+    Mutation("stream.no_saturation", "stream", _OUTPUT,
              "no saturation: an overflowing accumulator wraps around"),
-    Mutation("stream.no_reset_on_spike", "stream", _ARRAY,
+    Mutation("stream.no_reset_on_spike", "stream", _OUTPUT,
              "keep the accumulator after a spike (missed reset)"),
-    Mutation("stream.zero_instead_of_subtract", "stream", _ARRAY,
+    Mutation("stream.zero_instead_of_subtract", "stream", _OUTPUT,
              "reset to zero where the contract subtracts the threshold"),
-    Mutation("stream.no_negative_spikes", "stream", _ARRAY,
+    Mutation("stream.no_negative_spikes", "stream", _OUTPUT,
              "never fire -1 (the negative compare left out)"),
-    Mutation("stream.stale_threshold", "stream", _ARRAY,
+    Mutation("stream.stale_threshold", "stream", _OUTPUT,
              "compare with the previous position's threshold (a stale threshold read)"),
-    Mutation("stream.no_threshold_forwarding", "stream", _ARRAY,
+    Mutation("stream.no_threshold_forwarding", "stream", _STATE,
              "a threshold write meeting a read of its word is not forwarded"),
-    Mutation("stream.shift_off_by_one", "stream", _ARRAY,
+    Mutation("stream.shift_off_by_one", "stream", _OUTPUT,
              "shift the receptive sum one bit too far"),
-    Mutation("stream.swapped_lanes", "stream", _ARRAY,
+    Mutation("stream.swapped_lanes", "stream", _OUTPUT,
              "lanes 0 and 1 of every scale swapped on the output (P >= 2)"),
-    Mutation("stream.top_padding_off_by_one", "stream", _ARRAY,
+    Mutation("stream.top_padding_off_by_one", "stream", _WINDOW,
              "the top border's zero-padding mask lets one row too many through"),
-    Mutation("stream.right_padding_off_by_one", "stream", _ARRAY,
+    Mutation("stream.right_padding_off_by_one", "stream", _WINDOW,
              "the right border's zero-padding mask lets one column group through"),
-    Mutation("stream.advance_during_stall", "stream", _ARRAY,
+    Mutation("stream.advance_during_stall", "stream", _INPUT,
              "the pipeline advances while the input stalls (a beat duplicated)"),
-    Mutation("stream.clear_forgets_scale0", "stream", _ARRAY,
+    Mutation("stream.clear_forgets_scale0", "stream", _OUTPUT,
              "after a clear, scale 0 reads its old accumulators (a bank not cleared)"),
     Mutation("parallel.threshold_off_by_one", "parallel", _CELL,
              "fire +1 when the saturated total exceeds the threshold (> instead of >=)"),

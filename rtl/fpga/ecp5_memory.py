@@ -6,10 +6,12 @@ a register after it in fabric flip-flops, so the block RAM's slow clock-to-out (
 at speed grade 6) starts the next path. :class:`Ecp5BlockRam` instead instantiates the
 DP16KD primitives itself with ``REGMODE_B = "OUTREG"``: the same two registered stages
 (the read latch, then the output register), both inside the block RAM, so the fabric
-sees a short clock-to-out. It is elaborated in place of the generic banks of
-:class:`~rvsm.rtl.stream.banked_memory.BankedMemory` when a design is converted with
-``platform=ECP5_PLATFORM`` (what ``rvsm fpga`` does by default); simulation, formal and
-``rvsm verilog`` keep the generic memories.
+sees a short clock-to-out. It is the bank of :data:`ECP5_BLOCK_RAMS`, the
+:class:`~rvsm.rtl.stream.memory_target.MemoryTarget` of the ECP5 build: the streaming
+array takes it as a parameter (``RvsmStreamArray(..., memory=ECP5_BLOCK_RAMS)``) or from
+the platform it is elaborated for (:data:`ECP5_PLATFORM`, whose ``memory_target`` it is:
+what ``rvsm fpga`` converts with by default, so every array inside a wrapper gets it
+too); simulation, formal and ``rvsm verilog`` keep the generic memories.
 
 Configuration (one primitive per 18 bits of the word, side by side): port A writes, port
 B reads, both 18 bits wide (1024 words: ``AD[13:4]`` is the word address, ``ADA[1:0]``
@@ -48,16 +50,13 @@ from __future__ import annotations
 
 from amaranth.hdl import Cat, ClockSignal, Const, Instance, Module, Signal, Value, unsigned
 from amaranth.lib import wiring
-from amaranth.lib.wiring import In, Out
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.stream.memory_target import bank_signature
 
-__all__ = ["DP16KD_DEPTH", "DP16KD_WIDTH", "ECP5_PLATFORM", "Ecp5BlockRam", "dp16kd_count",
-           "initval", "kept_register"]
+__all__ = ["DP16KD_DEPTH", "DP16KD_WIDTH", "ECP5_BLOCK_RAMS", "ECP5_PLATFORM", "Ecp5BlockRam",
+           "Ecp5BlockRams", "Ecp5Platform", "dp16kd_count", "initval", "kept_register"]
 
-#: The ``platform`` value that makes :class:`~rvsm.rtl.stream.banked_memory.BankedMemory`
-#: elaborate :class:`Ecp5BlockRam` banks (``verilog.convert(..., platform=ECP5_PLATFORM)``).
-ECP5_PLATFORM = "ecp5"
 #: Data bits and words of one DP16KD in the configuration used.
 DP16KD_WIDTH = 18
 DP16KD_DEPTH = 1024
@@ -101,15 +100,17 @@ def kept_register(m: Module, d: Value, name: str, en: Value | None = None) -> Si
 
 class Ecp5BlockRam(wiring.Component):
     """``depth`` (at most 1024) words of ``width`` bits in ``ceil(width / 18)`` DP16KD with
-    the output register on (see the module docstring).
+    the output register on (see the module docstring): a bank of
+    :func:`~rvsm.rtl.stream.memory_target.bank_signature`.
 
-    Ports: ``write_en``, ``write_addr``, ``write_data`` (port A); ``read_addr`` (port
-    B); ``advance_next`` (the read and output registers' enable one edge ahead, module
-    docstring)
-    and ``data`` (the output register). ``init_word``: every word's value at
-    configuration. ``write_ahead=True`` adds ``write_en_next``: the write enable one
-    edge ahead, registered per primitive (:func:`kept_register`) and ANDed with
-    ``write_en`` (then a bank select, constant 1 for a single bank).
+    Ports used: ``write_en``, ``write_addr``, ``write_data`` (port A); ``read_addr``
+    (port B); ``advance_next`` (the read and output registers' enable one edge ahead,
+    module docstring) and ``data`` (the output register). ``advance`` and ``read_gate``
+    are left unused (the enables come one edge ahead; collisions are not gated).
+    ``init_word``: every word's value at configuration. ``write_ahead=True`` adds
+    ``write_en_next``: the write enable one edge ahead, registered per primitive
+    (:func:`kept_register`) and ANDed with ``write_en`` (then a bank select, constant 1
+    for a single bank).
     """
 
     def __init__(self, width: int, depth: int, init_word: int = 0,
@@ -123,13 +124,7 @@ class Ecp5BlockRam(wiring.Component):
         self.write_ahead = write_ahead
         #: Primitives side by side (DP16KD).
         self.primitives = dp16kd_count(width)
-        addr = unsigned(max(1, (depth - 1).bit_length()))
-        super().__init__({
-            "write_en": In(1), "write_addr": In(addr), "write_data": In(unsigned(width)),
-            "read_addr": In(addr), "advance_next": In(1),
-            "data": Out(unsigned(width)),
-            **({"write_en_next": In(1)} if write_ahead else {}),
-        })
+        super().__init__(bank_signature(width, depth, held_write=write_ahead))
 
     def elaborate(self, platform: object) -> Module:
         """The DP16KD instances; slice ``k`` holds bits ``[18k, 18k+18)`` of every word."""
@@ -184,3 +179,42 @@ class Ecp5BlockRam(wiring.Component):
             outs.append(do[:n])
         m.d.comb += self.data.eq(Cat(*outs))
         return m
+
+
+class Ecp5BlockRams:
+    """The ECP5 build's :class:`~rvsm.rtl.stream.memory_target.MemoryTarget`:
+    :class:`Ecp5BlockRam` banks; the accumulators write where their registered copy of
+    ``valid`` holds (held writes: no enable logic between a register and a block RAM);
+    every consumer of a pipeline flag gets its own :func:`kept_register` (no net from one
+    register to the zero multiplexers of every accumulator-adder input)."""
+
+    name = "ecp5-dp16kd"
+    held_write = True
+
+    def bank(self, width: int, depth: int, init_word: int = 0,
+             held_write: bool = False) -> Ecp5BlockRam:
+        return Ecp5BlockRam(width, depth, init_word, write_ahead=held_write)
+
+    def flag_copy(self, m: Module, ahead: Value, shared: Value, name: str,
+                  en: Value) -> Value:
+        return kept_register(m, ahead, name, en=en)
+
+
+#: The ECP5 build's memory target.
+ECP5_BLOCK_RAMS = Ecp5BlockRams()
+
+
+class Ecp5Platform:
+    """The ``platform`` value of the ECP5 build (``verilog.convert(...,
+    platform=ECP5_PLATFORM)``): it carries :data:`ECP5_BLOCK_RAMS` as its
+    ``memory_target``, so every streaming array elaborated for it, inside any wrapper,
+    maps its state memories to DP16KD with the output register."""
+
+    memory_target = ECP5_BLOCK_RAMS
+
+    def __repr__(self) -> str:
+        return "ECP5_PLATFORM"
+
+
+#: The platform of ``rvsm fpga``'s default memory (``--memory dp16kd``).
+ECP5_PLATFORM = Ecp5Platform()

@@ -2,8 +2,8 @@
 
 :class:`BankedMemory` holds ``depth`` words of ``width`` bits in banks of at most
 ``bank_words`` words (a power of two), each bank's read data registered before the
-bank multiplexer (ECP5 block-RAM timing). All registers load on ``advance`` (the
-array's beat advance), so stages count beats:
+bank multiplexer (block-RAM timing: no logic right after a block RAM's slow read). All
+registers load on ``advance`` (the array's beat advance), so stages count beats:
 
 * **Read.** ``read_addr`` is sampled at an ``advance`` edge; the bank's data is
   registered at the next ``advance`` edge and multiplexed by ``read_bank``, which must
@@ -12,49 +12,46 @@ array's beat advance), so stages count beats:
   (``read_stages=3``: a registered bank multiplexer, forwarding included).
 * **Write.** One port: ``write_en``, ``write_addr``, ``write_data`` (the enable is used
   as given; gate it with ``advance`` outside).
-* **Collisions.** A bank's read is disabled at an edge where the write port writes its
-  address: the read data is then undefined (yosys needs no read-first bypass
-  multiplexer after the block RAM; the ECP5 build leaves such reads enabled and their
-  data unused, :mod:`rvsm.rtl.fpga.ecp5_memory`). Either such collisions never meet a valid read, or
-  ``forward=True`` adds ``forward_hit`` / ``forward_data``: where ``forward_hit`` was set
-  with the read address, ``data`` is ``forward_data`` (the forwarded word, delayed
-  alike: two ``advance`` edges) instead of the read. ``guard_bits = k`` adds
-  ``may_write`` and gates the read where ``may_write`` holds and the low ``k`` address
-  bits match: a cheaper superset of the collisions, for a memory whose valid reads and
-  writes never match in those bits. The collision is a bank's: its word address
-  written meets its word address read, whichever bank the read is for (a read of
-  another bank's word is discarded after the bank registers, but is still a read).
-* **One edge ahead (ECP5 build).** ``advance_next``: the value ``advance`` takes at the
-  next edge, registered again in every block RAM
-  (:class:`~rvsm.rtl.fpga.ecp5_memory.Ecp5BlockRam`) as its own enable, so no control
-  net runs from one register to all block RAMs; the generic build ignores it.
-  ``held_write=True`` adds ``write_en_next``: a write enable that may stay high through
+* **Collisions.** A bank's read is gated (``read_gate``) at an edge where the write port
+  writes its address: the read data is then undefined (yosys needs no read-first bypass
+  multiplexer after the block RAM; a target with registered enables leaves such reads
+  ungated and their data unused, :mod:`rvsm.rtl.stream.memory_target`). Either such
+  collisions never meet a valid read, or ``forward=True`` adds ``forward_hit`` /
+  ``forward_data``: where ``forward_hit`` was set with the read address, ``data`` is
+  ``forward_data`` (the forwarded word, delayed alike: two ``advance`` edges) instead of
+  the read. ``guard_bits = k`` adds ``may_write`` and gates the read where ``may_write``
+  holds and the low ``k`` address bits match: a cheaper superset of the collisions, for
+  a memory whose valid reads and writes never match in those bits. The collision is a
+  bank's: its word address written meets its word address read, whichever bank the read
+  is for (a read of another bank's word is discarded after the bank registers, but is
+  still a read).
+* **Banks from the target.** Each bank is built by ``target``
+  (:class:`~rvsm.rtl.stream.memory_target.MemoryTarget`, the generic Amaranth memories
+  by default; the FPGA flow's block RAMs put the bank register in the primitive's output
+  register, same cycle behaviour). ``advance_next`` (the value ``advance`` takes at the
+  next edge) goes to every bank, for a target that registers it beside each primitive as
+  its own enable; the generic banks ignore it. ``held_write=True`` (only for a target
+  with ``held_write``) adds ``write_en_next``: a write enable that may stay high through
   cycles without ``advance`` (the caller's ``valid`` alone, where a held write repeats
   the same word to the same address), given one edge ahead and registered per block
-  RAM; the ECP5 build writes where it holds (and the bank matches), the generic build
-  where ``write_en`` holds. The caller must keep the write address and data constant
-  while ``advance`` is low, and read nothing that a write outside ``advance`` edges
-  changes (the array: the write of a clear edge lands in a word the fresh frame
-  after the clear reads as zero and overwrites).
+  RAM; the banks write where it holds and the bank matches. The caller must keep the
+  write address and data constant while ``advance`` is low, and read nothing that a
+  write outside ``advance`` edges changes (the array: the write of a clear edge lands in
+  a word the fresh frame after the clear reads as zero and overwrites).
 * **Initial contents.** ``init_word``: every word's value at configuration (block-RAM
   initialisation; 0 by default). No reset reloads it.
-* **ECP5 block RAMs.** Elaborated for ``platform=ECP5_PLATFORM``
-  (:mod:`rvsm.rtl.fpga.ecp5_memory`, ``rvsm fpga``), each bank is an
-  :class:`~rvsm.rtl.fpga.ecp5_memory.Ecp5BlockRam`: DP16KD primitives whose output
-  register (``REGMODE_B = "OUTREG"``) is the bank register, same cycle behaviour.
 * **Formal observation.** For the ``"formal"`` platform only, ``probe_data`` shows the
-  word at ``probe_addr`` (asynchronous read ports), for harnesses to state what the
-  memory holds; other platforms elaborate no such port.
+  word at ``probe_addr`` (the generic banks' asynchronous read ports), for harnesses to
+  state what the memory holds; other platforms elaborate no such port.
 """
 
 from __future__ import annotations
 
 from amaranth.hdl import Const, Module, Mux, Shape, Signal, Value, unsigned
 from amaranth.lib import wiring
-from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
-from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM, Ecp5BlockRam
+from rvsm.rtl.stream.memory_target import GENERIC_MEMORY, MemoryTarget
 
 __all__ = ["BankedMemory"]
 
@@ -63,14 +60,18 @@ class BankedMemory(wiring.Component):
     """``depth`` words of ``width`` bits in banks of ``bank_words``; see the module
     docstring for the ports ``advance``, ``read_addr``, ``read_bank``, ``write_en``,
     ``write_addr``, ``write_data``, ``data`` and the optional ``forward_hit``,
-    ``forward_data`` (``forward=True``), ``may_write`` (``guard_bits``) and the ECP5
-    build's ``advance_next`` and ``write_en_next`` (``held_write=True``)."""
+    ``forward_data`` (``forward=True``), ``may_write`` (``guard_bits``),
+    ``advance_next`` and ``write_en_next`` (``held_write=True``); banks from ``target``."""
 
     def __init__(self, width: int, depth: int, bank_words: int, forward: bool = False,
                  guard_bits: int | None = None, init_word: int = 0,
-                 read_stages: int = 2, held_write: bool = False):
+                 read_stages: int = 2, held_write: bool = False,
+                 target: MemoryTarget = GENERIC_MEMORY):
         if read_stages not in (2, 3):
             raise ValueError(f"read_stages must be 2 or 3, got {read_stages}")
+        if held_write and not target.held_write:
+            raise ValueError(f"memory target {target.name!r} has no held writes")
+        self.target = target
         self.read_stages = read_stages
         self.width = width
         self.init_word = init_word
@@ -128,49 +129,35 @@ class BankedMemory(wiring.Component):
         return may_write & hit & (wr[:k] == rd[:k])
 
     def elaborate(self, platform: object) -> Module:
-        """The banks, their read registers, the bank multiplexer and the forwarding."""
+        """The banks, the bank multiplexer and the forwarding."""
         m = Module()
         banked = len(self.bank_sizes) > 1
         offset_bits = (self.bank_words - 1).bit_length()
         outs, probes = [], []
-        ecp5 = platform == ECP5_PLATFORM
         for b, depth in enumerate(self.bank_sizes):
-            wr_en = self.write_en & self._hit(self.write_addr, b)
-            if ecp5:  # the bank register is the block RAM's output register
-                ram = Ecp5BlockRam(self.width, depth, self.init_word,
-                                   write_ahead=self.held_write)
-                m.submodules[f"b{b}"] = ram
-                wr_addr, rd_addr = ram.write_addr, ram.read_addr
-                if self.held_write:  # write_en_next registered per primitive, bank select
-                    m.d.comb += [ram.write_en.eq(self._hit(self.write_addr, b)),
-                                 ram.write_en_next.eq(self.write_en_next)]
-                else:
-                    m.d.comb += ram.write_en.eq(wr_en)
-                m.d.comb += [ram.write_data.eq(self.write_data),
-                             ram.advance_next.eq(self.advance_next)]
-                outs.append(ram.data)
+            bank = self.target.bank(self.width, depth, self.init_word,
+                                    held_write=self.held_write)
+            m.submodules[f"b{b}"] = bank
+            hit = self._hit(self.write_addr, b)
+            if self.held_write:  # write_en_next registered per primitive, bank select
+                m.d.comb += [bank.write_en.eq(hit), bank.write_en_next.eq(self.write_en_next)]
             else:
-                mem = Memory(shape=unsigned(self.width), depth=depth,
-                             init=[self.init_word] * depth if self.init_word else [])
-                m.submodules[f"b{b}"] = mem
-                wp = mem.write_port()
-                m.d.comb += [wp.data.eq(self.write_data), wp.en.eq(wr_en)]
-                if platform == "formal":
-                    probe = mem.read_port(domain="comb")
-                    m.d.comb += probe.addr.eq(self.probe_addr[:offset_bits] if banked
-                                              else self.probe_addr)
-                    probes.append(probe.data)
-                rp = mem.read_port()
-                wr_addr, rd_addr = wp.addr, rp.addr
-                collide = self._collide(b, self.write_en, self.write_addr, self.read_addr,
-                                        getattr(self, "may_write", None))
-                m.d.comb += rp.en.eq(self.advance & ~collide)
-                reg = Signal(unsigned(self.width), name=f"b{b}_q", reset_less=True)
-                with m.If(self.advance):
-                    m.d.sync += reg.eq(rp.data)
-                outs.append(reg)
-            m.d.comb += [wr_addr.eq(self._offset(self.write_addr)),
-                         rd_addr.eq(self._offset(self.read_addr))]
+                m.d.comb += bank.write_en.eq(self.write_en & hit)
+            m.d.comb += [bank.advance.eq(self.advance), bank.advance_next.eq(self.advance_next),
+                         bank.read_addr.eq(self._offset(self.read_addr)),
+                         bank.read_gate.eq(self._collide(b, self.write_en, self.write_addr,
+                                                         self.read_addr,
+                                                         getattr(self, "may_write", None))),
+                         bank.write_addr.eq(self._offset(self.write_addr)),
+                         bank.write_data.eq(self.write_data)]
+            if platform == "formal":
+                if not hasattr(bank, "probe_addr"):
+                    raise ValueError(f"memory target {self.target.name!r} has no formal "
+                                     "probe ports")
+                m.d.comb += bank.probe_addr.eq(self.probe_addr[:offset_bits] if banked
+                                               else self.probe_addr)
+                probes.append(bank.probe_data)
+            outs.append(bank.data)
         out = outs[-1]
         for b in range(len(outs) - 2, -1, -1):
             out = Mux(self.read_bank == b, outs[b], out)

@@ -18,7 +18,6 @@ from amaranth.lib import data
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.geometry import kernel_radius
-from rvsm.rtl.fpga.camera import state_memory
 from rvsm.rtl.receptive_sum import sum_width
 from rvsm.rtl.stream.pipelined_sum import Pipeline, Timed, orbit_terms, weighted_orbits
 from rvsm.rtl.stream.schedule import StreamSchedule
@@ -136,11 +135,14 @@ class StreamGeometry:
 
     @property
     def state_bits(self) -> dict[str, int]:
-        """Memory bits: ``accumulators``, ``thresholds``, ``line_buffer``
-        (:class:`~rvsm.rtl.fpga.camera.StateMemory`)."""
-        state = state_memory(self.contract)
-        return {"accumulators": state.accumulators, "thresholds": state.thresholds,
-                "line_buffer": state.line_buffers}
+        """Memory bits: ``accumulators`` (``S*H*W*A``), ``thresholds`` (``S*H*W*(A-1)``),
+        ``line_buffer`` (``2L*W*N``); the sensor-level account of the same bits, with
+        the devices that hold them, is ``rtl/fpga/camera.py``'s ``StateMemory``."""
+        c = self.contract
+        accumulators = c.num_scales * c.height * c.width
+        return {"accumulators": accumulators * c.accumulator_bits,
+                "thresholds": accumulators * c.threshold_bits,
+                "line_buffer": 2 * self.radius * c.width * c.adc_bits}
 
     @property
     def schedule(self) -> StreamSchedule:

@@ -18,7 +18,7 @@ from rvsm.model.fixed.contract import ArrayContract
 from rvsm.rtl.amaranth_sim import run_simulation
 from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.dimensions import StreamGeometry
-from rvsm.rtl.stream.protocol import ProtocolScript
+from rvsm.rtl.stream.protocol_script import ProtocolScript
 from rvsm.rtl.stream.schedule import OutputBeats, pack_lanes
 from rvsm.rtl.stream.signatures import threshold_word_bits
 
@@ -183,7 +183,7 @@ def simulate_with_threshold_writes(
 def simulate_script(script: ProtocolScript, bank_words: int = StreamGeometry.BANK_WORDS,
                     mutation: str | None = None, vcd_path: str | None = None,
                     ) -> tuple[OutputBeats, list[int]]:
-    """Drive a :class:`~rvsm.rtl.stream.protocol.ProtocolScript` cycle by cycle; return
+    """Drive a :class:`~rvsm.rtl.stream.protocol_script.ProtocolScript` cycle by cycle; return
     the output beats and the edge after which each was presented (compare both with
     :func:`~rvsm.rtl.stream.protocol.check_script`)."""
     dut = RvsmStreamArray(script.contract, script.lanes, bank_words, mutation=mutation)

@@ -8,8 +8,10 @@ stream does not: stalls, ``clear`` at any position of a frame (mid-frame, inside
 lag, after a drain, with ``codes.valid`` high while ``ready`` is low), and threshold
 writes while the stream runs, many at the very edge that reads the same word or one
 edge earlier. :func:`random_script` makes a seeded one; :func:`build_script` one from an
-explicit list of :class:`Segment`; :func:`script_coverage` measures its bins
-(:data:`PROTOCOL_BINS`).
+explicit list of :class:`Segment`; :func:`check_script` compares what an array gave.
+The script itself and its file are :mod:`.protocol_script`; :func:`script_coverage`
+(:mod:`.protocol_coverage`) measures its bins (:data:`PROTOCOL_BINS`); this module's
+namespace holds all of them.
 
 The expectation follows the array's documented rules (``docs/stream-array.md``),
 applied in numpy:
@@ -28,9 +30,7 @@ applied in numpy:
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -42,97 +42,12 @@ from rvsm.model.fixed.contract import (
 )
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.stream.dimensions import StreamGeometry
-from rvsm.rtl.stream.schedule import OutputBeats, pack_lanes
-from rvsm.rtl.stream.signatures import threshold_word_bits
+from rvsm.rtl.stream.protocol_coverage import PROTOCOL_BINS, protocol_summary, script_coverage
+from rvsm.rtl.stream.protocol_script import ProtocolScript, Segment, load_script, save_script
+from rvsm.rtl.stream.schedule import OutputBeats
 
 __all__ = ["PROTOCOL_BINS", "ProtocolScript", "Segment", "build_script", "check_script",
            "load_script", "protocol_summary", "random_script", "save_script", "script_coverage"]
-
-#: Row bands x group bands of the frame position at which a clear cuts the stream.
-CLEAR_POSITIONS = tuple(f"clear_at_{r}_{g}" for r in ("top", "middle", "bottom")
-                        for g in ("first", "middle", "last"))
-#: Coverage bins of a protocol run (every scale): clears before any beat; clears at each
-#: band of frame positions (:data:`CLEAR_POSITIONS`: the next beat's row in the top /
-#: middle / bottom ``R`` rows, its group first / middle / last), among them those after
-#: a drain (every position released) and those inside the lag (outputs of the previous
-#: frame still in flight); clears with ``codes.valid`` high (a refused beat); stalled
-#: cycles with positions in flight; threshold writes at the very edge a position reads the same
-#: word (not seen), one edge earlier (seen), while the stream runs, during a clear.
-PROTOCOL_BINS: tuple[str, ...] = (
-    "clear_before_first_beat", "clear_drained", *CLEAR_POSITIONS, "clear_in_lag",
-    "clear_with_valid", "thr_write_same_edge", "thr_write_edge_before",
-    "thr_write_streaming", "thr_write_in_clear", "stall")
-
-
-@dataclass(frozen=True)
-class Segment:
-    """One stream between clears: ``frames`` whole frames, then ``cut`` beats of one
-    more frame and a clear (``None``: ``lag`` flush beats instead, then a clear unless
-    it is the last segment). ``stall`` is the chance of 1-3 idle cycles before a beat;
-    ``idle_after`` idle cycles follow the beats; ``clear_cycles`` cycles of ``clear``,
-    with ``codes.valid`` high in them when ``valid_in_clear``."""
-
-    frames: int
-    cut: int | None = None
-    stall: float = 0.0
-    idle_after: int = 1
-    clear_cycles: int = 1
-    valid_in_clear: bool = False
-
-
-@dataclass(frozen=True)
-class ProtocolScript:
-    """A cycle-by-cycle drive of a streaming array and the output it must give.
-
-    Members (``C`` cycles, ``K`` expected output beats):
-
-    * ``valid (C,) bool``, ``codes (C, P) int64``: ``codes.valid`` and the payload's
-      lanes in each cycle (junk when not accepted);
-    * ``clear (C,) bool``;
-    * ``thr_we (C,) bool``, ``thr_scale (C,)``, ``thr_word (C,)`` (``y*G + g``),
-      ``thr_data (C, P) int64``: the threshold write of each cycle;
-    * ``expected``: :class:`OutputBeats` (``accepted`` unused) of the ``K`` beats;
-    * ``expected_cycles (K,)``: the edge after which each is presented;
-    * ``expected_steps (K,)``: the step (of ``codes``) each beat belongs to.
-    """
-
-    contract: ArrayContract
-    lanes: int
-    valid: np.ndarray
-    codes: np.ndarray
-    clear: np.ndarray
-    thr_we: np.ndarray
-    thr_scale: np.ndarray
-    thr_word: np.ndarray
-    thr_data: np.ndarray
-    expected: OutputBeats
-    expected_cycles: np.ndarray
-    expected_steps: np.ndarray
-    seed: int | None = None
-
-    @property
-    def num_cycles(self) -> int:
-        """C, the cycles driven."""
-        return int(self.valid.shape[0])
-
-    @property
-    def geometry(self) -> StreamGeometry:
-        """The array's geometry (default banks: the protocol does not depend on them)."""
-        return StreamGeometry(self.contract, self.lanes)
-
-    def payload_words(self) -> list[int]:
-        """``codes_payload`` of every cycle, lanes packed (lane ``i`` at ``i*N``)."""
-        return pack_lanes(self.codes, self.contract.adc_bits)
-
-    def thr_addresses(self) -> list[int]:
-        """``thr_addr`` of every cycle: ``(scale << word_bits) | word``."""
-        bits = threshold_word_bits(self.geometry.beats_per_frame)
-        return [int(s) << bits | int(w) for s, w in zip(self.thr_scale, self.thr_word,
-                                                        strict=True)]
-
-    def thr_words(self) -> list[int]:
-        """``thr_data`` of every cycle, lanes packed (lane ``i`` at ``i*(W-1)``)."""
-        return pack_lanes(self.thr_data, self.contract.threshold_bits)
 
 
 def _segment_codes(codes: np.ndarray, start: int, seg: Segment) -> np.ndarray:
@@ -330,88 +245,6 @@ def random_script(contract: ArrayContract, lanes: int, steps: int, seed: int
                         writes_per_cycle=0.1, collisions=0.25, seed=seed)
 
 
-def script_coverage(script: ProtocolScript) -> list[dict[str, int | None]]:
-    """Per scale, counts of :data:`PROTOCOL_BINS` in ``script`` (None: unreachable for
-    this geometry, e.g. a middle row band in a frame of at most ``2R`` rows)."""
-    geo = script.geometry
-    c, hg, lag, tl, g = (script.contract, geo.beats_per_frame, geo.lag, geo.threshold_lag,
-                         geo.groups)
-    r = geo.radius
-    counts = {b: np.zeros(c.num_scales, dtype=np.int64) for b in PROTOCOL_BINS}
-
-    def band(q: int) -> str:
-        y, grp = q // g, q % g
-        row = "top" if y < r else ("bottom" if y >= c.height - r else "middle")
-        col = "first" if grp == 0 else ("last" if grp == g - 1 else "middle")
-        return f"clear_at_{row}_{col}"
-
-    reachable = {band(q) for q in range(hg)}
-    accepted = script.valid & ~script.clear
-    read_edges: list[np.ndarray] = []
-    words: list[np.ndarray] = []
-    n = 0  # beats accepted since the last clear
-    edges: list[int] = []
-    streaming = np.zeros(script.num_cycles, dtype=bool)
-    prev_clear = False
-    stalls = 0
-
-    def close_segment() -> None:
-        released = max(0, len(edges) - lag)
-        if released:
-            e = np.asarray(edges)
-            read_edges.append(e[np.arange(released) + tl] + 1)
-            words.append(np.arange(released) % hg)
-
-    for cyc in range(script.num_cycles):
-        if script.clear[cyc]:
-            if script.valid[cyc]:
-                counts["clear_with_valid"] += 1
-            if not prev_clear:
-                if n == 0:
-                    counts["clear_before_first_beat"] += 1
-                else:  # the position the next beat would have had in its frame
-                    counts[band(n % hg)] += 1
-                    if n >= lag + hg and (n - lag) % hg == 0:
-                        counts["clear_drained"] += 1
-                    elif n % hg < lag and n >= hg:
-                        counts["clear_in_lag"] += 1
-                close_segment()
-                n, edges = 0, []
-            prev_clear = True
-            continue
-        prev_clear = False
-        if accepted[cyc]:
-            edges.append(cyc)
-            n += 1
-        elif 0 < n and not (n >= lag and (n - lag) % hg == 0):
-            stalls += 1  # a pause with positions in flight
-        streaming[cyc] = 0 < n
-    close_segment()
-    counts["stall"] += stalls
-    w = np.flatnonzero(script.thr_we)
-    scale = script.thr_scale
-    for cyc in w:
-        s = int(scale[cyc])
-        if script.clear[cyc]:
-            counts["thr_write_in_clear"][s] += 1
-        if streaming[cyc]:
-            counts["thr_write_streaming"][s] += 1
-    if read_edges:
-        r_all, word_all = np.concatenate(read_edges), np.concatenate(words)
-        by_edge = dict(zip(r_all.tolist(), word_all.tolist(), strict=True))
-        for cyc in w:
-            s, a = int(scale[cyc]), int(script.thr_word[cyc])
-            if by_edge.get(int(cyc)) == a:
-                counts["thr_write_same_edge"][s] += 1
-            if by_edge.get(int(cyc) + 1) == a:
-                counts["thr_write_edge_before"][s] += 1
-    out = []
-    for s in range(c.num_scales):
-        out.append({b: (int(counts[b][s]) if not b.startswith("clear_at_")
-                        or b in reachable else None) for b in PROTOCOL_BINS})
-    return out
-
-
 def check_script(script: ProtocolScript, got: OutputBeats, cycles: Sequence[int],
                  max_listed: int = 50) -> dict:
     """Compare received beats (and the cycles they were presented after) with the
@@ -454,62 +287,3 @@ def check_script(script: ProtocolScript, got: OutputBeats, cycles: Sequence[int]
     return {"compared": int(n * s_count * p_lanes), "mismatches": int(mismatches),
             "beats": int(n_got), "first_mismatch": listed[0] if listed else None,
             "mismatch_list": listed}
-
-
-SCRIPT_ARRAYS = ("valid", "codes", "clear", "thr_we", "thr_scale", "thr_word", "thr_data",
-                 "expected_cycles", "expected_steps")
-
-
-def save_script(path: str | os.PathLike, script: ProtocolScript) -> None:
-    """Write ``script`` to ``path`` (``.npz``, atomically): its arrays, the expected
-    beats and the contract (:func:`load_script` reads it)."""
-    import json
-    from dataclasses import asdict
-
-    from rvsm.model.infra.atomic import atomic_path
-
-    e = script.expected
-    arrays = {**{k: getattr(script, k) for k in SCRIPT_ARRAYS},
-              "exp_rows": e.rows, "exp_groups": e.groups, "exp_last": e.last,
-              "exp_spikes": e.spikes, "lanes": np.int64(script.lanes),
-              "seed": np.int64(-1 if script.seed is None else script.seed),
-              "contract": np.array(json.dumps(asdict(script.contract)))}
-    with atomic_path(path) as tmp, open(tmp, "wb") as handle:
-        np.savez_compressed(handle, **arrays)
-
-
-def load_script(path: str | os.PathLike) -> ProtocolScript:
-    """Read a script written by :func:`save_script` (a file this module wrote: the
-    testbench's input, not a user's)."""
-    import json
-
-    with np.load(path, allow_pickle=False) as z:
-        arrays = {k: z[k] for k in SCRIPT_ARRAYS}
-        expected = OutputBeats(z["exp_rows"], z["exp_groups"], z["exp_last"],
-                               z["exp_spikes"])
-        seed = int(z["seed"])
-        raw = json.loads(str(z["contract"]))
-        lanes = int(z["lanes"])
-    raw["weights"] = tuple(tuple(tuple(int(v) for v in row) for row in k)
-                           for k in raw["weights"])
-    return ProtocolScript(ArrayContract(**raw), lanes, expected=expected,
-                          seed=None if seed < 0 else seed, **arrays)
-
-
-def protocol_summary(coverage: list[dict[str, int | None]]) -> list[str]:
-    """One line for the clear bins (the same on every scale) and one per scale for the
-    threshold-write bins: ``clears: 9/11 bins hit (missing: ...)``."""
-    def line(bins: dict[str, int | None]) -> str:
-        live = {b: n for b, n in bins.items() if n is not None}
-        missing = [b for b, n in live.items() if not n]
-        tail = f" (missing: {', '.join(missing)})" if missing else ""
-        return f"{len(live) - len(missing)}/{len(live)} bins hit{tail}"
-
-    if not coverage:
-        return []
-    clears = {b: n for b, n in coverage[0].items() if not b.startswith("thr_")}
-    lines = [f"clears and stalls: {line(clears)}"]
-    for s, bins in enumerate(coverage):
-        lines.append(f"scale {s} threshold writes: "
-                     f"{line({b: n for b, n in bins.items() if b.startswith('thr_')})}")
-    return lines

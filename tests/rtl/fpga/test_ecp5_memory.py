@@ -13,10 +13,17 @@ import pytest
 from amaranth.back import verilog
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM, Ecp5BlockRam, dp16kd_count, initval
+from rvsm.rtl.fpga.ecp5_memory import (
+    ECP5_BLOCK_RAMS,
+    ECP5_PLATFORM,
+    Ecp5BlockRam,
+    dp16kd_count,
+    initval,
+)
 from rvsm.rtl.ports import verilog_ports
 from rvsm.rtl.stream.architecture import stream_port_map
 from rvsm.rtl.stream.array import RvsmStreamArray
+from rvsm.rtl.stream.memory_target import memory_target
 
 MODEL = Path(__file__).with_name("dp16kd_model.v")
 FF_MODEL = Path(__file__).with_name("trellis_ff_model.v")
@@ -51,7 +58,21 @@ def test_the_ecp5_build_instantiates_outreg_block_rams_only(small_contract) -> N
     assert "DP16KD" not in generic
 
 
-def _verilog(dut: RvsmStreamArray, name: str, platform: str | None) -> str:
+def test_the_array_takes_the_block_rams_as_a_parameter_or_from_the_platform(
+        small_contract) -> None:
+    """``rtl/stream`` knows no device: the ECP5 block RAMs are a memory target, given to
+    the array or carried by the platform the flow converts with; either way the same
+    netlist."""
+    assert memory_target(ECP5_PLATFORM) is ECP5_BLOCK_RAMS and ECP5_BLOCK_RAMS.held_write
+    c = small_contract("dog2", 6, 8)
+    given = verilog.convert(RvsmStreamArray(c, 2, bank_words=8, memory=ECP5_BLOCK_RAMS),
+                            name="fpga", emit_src=False)
+    carried = verilog.convert(RvsmStreamArray(c, 2, bank_words=8), name="fpga",
+                              platform=ECP5_PLATFORM, emit_src=False)
+    assert given == carried and given.count("DP16KD #(") == 18
+
+
+def _verilog(dut: RvsmStreamArray, name: str, platform: object | None) -> str:
     return verilog.convert(dut, name=name, platform=platform, emit_src=False,
                            ports=verilog_ports(dut))
 

@@ -13,7 +13,6 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.drive import simulate_script
 from rvsm.rtl.stream.protocol import (
-    CLEAR_POSITIONS,
     PROTOCOL_BINS,
     Segment,
     build_script,
@@ -23,6 +22,7 @@ from rvsm.rtl.stream.protocol import (
     save_script,
     script_coverage,
 )
+from rvsm.rtl.stream.protocol_coverage import CLEAR_POSITIONS
 
 
 def _codes_thr(c, steps: int, seed: int, thr_hi: int = 120):
