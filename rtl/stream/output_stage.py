@@ -1,7 +1,7 @@
 """The streaming array's tail: :class:`OutputStage` (add, compare, reset, output register).
 
 At stage Q the sums, the state words and the position meet. Per scale and lane, the
-sensor's output rule (:data:`OUTPUT_TAILS`, keyed by the contract's sensor: the spike
+sensor's output rule (:data:`OUTPUT_TAILS`, keyed by the sensor kind's output: the spike
 camera's :class:`SpikeTail`, the event sensor's :class:`EventTail`) fills the same two
 registered stages (``total``, ``thr1``, then ``sat``, ``thr2``, ``pos``, ``neg``) and
 gives the word written back to the accumulator memory (``write_data``, at the write-back
@@ -26,6 +26,7 @@ from amaranth.lib.wiring import In, Out
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.widths import signed_range
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kinds.sensor_kind import Output
 from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.input_stage import control_signature
 from rvsm.rtl.stream.memory_target import GENERIC_MEMORY, MemoryTarget
@@ -175,19 +176,20 @@ class EventTail:
         return pos, neg, np.where(fresh, np.clip(shifted, lo, hi), moved)
 
 
-#: The output rule of each sensor (``ArrayContract.sensor``); :func:`output_tail` is the
-#: one place it is looked up.
-OUTPUT_TAILS: dict[str, type[SpikeTail] | type[EventTail]] = {"spike": SpikeTail,
-                                                             "dvs": EventTail}
+#: The tail of each output rule (``ArrayContract.kind.output``, the sensor kind's
+#: :class:`~rvsm.model.kinds.sensor_kind.Output`); :func:`output_tail` is the one place it
+#: is looked up.
+OUTPUT_TAILS: dict[Output, type[SpikeTail] | type[EventTail]] = {Output.SPIKES: SpikeTail,
+                                                                Output.EVENTS: EventTail}
 
 
 def output_tail(contract: ArrayContract, mutation: str | None = None
                 ) -> SpikeTail | EventTail:
     """The output rule of ``contract``'s sensor (:data:`OUTPUT_TAILS`)."""
-    rule = OUTPUT_TAILS.get(contract.sensor)
+    rule = OUTPUT_TAILS.get(contract.kind.output)
     if rule is None:
-        raise RvsmError(f"no output rule for sensor {contract.sensor!r} (known: "
-                        f"{', '.join(OUTPUT_TAILS)})")
+        raise RvsmError(f"no streaming-array tail for the {contract.sensor!r} sensor's "
+                        f"output rule {contract.kind.output.name}")
     return rule(contract, mutation)
 
 

@@ -12,6 +12,7 @@ import pytest
 from rvsm.model.fixed.contract import FixedEventIntegrator, FixedIntegrator
 from rvsm.model.fixed.widths import signed_range
 from rvsm.model.infra.errors import RvsmError
+from rvsm.model.kinds.sensor_kind import Output
 from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.output_stage import (
     OUTPUT_TAILS,
@@ -149,8 +150,8 @@ def test_the_rules_are_the_contract_s_integrators() -> None:
 
 
 def test_one_table_chooses_the_rule() -> None:
-    assert set(OUTPUT_TAILS) == {"spike", "dvs"}
+    assert set(OUTPUT_TAILS) == set(Output)  # every output rule has its tail
     assert isinstance(output_tail(_contract("spike")), SpikeTail)
     assert isinstance(output_tail(_contract("dvs")), EventTail)
-    with pytest.raises(RvsmError, match="no output rule"):
+    with pytest.raises(RvsmError, match="sensor must be one of"):  # refused by its kind
         output_tail(_contract("radar"))
