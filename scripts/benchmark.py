@@ -13,6 +13,13 @@ targets are issue 10's (the ``dvs`` rows, RVSM-DVS: issue 19's), for a 2-core ma
 ``fused/cpu-s`` is the same work per CPU second of all threads: the rate a core delivers,
 less sensitive to other jobs' load (on an idle 2-core machine the wall rate approaches
 twice it).
+
+``api/s`` is the same work through the public whole-array API with its defaults, as a
+user calls it: ``sample(scene, SamplerConfig(model=...))`` and ``simulate_fixed(scene,
+DesignPoint(model=...))`` (the spikes collected into one ``(T, S, H, W)`` array, the fixed
+twin's min/max statistics on); ``api/fused`` is its rate over the fused row's (wall), and
+``api/fused cpu`` the same per CPU second. The two are timed alternately in one process
+(best of ``--repeat`` each), so load drifts hit both.
 """
 
 from __future__ import annotations
@@ -27,10 +34,10 @@ import time
 from pathlib import Path
 
 from rvsm.model.fixed.design_point import DesignPoint
-from rvsm.model.fixed.twin import stream_fixed
+from rvsm.model.fixed.twin import simulate_fixed, stream_fixed
 from rvsm.model.noise.sensor import NoiseParams
 from rvsm.model.sampling.config import SamplerConfig
-from rvsm.model.sampling.twin import stream_float
+from rvsm.model.sampling.twin import sample, stream_float
 from rvsm.model.scene.library import builtin_scene
 
 #: (label, kind, model, noise) -> target acc-steps/s (None: no target)
@@ -77,15 +84,22 @@ def vector_bits() -> str:
     return "512" if wide else "default"
 
 
+def best_times(fns, repeat: int) -> list[tuple[float, float]]:
+    """Per function of ``fns``: best wall time and best CPU time (all threads) of
+    ``repeat`` calls, in seconds; the functions are called in turn, ``repeat`` rounds."""
+    best = [[float("inf"), float("inf")] for _ in fns]
+    for _ in range(repeat):
+        for fn, b in zip(fns, best, strict=True):
+            start, cpu = time.perf_counter(), time.process_time()
+            fn()
+            b[0] = min(b[0], time.perf_counter() - start)
+            b[1] = min(b[1], time.process_time() - cpu)
+    return [(wall, cpu) for wall, cpu in best]
+
+
 def best_time(fn, repeat: int) -> tuple[float, float]:
     """Best wall time and best CPU time (all threads) of ``repeat`` calls, in seconds."""
-    best, best_cpu = float("inf"), float("inf")
-    for _ in range(repeat):
-        start, cpu = time.perf_counter(), time.process_time()
-        fn()
-        best = min(best, time.perf_counter() - start)
-        best_cpu = min(best_cpu, time.process_time() - cpu)
-    return best, best_cpu
+    return best_times([fn], repeat)[0]
 
 
 def run_case(kind: str, model: str, noise: bool, scene, engine: str):
@@ -103,6 +117,27 @@ def run_case(kind: str, model: str, noise: bool, scene, engine: str):
     point = DesignPoint(model=model, noise=noise)
     return (lambda: stream_fixed(scene, point, NullSink(), engine=engine, ranges=False),
             point.num_scales)
+
+
+def api_case(kind: str, model: str, noise: bool, scene):
+    """The public whole-array call of the same work, with its defaults (None: no such
+    call in this table, the event sensor)."""
+    if kind == "float":
+        config = SamplerConfig(model=model, noise=NoiseParams() if noise else None)
+        return lambda: sample(scene, config)
+    if kind == "fixed":
+        point = DesignPoint(model=model, noise=noise)
+        return lambda: simulate_fixed(scene, point)
+    return None
+
+
+def api_text(fused: tuple[float, float], api: tuple[float, float] | None, rate: float) -> str:
+    """The ``api/s``, ``api/fused`` and ``api/fused cpu`` columns from the best ``(wall,
+    cpu)`` seconds of the fused and API runs (``-`` without an API row)."""
+    if api is None:
+        return f"{'-':>10s} {'-':>9s} {'-':>13s}"
+    return (f"{rate * fused[0] / api[0]:10.3g} {fused[0] / api[0]:9.2f} "
+            f"{fused[1] / api[1]:13.2f}")
 
 
 def verdict(rate: float, target: float | None) -> str:
@@ -152,7 +187,8 @@ def main() -> None:
           f"{os.cpu_count()} CPUs; {vector_bits()}-bit vectors; "
           "load = 1-min load average at the start of each row")
     head = (f"{'twin':13s} {'noise':5s} {'fused/s':>10s} {'numpy/s':>10s} {'speed-up':>8s} "
-            f"{'target':>8s} {'met':>6s} {'load':>5s} {'fused/cpu-s':>11s}")
+            f"{'target':>8s} {'met':>6s} {'load':>5s} {'fused/cpu-s':>11s} {'api/s':>10s} "
+            f"{'api/fused':>9s} {'api/fused cpu':>13s}")
     print(head)
     print("-" * len(head))
     for label, kind, model, noise, target in CASES:
@@ -160,8 +196,14 @@ def main() -> None:
             continue
         ld = load()
         fused, scales = run_case(kind, model, noise, scene, "fused")
+        api = api_case(kind, model, noise, scene)
         fused()  # compile / warm the caches
-        t_fused, cpu_fused = best_time(fused, args.repeat)
+        api_times = None
+        if api is not None:
+            api()
+            (t_fused, cpu_fused), api_times = best_times([fused, api], args.repeat)
+        else:
+            t_fused, cpu_fused = best_time(fused, args.repeat)
         rate = scene.num_steps * scales * h * w / t_fused
         cpu_rate = scene.num_steps * scales * h * w / cpu_fused
         ref, _ = run_case(kind, model, noise, short, "numpy")
@@ -170,7 +212,8 @@ def main() -> None:
         tgt = f"{target:.1e}" if target else "-"
         print(f"{label:13s} {'on' if noise else 'off':5s} {rate:10.3g} {ref_rate:10.3g} "
               f"{rate / ref_rate:7.1f}x {tgt:>8s} {verdict(rate, target):>6s} {ld:>5s} "
-              f"{cpu_rate:11.3g}", flush=True)
+              f"{cpu_rate:11.3g} {api_text((t_fused, cpu_fused), api_times, rate)}",
+              flush=True)
     if args.long_steps:
         ld = load()
         with tempfile.TemporaryDirectory() as tmp:

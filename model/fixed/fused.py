@@ -85,54 +85,69 @@ def _range_row(analog, width, out):
     out[1] = hi
 
 
+def as_exact_int(v):
+    """The integer-valued ``v`` as an integer: int32 for float32 (exact below ``2**24``),
+    int64 for float64 and integers. LLVM vectorises integer min/max reductions, not float
+    ones (numba's float ``min`` carries NaN tests that fast-math flags do not remove)."""
+    return np.int32(v) if isinstance(v, np.float32) else np.int64(v)
+
+
+@overload(as_exact_int, jit_options={"cache": True})
+def _as_exact_int_impl(v):
+    if isinstance(v, types.Float):
+        ty = types.int32 if v.bitwidth == 32 else types.int64
+        return lambda v: ty(v)
+    return lambda v: v
+
+
 @njit(fastmath=_INTEGER_FASTMATH, cache=True)
 def _integrate_fixed_row(sums, acc, thr, spikes, st, width, shift, scale, lo, hi, signed,
                          zero_reset):
-    """Shift, saturate, compare, fire and reset one row of one scale; ``st`` holds the
-    running sum / shifted / accumulator min-max and the saturation count."""
+    """:func:`_integrate_fixed_row_fast` that also tracks the row's sum and accumulator
+    min/max into ``st`` (as integers: the reductions vectorise, measured 1.3x the loop
+    without them against 5x with float reductions and branches); the shifted sums' range
+    is the shift of the sums' range (``floor(v / 2**shift)`` is monotone)."""
     zero = lo - lo
-    smin = st[0]
-    smax = st[1]
-    hmin = st[2]
-    hmax = st[3]
-    vmin = st[4]
-    vmax = st[5]
+    one = one_like(zero)
+    sgn = one if signed else zero
+    keep = zero if zero_reset else one
     sat = 0
+    smin = as_exact_int(sums[0])
+    smax = smin
+    vmin = as_exact_int(acc[0] + shift_down(sums[0], shift, scale))
+    vmax = vmin
     for x in range(width):
         sm = sums[x]
-        smin = min(smin, sm)
-        smax = max(smax, sm)
-        sh = shift_down(sm, shift, scale)
-        hmin = min(hmin, sh)
-        hmax = max(hmax, sh)
-        v = acc[x] + sh
-        vmin = min(vmin, v)
-        vmax = max(vmax, v)
+        ism = as_exact_int(sm)
+        smin = min(smin, ism)
+        smax = max(smax, ism)
+        v = acc[x] + shift_down(sm, shift, scale)
+        iv = as_exact_int(v)
+        vmin = min(vmin, iv)
+        vmax = max(vmax, iv)
         sat += (v > hi) | (v < lo)
         v = min(max(v, lo), hi)
         th = thr[x]
-        pos = v >= th
-        neg = signed & (v <= -th) & (not pos)
-        sp = np.int8(pos) - np.int8(neg)
-        spikes[x] = sp
-        if zero_reset:
-            acc[x] = zero if (pos | neg) else v
-        else:
-            acc[x] = v - th * sp
-    st[0] = smin
-    st[1] = smax
-    st[2] = hmin
-    st[3] = hmax
-    st[4] = vmin
-    st[5] = vmax
+        p = one if v >= th else zero
+        n = sgn * (one if v <= -th else zero) * (one - p)
+        sp = p - n
+        spikes[x] = np.int8(sp)
+        fired = p + n
+        acc[x] = (one - fired) * v + fired * keep * (v - th * sp)
+    st[0] = min(st[0], smin)
+    st[1] = max(st[1], smax)
+    st[2] = min(st[2], shift_down(smin, shift, scale))
+    st[3] = max(st[3], shift_down(smax, shift, scale))
+    st[4] = min(st[4], vmin)
+    st[5] = max(st[5], vmax)
     st[6] += sat
 
 
 @njit(fastmath=_INTEGER_FASTMATH, cache=True)
 def _integrate_fixed_row_fast(sums, acc, thr, spikes, st, width, shift, scale, lo, hi,
                               signed, zero_reset):
-    """:func:`_integrate_fixed_row` without the min/max tracking (it keeps the saturation
-    count): branch-free, so the loop vectorises."""
+    """Shift, saturate, compare, fire and reset one row of one scale; ``st[6]`` counts the
+    saturated accumulators. Branch-free, so the loop vectorises."""
     zero = lo - lo
     one = one_like(zero)
     sgn = one if signed else zero

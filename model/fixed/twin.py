@@ -32,7 +32,7 @@ from rvsm.model.sampling.config import (
 )
 from rvsm.model.sampling.fused import DEFAULT_TILE_ROWS
 from rvsm.model.scene.scene import Scene
-from rvsm.model.spikes.sinks import ArraySink, SpikeSink, fill_sink
+from rvsm.model.spikes.sinks import ArraySink, SpikeSink, chunk_target, fill_sink
 
 
 def fit_point(scene: Scene, point: DesignPoint) -> DesignPoint:
@@ -89,7 +89,7 @@ def stream_fixed(
     buf = np.empty((min(chunk_steps, max(t_total, 1)),) + shape[1:], dtype=np.int8)
 
     def produce(t0: int, t1: int) -> np.ndarray:
-        return twin.run(t0, t1, buf[:t1 - t0])
+        return twin.run(t0, t1, chunk_target(sink, t0, t1, buf))
 
     def stats() -> FixedStats:
         return FixedStats(steps=t_total, accumulators=h * w, **twin.stats())

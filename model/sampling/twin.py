@@ -29,7 +29,7 @@ from rvsm.model.sampling.config import (
 from rvsm.model.sampling.fused import DEFAULT_TILE_ROWS, FusedFloatSampler
 from rvsm.model.sampling.numpy_engine import NumpyFloatSampler
 from rvsm.model.scene.scene import Scene
-from rvsm.model.spikes.sinks import ArraySink, SpikeSink, fill_sink
+from rvsm.model.spikes.sinks import ArraySink, SpikeSink, chunk_target, fill_sink
 
 
 def stream_float(
@@ -65,7 +65,7 @@ def stream_float(
         sampler = NumpyFloatSampler(scene, config, thresholds, block_steps)
 
     def produce(t0: int, t1: int) -> np.ndarray:
-        return sampler.run(t0, t1, buf[:t1 - t0])
+        return sampler.run(t0, t1, chunk_target(sink, t0, t1, buf))
 
     bar = progress_bar(scene.num_steps, f"{spec.name} {scene.name}", progress)
     fill_sink(sink, shape, meta, produce, int(chunk_steps), bar)

@@ -34,7 +34,11 @@ class SpikeSink(Protocol):
 
 
 class ArraySink:
-    """Collects every chunk into one ``(T, S, H, W) int8`` array (``self.spikes``)."""
+    """Collects every chunk into one ``(T, S, H, W) int8`` array (``self.spikes``).
+
+    :meth:`target` lends the array's own rows to a producer, so a run that writes its
+    chunks there (:func:`chunk_target`) needs no copy; :meth:`write` then copies nothing.
+    """
 
     def __init__(self) -> None:
         self.spikes: np.ndarray | None = None
@@ -43,14 +47,35 @@ class ArraySink:
     def begin(self, shape, meta) -> None:
         self.spikes = np.empty(shape, dtype=np.int8)
 
+    def target(self, t0: int, t1: int) -> np.ndarray:
+        """Steps ``t0 .. t1 - 1`` of the array, ``(t1 - t0, S, H, W)``, to be written in place."""
+        return self.spikes[t0:t1]
+
     def write(self, t0, spikes) -> None:
-        self.spikes[t0:t0 + spikes.shape[0]] = spikes
+        dest = self.spikes[t0:t0 + spikes.shape[0]]
+        if not _same_memory(dest, spikes):  # written in place through target(): no copy
+            dest[...] = spikes
 
     def finish(self, meta) -> None:
         self.meta = meta
 
     def abort(self) -> None:
         self.spikes = None
+
+
+def _same_memory(a: np.ndarray, b: np.ndarray) -> bool:
+    """True when ``a`` and ``b`` are the same bytes (same start, shape and strides)."""
+    return (a.shape == b.shape and a.strides == b.strides
+            and a.__array_interface__["data"][0] == b.__array_interface__["data"][0])
+
+
+def chunk_target(sink, t0: int, t1: int, spare: np.ndarray) -> np.ndarray:
+    """Where a producer writes steps ``t0 .. t1 - 1``: the sink's own memory when it lends
+    it (``sink.target(t0, t1)``, e.g. :class:`ArraySink`, saving a copy of every chunk),
+    else ``spare[:t1 - t0]`` (a reused buffer). Call it after ``begin``."""
+    target = getattr(sink, "target", None)
+    out = target(t0, t1) if target is not None else None
+    return spare[:t1 - t0] if out is None else out
 
 
 class CountSink:
@@ -91,6 +116,15 @@ class TeeSink:
             check = getattr(s, "check", None)
             if check is not None:
                 check(shape, meta)
+
+    def target(self, t0: int, t1: int) -> np.ndarray | None:
+        """The memory of the first sink that lends it (:meth:`ArraySink.target`), else None;
+        the other sinks read the chunk from there."""
+        for s in self.sinks:
+            target = getattr(s, "target", None)
+            if target is not None:
+                return target(t0, t1)
+        return None
 
     def begin(self, shape, meta) -> None:
         """Check every sink, then begin each; a ``begin`` that fails aborts the sinks

@@ -51,6 +51,20 @@ def test_fused_equals_numpy(model, noise, reset, case):
     assert quick.stats.sum_min is None
 
 
+@pytest.mark.parametrize("case", EXTRAS)
+def test_ranges_of_rows_wider_than_a_vector(case):
+    # 71 columns: the vectorised min/max reductions' main loop and their remainder
+    extra, _ = EXTRAS[case]
+    scene = _scene(seed=5, shape=(3, 9, 71), m=4)
+    point = DesignPoint(height=9, width=71, model="dog4", noise=True, seed=1, phi=90.0,
+                        **extra)
+    ref = simulate_fixed(scene, point, engine="numpy")
+    run = simulate_fixed(scene, point)
+    np.testing.assert_array_equal(run.spikes, ref.spikes)
+    for name in STATS:
+        np.testing.assert_array_equal(getattr(run.stats, name), getattr(ref.stats, name))
+
+
 def test_tiles_chunks_threads_and_streamed_numpy_engine():
     scene = _scene(seed=8, shape=(5, 26, 15), m=4)
     point = DesignPoint(height=26, width=15, model="dog4", noise=True, seed=2,
