@@ -80,6 +80,7 @@ class StimulusChunks:
     _engine: str = field(default="fused", repr=False)
     _recompute: bool = field(default=False, repr=False)
     _engine_state: object = field(default=None, init=False, repr=False)
+    _start_state: np.ndarray | None = field(default=None, init=False, repr=False)
 
     @classmethod
     def from_stimulus(cls, stim: Stimulus, path: str | None = None,
@@ -126,7 +127,7 @@ class StimulusChunks:
         ``start`` / ``stop`` (a segment of a sharded run): only steps ``start .. stop -
         1`` are yielded; the twin is first run over steps ``0 .. start - 1`` without
         yielding them (the state at ``start`` is a function of the steps before it
-        only), so :meth:`state` is then the twin's state at ``start``. After the
+        only): :meth:`start_state` is the twin's state at ``start``. After the
         generator has yielded a chunk, :meth:`state` is the state after its last
         step."""
         stop = self.num_steps if stop is None else int(stop)
@@ -152,6 +153,8 @@ class StimulusChunks:
             if stream is not None and clear:
                 stream.clear()
             skip = t1 <= start  # before the segment: state only
+            if t0 == start:
+                self._start_state = self.state()
             if self.stimulus is not None:
                 codes = np.asarray(self.stimulus.codes[t0:t1])
                 spikes = (stream.run(codes) if stream is not None
@@ -186,6 +189,13 @@ class StimulusChunks:
                 yield start, t1, False
             else:
                 yield t0, t1, clear
+
+    def start_state(self) -> np.ndarray:
+        """The twin's state ``(S, H, W) int64`` at the ``start`` of the last
+        :meth:`chunks` (known once it has yielded its first chunk)."""
+        if self._start_state is None:
+            raise RvsmError("no start state yet: take the first chunk first")
+        return self._start_state
 
     def state(self) -> np.ndarray:
         """The twin's state ``(S, H, W) int64`` after the last step :meth:`chunks` ran:
