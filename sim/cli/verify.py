@@ -87,7 +87,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="with --harness chunk: split the run into N segments, each started "
                    "from the fixed twin's state and ending in a word-for-word state "
                    "compare, run in parallel (docs/long-runs.md)")
-    p.add_argument("--workers", type=int, default=1, metavar="W",
+    p.add_argument("--workers", type=int, metavar="W",
                    help="with --shards: local Dask worker processes (default 1; 0 runs the "
                    "segments one after another in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
@@ -352,7 +352,8 @@ def _verify(args: argparse.Namespace) -> int:
         return _verify_wrapper(args, args.sim, args.work, args.waves, args.json)
     arch, options = command_architecture(args)
     long_run = _long_run_settings(args)
-    if args.shards is not None or args.state_fault or args.scheduler:
+    if (args.shards is not None or args.state_fault or args.scheduler
+            or args.workers is not None):
         return _verify_shards(args, arch, options, long_run)
     if args.recompute_expected and not args.stimulus:
         raise RvsmError("--recompute-expected applies to --stimulus FILE only (the other "
@@ -405,7 +406,8 @@ def _verify_shards(args: argparse.Namespace, arch: Architecture, options: dict[s
         name = scene.name or "scene"
     else:
         raise RvsmError("--shards runs SCENE --fixed POINT.toml or --stimulus FILE")
-    r = check_shards(source, args.shards, args.sim, workers=args.workers,
+    workers = 1 if args.workers is None else args.workers
+    r = check_shards(source, args.shards, args.sim, workers=workers,
                      scheduler=args.scheduler, work_dir=args.work, name=name, arch=arch,
                      chunk_steps=long_run.chunk_steps, fault=fault,
                      progress=long_run.progress, **options)
@@ -415,7 +417,7 @@ def _verify_shards(args: argparse.Namespace, arch: Architecture, options: dict[s
         print(json.dumps(r))
     else:
         print(f"{args.sim}, {arch_text(r['arch'], r['options'])}: {r['steps']} steps in "
-              f"{r['shards']} segments on {args.scheduler or f'{args.workers} worker(s)'}: "
+              f"{r['shards']} segments on {args.scheduler or f'{workers} worker(s)'}: "
               f"compared {r['compared']} spikes and {r['boundary_states_compared']} "
               f"boundary states, {r['mismatches']} mismatches "
               f"({r['boundary_mismatches']} state words)")
