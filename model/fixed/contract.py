@@ -187,6 +187,11 @@ class FixedIntegrator:
         """Every accumulator back to 0 (the RTL's ``clear``; thresholds kept)."""
         self.acc[...] = 0
 
+    def state(self) -> np.ndarray:
+        """A copy of the accumulators ``(S, H, W) int64``: what the RTL's accumulator
+        memories hold between steps."""
+        return self.acc.copy()
+
     def step(self, sums: np.ndarray) -> np.ndarray:
         """Add ``sums (S, H, W) int64``, saturate, compare, reset; return spikes int8."""
         acc = self.acc
@@ -238,6 +243,11 @@ class FixedEventIntegrator:
     def clear(self) -> None:
         """The next step captures the references again (thresholds kept)."""
         self.captured = False
+
+    def state(self) -> np.ndarray:
+        """A copy of the references ``(S, H, W) int64`` (the RTL's accumulator memories
+        hold them between steps)."""
+        return self.ref.copy()
 
     def _update(self, new: np.ndarray) -> None:
         ev = self._events

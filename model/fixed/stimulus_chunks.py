@@ -79,6 +79,8 @@ class StimulusChunks:
     _point: DesignPoint | None = field(default=None, repr=False)
     _engine: str = field(default="fused", repr=False)
     _recompute: bool = field(default=False, repr=False)
+    _engine_state: object = field(default=None, init=False, repr=False)
+    _start_state: np.ndarray | None = field(default=None, init=False, repr=False)
 
     @classmethod
     def from_stimulus(cls, stim: Stimulus, path: str | None = None,
@@ -118,34 +120,93 @@ class StimulusChunks:
         return cls(point.contract(), thresholds, steps, (), spec, _scene=scene,
                    _point=point, _engine=engine)
 
-    def chunks(self, chunk_steps: int) -> Iterator[StimulusChunk]:
-        """Consecutive chunks of at most ``chunk_steps`` steps, never across a clear."""
+    def chunks(self, chunk_steps: int, start: int = 0, stop: int | None = None
+               ) -> Iterator[StimulusChunk]:
+        """Consecutive chunks of at most ``chunk_steps`` steps, never across a clear.
+
+        ``start`` / ``stop`` (a segment of a sharded run): only steps ``start .. stop -
+        1`` are yielded; the twin is first run over steps ``0 .. start - 1`` without
+        yielding them (the state at ``start`` is a function of the steps before it
+        only): :meth:`start_state` is the twin's state at ``start``. After the
+        generator has yielded a chunk, :meth:`state` is the state after its last
+        step."""
+        stop = self.num_steps if stop is None else int(stop)
+        if not 0 <= int(start) < stop <= self.num_steps:
+            raise RvsmError(f"segment {start}..{stop} is not inside 0..{self.num_steps}")
         ranges = step_ranges(self.num_steps, self.clear_before, chunk_steps)
+        # a segment of a stimulus runs the contract for its state (the file's spikes
+        # stay the expectation)
+        segment = self.stimulus is not None and (start > 0 or stop < self.num_steps)
         stream = twin = None
         fused = sensor_rules(self.contract.kind).fused_twin  # not the event sensor
         if (self._engine == "numpy" or not fused) and self.stimulus is None \
-                or self._recompute:
+                or self._recompute or segment:
             stream = self.contract.stream(self.thresholds)
         elif self.stimulus is None:
             assert self._scene is not None and self._point is not None
             if any(0 < t < self.num_steps for t in self.clear_before):
                 raise RvsmError("the fused engine runs scenes without clears")
             twin = FusedFixedTwin(self._scene, self._point, self.thresholds, ranges=False)
+        self._engine_state = twin if twin is not None else stream
         noise = self._point.noise_source() if self._point is not None else None
-        for t0, t1, clear in ranges:
+        for t0, t1, clear in self._cut(ranges, int(start), stop):
             if stream is not None and clear:
                 stream.clear()
+            skip = t1 <= start  # before the segment: state only
+            if t0 == start:
+                self._start_state = self.state()
             if self.stimulus is not None:
                 codes = np.asarray(self.stimulus.codes[t0:t1])
                 spikes = (stream.run(codes) if stream is not None
                           else self.stimulus.spikes[t0:t1])
+                if segment and not self._recompute:
+                    spikes = self.stimulus.spikes[t0:t1]
             else:
                 assert self._scene is not None and self._point is not None
+                if skip and twin is not None:
+                    twin.run(t0, t1)
+                    continue
                 codes = step_codes(self._scene, self._point, noise, t0, t1)
                 spikes = (twin.run(t0, t1) if twin is not None
                           else stream.run(codes))  # type: ignore[union-attr]
+            if skip:
+                continue
             yield StimulusChunk(t0, np.asarray(codes, dtype=np.uint16),
                                 np.asarray(spikes, dtype=np.int8), clear=clear)
+
+    @staticmethod
+    def _cut(ranges: Iterator[tuple[int, int, bool]], start: int, stop: int
+             ) -> Iterator[tuple[int, int, bool]]:
+        """The ranges cut at ``start`` and ended at ``stop``."""
+        for t0, t1, clear in ranges:
+            if t0 >= stop:
+                return
+            t1 = min(t1, stop)
+            if t1 <= start:
+                yield t0, t1, clear
+            elif t0 < start:
+                yield t0, start, clear
+                yield start, t1, False
+            else:
+                yield t0, t1, clear
+
+    def start_state(self) -> np.ndarray:
+        """The twin's state ``(S, H, W) int64`` at the ``start`` of the last
+        :meth:`chunks` (known once it has yielded its first chunk)."""
+        if self._start_state is None:
+            raise RvsmError("no start state yet: take the first chunk first")
+        return self._start_state
+
+    def state(self) -> np.ndarray:
+        """The twin's state ``(S, H, W) int64`` after the last step :meth:`chunks` ran:
+        the accumulators (the event sensor: the references). What the RTL's state
+        memories hold at a frame boundary."""
+        engine = self._engine_state
+        if engine is None:
+            raise RvsmError("no state yet: run chunks() first")
+        if isinstance(engine, FusedFixedTwin):
+            return np.asarray(engine.acc).astype(np.int64)
+        return engine.integrator.state()
 
 
 def open_stimulus_chunks(spec: dict | str) -> StimulusChunks:

@@ -83,6 +83,20 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--chunk-steps", type=int, default=8, metavar="N",
                    help="with --harness chunk: steps produced and streamed at a time "
                    "(default 8)")
+    p.add_argument("--shards", type=int, metavar="N",
+                   help="with --harness chunk: split the run into N segments, each started "
+                   "from the fixed twin's state and ending in a word-for-word state "
+                   "compare, run in parallel (docs/long-runs.md)")
+    p.add_argument("--workers", type=int, metavar="W",
+                   help="with --shards: local Dask worker processes (default 1; 0 runs the "
+                   "segments one after another in this process)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="with --shards: the Dask scheduler to run the segments on (e.g. "
+                   "tcp://host:8786) instead of local workers")
+    p.add_argument("--state-fault", metavar="K:FILE:WORD:BIT",
+                   help="with --shards: flip bit BIT of word WORD of the state file FILE "
+                   "(e.g. acc_s0.b0.hex) loaded into segment K's RTL: a seeded fault, "
+                   "to see the boundary check catch it")
     p.add_argument("--quiet", action="store_true",
                    help="no progress bar (--harness chunk)")
     p.add_argument("--code-coverage", action="store_true",
@@ -338,6 +352,9 @@ def _verify(args: argparse.Namespace) -> int:
         return _verify_wrapper(args, args.sim, args.work, args.waves, args.json)
     arch, options = command_architecture(args)
     long_run = _long_run_settings(args)
+    if (args.shards is not None or args.state_fault or args.scheduler
+            or args.workers is not None):
+        return _verify_shards(args, arch, options, long_run)
     if args.recompute_expected and not args.stimulus:
         raise RvsmError("--recompute-expected applies to --stimulus FILE only (the other "
                         "ways compute the expectation from the fixed twin anyway)")
@@ -349,6 +366,67 @@ def _verify(args: argparse.Namespace) -> int:
         print(json.dumps(r))
     else:
         _print_result(r, arch, args.sim, args.protocol)
+    return 1 if r["mismatches"] else 0
+
+
+def _verify_shards(args: argparse.Namespace, arch: Architecture, options: dict[str, int],
+                   long_run: LongRunSettings) -> int:
+    """``--shards N``: the run as state-seeded segments (:mod:`~.long_runs.shards`)."""
+    from rvsm.model.fixed.stimulus_chunks import StimulusChunks, open_stimulus_chunks
+    from rvsm.sim.cosim.long_runs.shards import check_shards
+
+    if args.shards is None:
+        raise RvsmError("--workers, --scheduler and --state-fault go with --shards N")
+    if long_run.harness != "chunk":
+        raise RvsmError("--shards needs --harness chunk (segments run in the long-run "
+                        "harness)")
+    bad = [n for n, v in (("--waves", args.waves), ("--code-coverage", args.code_coverage))
+           if v]
+    if bad:
+        raise RvsmError(f"--shards cannot be combined with {', '.join(bad)}")
+    fault = None
+    if args.state_fault:
+        k, _, rest = args.state_fault.partition(":")
+        parts = rest.split(":")
+        if not k.isdigit() or len(parts) != 3 or not all(x.isdigit() for x in parts[1:]):
+            raise RvsmError(f"--state-fault must be K:FILE:WORD:BIT, got {args.state_fault!r}")
+        fault = (int(k), rest)
+    request = StimulusRequest.from_args(args)
+    if request.kind == "file":
+        source = open_stimulus_chunks({"kind": "stimulus", "path": request.file,
+                                       "steps": request.steps,
+                                       "recompute": request.recompute_expected})
+        name = "stimulus"
+    elif request.kind == "scene":
+        scene, run = request.scene_and_point()
+        if request.steps is not None and request.steps > scene.num_steps:
+            raise RvsmError(f"--steps {request.steps} is more than the {scene.num_steps} "
+                            f"steps of scene {scene.name!r}")
+        source = StimulusChunks.from_scene(scene, run.point, request.steps)
+        name = scene.name or "scene"
+    else:
+        raise RvsmError("--shards runs SCENE --fixed POINT.toml or --stimulus FILE")
+    workers = 1 if args.workers is None else args.workers
+    r = check_shards(source, args.shards, args.sim, workers=workers,
+                     scheduler=args.scheduler, work_dir=args.work, name=name, arch=arch,
+                     chunk_steps=long_run.chunk_steps, fault=fault,
+                     progress=long_run.progress, **options)
+    if args.json:
+        r = dict(r)
+        r["mismatch_list"] = r["mismatch_list"][:10]
+        print(json.dumps(r))
+    else:
+        print(f"{args.sim}, {arch_text(r['arch'], r['options'])}: {r['steps']} steps in "
+              f"{r['shards']} segments on {args.scheduler or f'{workers} worker(s)'}: "
+              f"compared {r['compared']} spikes and {r['boundary_states_compared']} "
+              f"boundary states, {r['mismatches']} mismatches "
+              f"({r['boundary_mismatches']} state words)")
+        if r["mismatches"]:
+            f = r["first_mismatch"] or {}
+            print("first mismatch: " + ", ".join(f"{k}={v}" for k, v in f.items()))
+        print(f"wall {r['wall_seconds']:.0f} s (build {r['build_seconds']:.0f} s"
+              f"{', cached' if r['build_cached'] else ''}), {r['cycles']} cycles")
+        print(f"run folders: {r['run_dir']}")
     return 1 if r["mismatches"] else 0
 
 

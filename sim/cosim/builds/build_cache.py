@@ -55,6 +55,7 @@ from rvsm.sim.cosim.builds.chunk_harness import (
     HarnessLayout,
     clock_inside,
     harness_verilog,
+    state_memories,
 )
 from rvsm.sim.cosim.builds.cocotb_adapter import build_args, check_simulator, cocotb_build, cxx_opt
 from rvsm.sim.cosim.builds.icarus_netlist import (
@@ -264,12 +265,13 @@ def build(
         ports = [p["name"] for p in port_map["ports"]]
         if harness:
             layout = HarnessLayout.from_ports(port_map)
-            sources.append(stage / f"{HARNESS_TOP}.v")
-            sources[-1].write_text(harness_verilog(layout, clock_inside(sim)))
-            hdl_top, ports = HARNESS_TOP, layout.ports
             if sim == "icarus":  # simulation-only, about 2x faster (:mod:`.icarus_netlist`)
                 sources[0] = stage / icarus_netlist_name(top)
                 write_icarus_netlist(paths["verilog"], top, sources[0], log)
+            state = state_memories(sources[0].read_text(), top)  # for sharded runs
+            sources.append(stage / f"{HARNESS_TOP}.v")
+            sources[-1].write_text(harness_verilog(layout, clock_inside(sim), state))
+            hdl_top, ports = HARNESS_TOP, layout.ports
         cocotb_build(sim, sources, hdl_top, ports, stage / "sim_build", traced, log,
                      long_run=harness, coverage=coverage)
         build_seconds = time.perf_counter() - t0

@@ -32,6 +32,14 @@ the array's port map (``<top>.ports.json``): it instantiates the array and adds
   4,648 -> 5,584 cycles per CPU second of the simulator's thread, 12.0 -> 6.8 s of
   simulation on a quieter machine (docs/long-runs.md); Verilator builds keep the input
   (a delay needs ``--timing``);
+* the array's state, for a segment of a sharded run (:mod:`rvsm.sim.cosim.long_runs.shards`):
+  ``state_load`` high at a rising edge: at the next falling edge, ``$readmemh`` of every
+  accumulator and threshold memory bank from ``state_in/<acc|thr>_s<S>.b<K>.hex`` by
+  hierarchical name (:func:`state_memories`: the banks as the array's Verilog declares
+  them), and the fresh-frame flag cleared (the first frame after reset then reads the
+  loaded accumulators, as a run that reached this step would); ``state_dump`` likewise
+  ``$writememh`` of every bank to ``state_out/``. Both reach into the simulation only:
+  the array has no port for them;
 * ``+rvsm_dump_file=F +rvsm_dump_from=C0 +rvsm_dump_to=C1``: a waveform (VCD) of the
   array's ports and internals for clock cycles ``C0 .. C1`` only (``$dumpvars`` at
   ``C0``, ``$dumpoff`` after ``C1``), the window around a mismatch of a long run.
@@ -52,12 +60,12 @@ import numpy as np
 from rvsm.model.infra.errors import ToolError
 
 __all__ = ["CLOCK_NS", "DEFAULT_DEPTH", "HARNESS_TOP", "HARNESS_VERSION",
-           "STAMP_BITS", "TAIL", "HarnessLayout", "clock_inside",
-           "decode_output_beats", "encode_input_beats", "encode_threshold_writes",
-           "harness_verilog"]
+           "STAMP_BITS", "TAIL", "HarnessLayout", "StateMemories", "StateMemory",
+           "clock_inside", "decode_output_beats", "encode_input_beats",
+           "encode_threshold_writes", "harness_verilog", "state_memories"]
 
 #: Bump when the harness's Verilog changes (part of a harness build's cache key).
-HARNESS_VERSION = "3"
+HARNESS_VERSION = "4"
 #: Module name of the harness (the simulation's top level).
 HARNESS_TOP = "rvsm_chunk_harness"
 #: Beats per chunk the harness memories hold.
@@ -117,7 +125,75 @@ class HarnessLayout:
     def ports(self) -> list[str]:
         """The harness's own ports (what the testbench touches)."""
         return ["clk", "rst", "clear", "thr_we", "thr_addr", "thr_data", "thr_load",
-                "thr_count", "start", "count", "done", "out_count", "stray", "overflow"]
+                "thr_count", "start", "count", "done", "out_count", "stray", "overflow",
+                "state_load", "state_dump"]
+
+
+@dataclass(frozen=True)
+class StateMemory:
+    """One bank of a state memory of the array: ``kind`` (``"acc"`` or ``"thr"``),
+    ``scale``, ``bank``, ``width`` bits x ``depth`` words, and its hierarchical
+    ``name`` below the array's instance, as Verilog text."""
+
+    kind: str
+    scale: int
+    bank: int
+    width: int
+    depth: int
+    name: str
+
+    @property
+    def file(self) -> str:
+        """Its file name in ``state_in/`` and ``state_out/``."""
+        return f"{self.kind}_s{self.scale}.b{self.bank}.hex"
+
+
+@dataclass(frozen=True)
+class StateMemories:
+    """The array's state memory banks (in scale, bank order) and the hierarchical name
+    of its fresh-frame flag (``fresh_s0``)."""
+
+    banks: tuple[StateMemory, ...]
+    fresh: str
+
+
+_MODULE = re.compile(r"^module\s+(\\\S+|\w+)\s*\((.*?)^endmodule", re.S | re.M)
+_BANK = re.compile(r"^\s*reg\s+\[(\d+):0\]\s+(\\\S+|\w+)\s+\[(\d+):(\d+)\];", re.M)
+_FRESH = re.compile(r"^\s*reg\s+(\\\S+|\w+)\s*=\s*1'h1;", re.M)
+
+
+def state_memories(verilog: str, top: str) -> StateMemories:
+    """The state memory banks of the streaming array ``top`` in its Verilog: Amaranth's
+    (a module ``\\top.acc_s0`` declaring ``reg [W-1:0] b0 [N-1:0]``: name
+    ``acc_s0.b0``) or the flat Icarus netlist (``reg ... \\acc_s0.b0  [...]`` in the
+    top module: that escaped name). Raises :class:`ToolError` when none is found."""
+    banks: list[StateMemory] = []
+    fresh = None
+    for m in _MODULE.finditer(verilog):
+        module, body = m.group(1), m.group(2)
+        plain = module.lstrip("\\")
+        inside = plain[len(top) + 1:].split(".") if plain.startswith(top + ".") else []
+        for b in _BANK.finditer(body):
+            width, name, hi, lo = int(b.group(1)) + 1, b.group(2), int(b.group(3)), \
+                int(b.group(4))
+            path = [*inside, name.lstrip("\\")]
+            found = re.fullmatch(r"(?:.*\.)?(acc|thr)_s(\d+)\.b(\d+)", ".".join(path))
+            if not found:
+                continue
+            text = ".".join(path) if not name.startswith("\\") else name + " "
+            banks.append(StateMemory(found.group(1), int(found.group(2)),
+                                     int(found.group(3)), width, abs(hi - lo) + 1, text))
+        for f in _FRESH.finditer(body):
+            if f.group(1).lstrip("\\").endswith("fresh_s0"):
+                name = f.group(1)
+                fresh = (".".join([*inside, name]) if not name.startswith("\\")
+                         else name + " ")
+    if not banks or fresh is None:
+        raise ToolError(f"no state memories (acc_s*/thr_s* banks, fresh_s0) found in the "
+                        f"Verilog of {top!r}: the long-run harness cannot load or dump "
+                        "its state")
+    banks.sort(key=lambda b: (b.kind, b.scale, b.bank))
+    return StateMemories(tuple(banks), fresh)
 
 
 def clock_inside(sim: str) -> bool:
@@ -125,9 +201,12 @@ def clock_inside(sim: str) -> bool:
     return sim == "icarus"
 
 
-def harness_verilog(layout: HarnessLayout, clock_inside: bool = False) -> str:
+def harness_verilog(layout: HarnessLayout, clock_inside: bool = False,
+                    state: StateMemories | None = None) -> str:
     """The Verilog text of :data:`HARNESS_TOP` around ``layout.top``; ``clock_inside``:
-    ``clk`` is made by the harness (module docstring), not driven from outside."""
+    ``clk`` is made by the harness (module docstring), not driven from outside;
+    ``state``: the banks ``state_load`` / ``state_dump`` reach (none: both do
+    nothing)."""
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", layout.top):
         raise ToolError(f"not a Verilog identifier: {layout.top!r}")
     w = layout.widths
@@ -152,6 +231,8 @@ module {HARNESS_TOP} (
   input  wire [31:0] thr_count,
   input  wire start,
   input  wire [31:0] count,
+  input  wire state_load,
+  input  wire state_dump,
   output reg  done,
   output reg  [31:0] out_count,
   output reg  [31:0] stray,
@@ -169,6 +250,7 @@ module {HARNESS_TOP} (
   reg [7:0] tail;
   reg thr_loading;
   reg [31:0] thr_taken;
+  reg state_load_now, state_dump_now;
   wire [{ta + td - 1}:0] thr_word = thr_mem[thr_taken[{tbits - 1}:0]];
   wire codes_ready;
   wire spikes_valid;
@@ -200,13 +282,18 @@ module {HARNESS_TOP} (
     tail = 0;
     thr_loading = 0;
     thr_taken = 0;
+    state_load_now = 0;
+    state_dump_now = 0;
     out_count = 0;
     stray = 0;
     overflow = 0;
   end
 
+{_state_block(state)}
   always @(posedge clk) begin
     cycle <= cycle + 64'd1;
+    state_load_now <= state_load && !running;
+    state_dump_now <= state_dump && !running;
     if (dump_file != 0 && cycle == dump_from) begin
       $dumpfile(dump_file);
       $dumpvars(0, dut);
@@ -271,6 +358,25 @@ module {HARNESS_TOP} (
   end
 endmodule
 // verilator coverage_on
+"""
+
+
+def _state_block(state: StateMemories | None) -> str:
+    """The falling-edge block loading and dumping the array's state (module docstring)."""
+    if state is None:
+        return "  // no state memories: state_load and state_dump do nothing"
+    load = "".join(f'      $readmemh("state_in/{b.file}", dut.{b.name}, 0, {b.depth - 1});\n'
+                   for b in state.banks)
+    dump = "".join(f'      $writememh("state_out/{b.file}", dut.{b.name}, 0, {b.depth - 1});\n'
+                   for b in state.banks)
+    return f"""  // The array's state, reached by hierarchical names (simulation only).
+  always @(negedge clk) begin
+    if (state_load_now) begin
+{load}      dut.{state.fresh} = 1'b0;
+    end
+    if (state_dump_now) begin
+{dump}    end
+  end
 """
 
 

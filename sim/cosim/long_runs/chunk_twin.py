@@ -36,6 +36,7 @@ output is ignored, so the counts are those of the run up to that chunk.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import json
 import os
 import secrets
@@ -63,6 +64,7 @@ from rvsm.sim.cosim.builds.chunk_harness import (
     encode_input_beats,
     encode_threshold_writes,
 )
+from rvsm.sim.cosim.long_runs.segment_state import SegmentState
 from rvsm.sim.cosim.testbenches.tb_common import beat_stream, stream_geometry
 
 __all__ = ["AHEAD", "TwinProcess", "connect", "decode_beats", "start_twin"]
@@ -104,17 +106,21 @@ class TwinProcess:
 
 
 def start_twin(source: str, ports: str | os.PathLike, run_dir: str | os.PathLike,
-               chunk_steps: int, depth: int, stop_on_mismatch: bool = True) -> TwinProcess:
+               chunk_steps: int, depth: int, stop_on_mismatch: bool = True,
+               segment: tuple[int, int] | None = None) -> TwinProcess:
     """Launch the twin for the run ``source`` (the JSON of ``StimulusChunks.spec``) on the
     build whose port map is ``ports``; its files go in ``run_dir`` (the simulator's
-    folder), its log in ``run_dir/twin.log``."""
+    folder), its log in ``run_dir/twin.log``. ``segment``: steps ``t0, t1`` of a
+    sharded run (the state at ``t0`` written to ``state_in/``, the RTL's at ``t1``
+    compared)."""
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
     address = str(Path(tempfile.mkdtemp(prefix="rvsm-twin-")) / "s")  # short: AF_UNIX
     key = secrets.token_hex(16)
     config = {"source": source, "ports": str(ports), "dir": str(run_dir),
               "chunk_steps": int(chunk_steps), "depth": int(depth),
-              "stop_on_mismatch": bool(stop_on_mismatch), "address": address}
+              "stop_on_mismatch": bool(stop_on_mismatch), "address": address,
+              "segment": None if segment is None else [int(t) for t in segment]}
     env = {**os.environ, CONFIG_ENV: json.dumps(config), KEY_ENV: key}
     log = run_dir / "twin.log"
     with open(log, "ab") as f:
@@ -181,13 +187,26 @@ class _Twin:
                                                               self.layout.in_bits)
         self.checker = beats.checker(self.sched)
         self.border = beats.border_coverage(c, geo.lanes)
-        self.chunks: Iterator = source.chunks(int(cfg["chunk_steps"]))
+        segment = cfg.get("segment")
+        self.state: SegmentState | None = None
+        if segment is None:
+            self.chunks: Iterator = source.chunks(int(cfg["chunk_steps"]))
+        else:  # a segment of a sharded run: the state at its start goes to the RTL
+            t0, t1 = (int(t) for t in segment)
+            chunks = source.chunks(int(cfg["chunk_steps"]), t0, t1)
+            t = time.perf_counter()
+            first = next(chunks)
+            self.seconds_fast_forward = time.perf_counter() - t
+            self.chunks = itertools.chain([first], chunks)
+            self.checker.restart(t0)
+            self.state = SegmentState(source, geo, t0, t1)
+            self.state.write_start(self.dir / "state_in")
         self.num_steps = source.num_steps
         flush = np.zeros((self.sched.lag, geo.lanes), dtype=np.uint16)
         writes = beats.threshold_writes(geo, source.thresholds)
         (self.dir / "thresholds.hex").write_bytes(encode_threshold_writes(
             writes, self.layout.widths["thr_addr"], self.layout.widths["thr_data"]))
-        self.setup = {"thresholds": len(writes),
+        self.setup = {"thresholds": len(writes), "state": self.state is not None,
                       "num_steps": source.num_steps, "lanes": geo.lanes,
                       "flush": [(n, self._encode_beats(b)) for n, b in self._parts(flush)]}
         self.expected: dict[int, np.ndarray] = {}
@@ -282,8 +301,10 @@ class _Twin:
         self.seconds["decode"] += tc - t
         self.seconds["check"] += time.perf_counter() - tc
 
-    def result(self, ended: bool, steps_done: int) -> dict:
-        """The checker's verdict and the twin's figures."""
+    def result(self, ended: bool, steps_done: int, dumped: bool = False) -> dict:
+        """The checker's verdict and the twin's figures; ``dumped``: the RTL's state at
+        the segment's end is in ``state_out/``, compared word for word with the twin's
+        (``boundary``)."""
         for paths in self.files.values():  # made ahead of a run stopped early
             for path in paths:
                 Path(path).unlink(missing_ok=True)
@@ -296,6 +317,12 @@ class _Twin:
              "first_chunk_at": self.first_chunk_at}
         if not finished:
             r["stopped_at_step"] = self.failed_at if self.failed_at is not None else steps_done
+        if self.state is not None:
+            t = time.perf_counter()
+            r["boundary"] = (self.state.compare_end(self.dir / "state_out")
+                             if dumped and finished else None)
+            self.seconds["state_compare"] = time.perf_counter() - t
+            self.seconds["fast_forward"] = self.seconds_fast_forward
         return r
 
 
@@ -330,7 +357,8 @@ def serve(cfg: dict, key: bytes) -> None:
             twin.seconds["idle"] += time.perf_counter() - t
             for m in msg[1] if msg[0] == "batch" else [msg]:
                 if m[0] == "finish":
-                    c.send(("result", twin.result(bool(m[1]), int(m[2]))))
+                    c.send(("result", twin.result(bool(m[1]), int(m[2]),
+                                                  bool(m[3]) if len(m) > 3 else False)))
                     return
                 reply = twin.handle(m)
                 if reply is not None:

@@ -77,9 +77,11 @@ def _run(sb: SimBuild, inputs: dict, run_dir: Path, plusargs: list[str],
          hdl_dumps: bool) -> dict:
     """One testbench run, the twin's process (:mod:`.chunk_twin`) started first: its
     first chunk is made while the simulator starts."""
+    segment = json.loads(inputs.get("RVSM_SEGMENT", "null"))
     twin = start_twin(inputs["RVSM_SOURCE"], sb.ports_json.resolve(), run_dir,
                       int(inputs["RVSM_CHUNK_STEPS"]), DEFAULT_DEPTH,
-                      stop_on_mismatch="RVSM_STOP_AFTER_CYCLE" not in inputs)
+                      stop_on_mismatch="RVSM_STOP_AFTER_CYCLE" not in inputs,
+                      segment=segment)
     try:
         return run_cocotb(sb, {**inputs, **twin.env()}, run_dir, plusargs=plusargs,
                           hdl_dumps=hdl_dumps)
@@ -129,6 +131,8 @@ def check_chunks(
     waves: bool = False,
     progress: bool = False,
     code_coverage: bool = False,
+    segment: tuple[int, int] | None = None,
+    state_flip: str | None = None,
     **options: int | None,
 ) -> dict:
     """Run ``source`` through the RTL in the long-run harness; compare every spike.
@@ -140,6 +144,10 @@ def check_chunks(
     (module docstring); with ``waves``, the whole run. ``code_coverage`` (Verilator)
     builds line and toggle coverage in and gives ``code_coverage``, the run's
     ``coverage.dat`` (:mod:`.code_coverage`), and its ``code_coverage_summary``.
+    ``segment`` ``(t0, t1)``: only steps ``t0 .. t1 - 1``, the RTL started from the
+    twin's state at ``t0`` and its state at ``t1`` compared (``boundary``; a segment of
+    :func:`~.shards.check_shards`); ``state_flip`` (``FILE:WORD:BIT``) flips a bit of
+    the state loaded: a seeded fault.
     """
     a = get_architecture(arch)
     resolved = a.resolve(options)
@@ -155,11 +163,16 @@ def check_chunks(
     try:
         inputs = {**_source_inputs(source, run_dir, chunk_steps),
                   "RVSM_HARNESS_CLOCK": "inside" if clock_inside(sim) else "outside"}
+        if segment is not None:
+            inputs["RVSM_SEGMENT"] = json.dumps([int(t) for t in segment])
+            if state_flip:
+                inputs["RVSM_STATE_FLIP"] = state_flip
+        total = source.num_steps if segment is None else segment[1] - segment[0]
         plusargs = []
         if waves:
             plusargs = [f"+rvsm_dump_file={run_dir / WHOLE_RUN_WAVES}", "+rvsm_dump_from=0",
                         f"+rvsm_dump_to={2**62}"]
-        result = _run_with_progress(sb, inputs, run_dir, source.num_steps,
+        result = _run_with_progress(sb, inputs, run_dir, total,
                                     f"{sim} {a.name} {name}", progress, plusargs, waves)
         result["waves"] = str(run_dir / WHOLE_RUN_WAVES) if waves else None
         dat = run_dir / "coverage.dat"

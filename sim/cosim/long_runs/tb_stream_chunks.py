@@ -10,7 +10,15 @@ on the run's source, chunk steps and harness depth); optional ``RVSM_PROGRESS`` 
 rewritten with ``steps done/total`` as chunks finish), ``RVSM_STOP_AFTER_CYCLE`` (stop
 once the simulation passes that cycle: a waveform window's re-run) and
 ``RVSM_HARNESS_CLOCK`` (``inside``: the harness makes ``clk`` itself,
-:func:`~.chunk_harness.clock_inside`; default ``outside``, a cocotb ``Clock``).
+:func:`~.chunk_harness.clock_inside`; default ``outside``, a cocotb ``Clock``) and
+``RVSM_STATE_FLIP`` (a segment's seeded fault: ``FILE:WORD:BIT`` of the state loaded,
+:func:`_flip_state_word`).
+
+A segment of a sharded run (:mod:`.shards`; the twin's ``setup`` says ``state``): after
+reset the harness loads the twin's state at the segment's first step (``state_load``:
+the files the twin wrote in ``state_in/``), and after the last flush it dumps the RTL's
+state (``state_dump``, ``state_out/``), which the twin compares word for word with its
+own (``boundary`` in the result; its mismatches count).
 
 The twin's process makes each chunk's input beats as a ``$readmemh`` file; per chunk
 the testbench moves the file to ``chunk_in.hex``, pulses ``start`` and awaits ``done``:
@@ -131,8 +139,15 @@ async def stream_long_run(dut: object) -> None:
     clk = dut.clk  # type: ignore[attr-defined]
     h = {name: getattr(dut, name) for name in layout.ports}
     await clock_and_reset(dut, ("clear", "thr_we", "thr_addr", "thr_data", "thr_load",
-                                "thr_count", "start", "count"), clock=clock == "outside")
+                                "thr_count", "start", "count", "state_load", "state_dump"),
+                          clock=clock == "outside")
     mark("reset")
+    if setup["state"]:  # a segment: the twin's state at its first step (state_in/)
+        flip = _optional("state_flip", None)
+        if flip:
+            _flip_state_word(Path.cwd() / "state_in", flip)
+        await _pulse(h["state_load"], clk)
+        mark("state_loaded")
     t0 = time.perf_counter()
     if setup["thresholds"]:  # the harness writes them, one per cycle (thresholds.hex)
         h["thr_count"].value = setup["thresholds"]
@@ -192,7 +207,7 @@ async def stream_long_run(dut: object) -> None:
             counts["parts"] += 1
 
     steps_done = 0
-    stopped_early = ended = False
+    stopped_early = ended = dumped = False
     outbox: list[tuple] = []  # messages to the twin, sent with the next output file
     last_progress = 0.0
     while True:
@@ -204,6 +219,10 @@ async def stream_long_run(dut: object) -> None:
         if item[0] == "end":
             await send(flush)  # the last lag positions
             ended = True
+            if setup["state"]:  # the RTL's state at the segment's end, to state_out/
+                (Path.cwd() / "state_out").mkdir(exist_ok=True)
+                await _pulse(h["state_dump"], clk)
+                dumped = True
             break
         _, k, t0_step, num_steps, clear, files = item
         if clear:
@@ -235,7 +254,8 @@ async def stream_long_run(dut: object) -> None:
     te = time.perf_counter()
     if progress:
         write_text_atomic(progress, f"{steps_done}/{setup['num_steps']}\n")
-    conn.send(("batch", [*outbox, ("finish", ended and not stopped_early, steps_done)]))
+    conn.send(("batch", [*outbox, ("finish", ended and not stopped_early, steps_done,
+                                   dumped)]))
     twin = wait_for("result")[1]
     timings["wait_for_check"] += time.perf_counter() - te
     stream_seconds = time.perf_counter() - t0
@@ -247,6 +267,16 @@ async def stream_long_run(dut: object) -> None:
     result = twin["result"]
     if "stopped_at_step" in twin:
         result["stopped_at_step"] = twin["stopped_at_step"]
+    boundary = twin.get("boundary")
+    if boundary is not None:
+        result["boundary"] = boundary
+        result["mismatches"] += boundary["mismatches"]
+        if boundary["mismatches"]:
+            first_state = {"step": boundary["step"], "error": "state at the segment's end",
+                           **boundary["mismatch_list"][0]}
+            result["mismatch_list"].append(first_state)
+            if result["first_mismatch"] is None:
+                result["first_mismatch"] = first_state
     if stray or overflow:
         result["mismatches"] += stray + overflow
         result["mismatch_list"].insert(0, {"beat": twin["beats_received"], "error": (
@@ -278,6 +308,27 @@ async def stream_long_run(dut: object) -> None:
     Path(result_path).write_text(json.dumps(result))
     assert result["mismatches"] == 0, \
         f"{result['mismatches']} mismatches; first {result['first_mismatch']}"
+
+
+async def _pulse(signal: object, clk: object) -> None:
+    """``signal`` high for one rising edge; returns after the falling edge the harness
+    acts at (its state load or dump)."""
+    signal.value = 1  # type: ignore[attr-defined]
+    await FallingEdge(clk)
+    signal.value = 0  # type: ignore[attr-defined]
+    await FallingEdge(clk)
+
+
+def _flip_state_word(folder: Path, flip: str) -> None:
+    """A seeded fault (``RVSM_STATE_FLIP=FILE:WORD:BIT``, e.g. ``acc_s0.b0.hex:3:0``):
+    flip one bit of one word of the state the RTL is about to load, so the RTL starts
+    the segment from a state the twin does not have."""
+    name, word, bit = flip.split(":")
+    path = folder / name
+    lines = path.read_text().split("\n")
+    digits = len(lines[int(word)])
+    lines[int(word)] = f"{int(lines[int(word)], 16) ^ (1 << int(bit)):0{digits}x}"
+    path.write_text("\n".join(lines))
 
 
 def _cycle_time_ns(cycle: int) -> int:
