@@ -1,5 +1,7 @@
 """Sweep files: parse, validate and expand a fixed-point design sweep (docs/design-space.md).
 
+(About 460 lines: one file format, its every table and its refusals, read together.)
+
 A sweep file (TOML) names a base design point (``[base]``), the axes to vary (``[axes]``,
 keyed by the design point's ``section.key`` names), what to run (``[run]``: scenes, size,
 frames, seeds, noise) and how to measure hardware (``[hardware]``). :func:`expand` turns it
