@@ -130,13 +130,14 @@ class StimulusChunks:
         only): :meth:`start_state` is the twin's state at ``start``. After the
         generator has yielded a chunk, :meth:`state` is the state after its last
         step."""
+        tracked = start > 0 or stop is not None  # a segment: its states are asked for
         stop = self.num_steps if stop is None else int(stop)
         if not 0 <= int(start) < stop <= self.num_steps:
             raise RvsmError(f"segment {start}..{stop} is not inside 0..{self.num_steps}")
         ranges = step_ranges(self.num_steps, self.clear_before, chunk_steps)
         # a segment of a stimulus runs the contract for its state (the file's spikes
         # stay the expectation)
-        segment = self.stimulus is not None and (start > 0 or stop < self.num_steps)
+        segment = self.stimulus is not None and tracked
         stream = twin = None
         fused = sensor_rules(self.contract.kind).fused_twin  # not the event sensor
         if (self._engine == "numpy" or not fused) and self.stimulus is None \
@@ -153,7 +154,7 @@ class StimulusChunks:
             if stream is not None and clear:
                 stream.clear()
             skip = t1 <= start  # before the segment: state only
-            if t0 == start:
+            if t0 == start and self._engine_state is not None:
                 self._start_state = self.state()
             if self.stimulus is not None:
                 codes = np.asarray(self.stimulus.codes[t0:t1])
