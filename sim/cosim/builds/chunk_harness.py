@@ -177,7 +177,10 @@ def state_memories(verilog: str, top: str) -> StateMemories:
             width, name, hi, lo = int(b.group(1)) + 1, b.group(2), int(b.group(3)), \
                 int(b.group(4))
             path = [*inside, name.lstrip("\\")]
-            found = re.fullmatch(r"(?:.*\.)?(acc|thr)_s(\d+)\.b(\d+)", ".".join(path))
+            # the bank's array, named by its module (``acc_s0.b0``) or inside it
+            # (``state.acc_s0.b0.mem``, the memory lowered as a cell of its own)
+            found = re.fullmatch(r"(?:.*\.)?(acc|thr)_s(\d+)\.b(\d+)(?:\.mem)?",
+                                 ".".join(path))
             if not found:
                 continue
             text = ".".join(path) if not name.startswith("\\") else name + " "
