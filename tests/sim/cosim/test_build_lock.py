@@ -45,7 +45,7 @@ def test_two_processes_building_the_same_design_build_it_once(tmp_path: Path) ->
     assert sorted(r["cached"] for r in results) == [False, True]  # one build, both get it
     building = [err for _, err in outs if "rvsm: building " in err]
     assert len(building) == 1, outs
-    assert not list(root.glob("*.tmp*"))
+    assert not list(root.glob("*.tmp*")) and not list(root.glob("*.lock"))
 
 
 def test_a_killed_builder_leaves_nothing_the_next_build_keeps(tmp_path: Path) -> None:
@@ -61,7 +61,7 @@ def test_a_killed_builder_leaves_nothing_the_next_build_keeps(tmp_path: Path) ->
     proc.communicate()
     tmp = list(root.glob("*.tmp*"))[0]
     final = tmp.with_name(tmp.name.rsplit(".tmp", 1)[0])
-    fd = os.open(lock_path(final), os.O_RDWR)
+    fd = os.open(lock_path(final), os.O_RDWR)  # left by the killed builder
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # free: the kernel released it
     finally:
@@ -69,3 +69,4 @@ def test_a_killed_builder_leaves_nothing_the_next_build_keeps(tmp_path: Path) ->
     with build_lock(final):  # held: the sweep must leave a folder being built alone
         assert sweep_stale(root) == [] and tmp.exists()
     assert sweep_stale(root) == [tmp] and not tmp.exists()
+    assert list(root.iterdir()) == []  # no lock file either
