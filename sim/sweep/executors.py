@@ -14,6 +14,7 @@ must be on a trusted network or use ``tls://`` with certificates
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 from collections.abc import Iterator, Sequence
@@ -41,6 +42,8 @@ class Executor(Protocol):
     workers: int
     #: Numba threads each point evaluation may use (None: the process default).
     threads: int | None
+    #: Process ids that ran (or may have run) items.
+    pids: set[int]
 
     def __enter__(self) -> Executor: ...
 
@@ -63,6 +66,11 @@ class LocalExecutor:
 
     def __exit__(self, *exc: object) -> None:
         pass
+
+    @property
+    def pids(self) -> set[int]:
+        """Process ids that ran items: this process."""
+        return {os.getpid()}
 
     def run(self, items: Sequence[WorkItem]) -> Iterator[Finished]:
         """Run each item in turn; see :meth:`Executor.run`."""
@@ -87,7 +95,10 @@ def local_cluster(workers: int, processes: bool = True):
     random ports (threaded workers talk in-process)."""
     from dask.distributed import LocalCluster
 
-    where = {"host": LOCAL_HOST} if processes else {}  # threads talk in-process (inproc://)
+    # threads talk in-process (inproc://); worker processes get their own process group
+    # and ignore SIGINT (:mod:`.worker_setup`): an interrupt is the parent's to handle
+    where = ({"host": LOCAL_HOST, "preload": ["rvsm.sim.sweep.worker_setup"]} if processes
+             else {})
     return LocalCluster(n_workers=workers, threads_per_worker=1, processes=processes,
                         **where, dashboard_address=f"{LOCAL_HOST}:0",
                         worker_dashboard_address=f"{LOCAL_HOST}:0", silence_logs=logging.ERROR)
@@ -116,6 +127,13 @@ class DaskExecutor:
         self._cluster = None
         self._client = None
         self._futures: list = []
+        #: Process ids of the workers seen (a killed worker's too: what it left half-made
+        #: carries its pid).
+        self.pids: set[int] = set()
+
+    def _note_pids(self) -> None:
+        with contextlib.suppress(Exception):  # a worker dying now is noted next time
+            self.pids |= set(self._client.run(os.getpid).values())
 
     def __enter__(self) -> DaskExecutor:
         from dask.distributed import Client
@@ -132,6 +150,7 @@ class DaskExecutor:
             if self._client is None:
                 self._client = Client(self._cluster)
             self.workers = len(self._client.scheduler_info().get("workers", {}))
+            self._note_pids()
         except BaseException:
             self.__exit__()
             raise
@@ -139,6 +158,8 @@ class DaskExecutor:
 
     def __exit__(self, *exc: object) -> None:
         try:
+            if self._client is not None and exc and exc[0] is not None:
+                self._note_pids()
             if self._futures:
                 self._client.cancel([f for f in self._futures if not f.done()])
         finally:
@@ -168,6 +189,7 @@ class DaskExecutor:
             else:
                 yield Finished(work[future.key], value)
             future.release()
+            self._note_pids()
 
 
 def executor_for(workers: int | None = None, scheduler: str | None = None,

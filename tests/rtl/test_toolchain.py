@@ -129,3 +129,31 @@ def test_find_tool_prefers_the_override(tmp_path: Path, monkeypatch: pytest.Monk
     monkeypatch.setenv("PATH", str(tmp_path))
     with pytest.raises(ToolError, match="no-such-tool not found"):
         find_tool("no-such-tool")
+
+
+def test_a_parent_killed_outright_takes_its_tools_along(tmp_path: Path) -> None:
+    """A parent SIGKILLed while its tool runs (a Dask worker ended by its nanny, the OOM
+    killer) cannot clean up: the group's guard kills the tool and its children."""
+    pid_file = tmp_path / "pid"
+    script = textwrap.dedent(f"""
+        from rvsm.rtl.toolchain import run_tool
+        run_tool(["sh", "-c", "sleep 60 & echo $! > {pid_file}; wait"])
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script], preexec_fn=default_signals)
+    end = time.monotonic() + 20
+    while not (pid_file.exists() and pid_file.read_text().strip()):
+        assert time.monotonic() < end and proc.poll() is None
+        time.sleep(0.05)
+    child = int(pid_file.read_text())
+    assert _alive(child)
+    proc.kill()
+    proc.wait(timeout=20)
+    assert _wait_dead(child)
+
+
+def test_a_finished_tool_leaves_no_guard() -> None:
+    """The guard ends with its tool: no process of the group is left."""
+    run = run_tool(["sh", "-c", "echo $$"], capture=True)
+    pgid = int(run.stdout.strip())
+    with pytest.raises(ProcessLookupError):
+        os.killpg(pgid, 0)

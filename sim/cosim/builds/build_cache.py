@@ -6,7 +6,8 @@ checked by checksum before each use and reused by every stimulus
 (:func:`rvsm.sim.cosim.builds.testbench_run.run_testbench`), so a Verilator compile is paid once.
 Icarus builds always include the FST dump module; Verilator builds get ``--trace-fst``
 only when waves are asked for (a second cached build), since tracing doubles the C++. A
-build happens in a private folder renamed into place when done; the Verilog of a
+build happens in a private folder renamed into place when done, one process at a time
+per key (:mod:`.build_lock`), and says on stderr what it is doing; the Verilog of a
 contract already generated for another build is reused; each run gets a fresh folder
 (:func:`new_run_dir`). The simulators are driven through
 :mod:`rvsm.sim.cosim.builds.cocotb_adapter`.
@@ -49,6 +50,7 @@ from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.rtl_digest import rtl_digest
 from rvsm.rtl.toolchain import ToolFailure, run_tool
+from rvsm.sim.cosim.builds.build_lock import build_lock, remove_stale
 from rvsm.sim.cosim.builds.chunk_harness import (
     HARNESS_TOP,
     HARNESS_VERSION,
@@ -208,8 +210,11 @@ def build(
     Icarus builds always carry the FST dump module (cheap); Verilator builds carry
     ``--trace-fst`` only when ``waves`` (a separate cached build: tracing doubles the
     C++). A build happens in a private folder ``<name>.tmp<pid>`` renamed into place
-    when done, so concurrent processes share ``build_root`` safely; it is removed when
-    the build fails or is interrupted (a failed build's log is kept as
+    when done, under a lock on ``<name>.lock`` (:mod:`.build_lock`): a second process
+    asking for the same build waits for the first and uses its build, so a design is
+    compiled once whatever the workers; the private folder is removed when
+    the build fails or is interrupted (or, when its builder was killed outright, by the
+    next builder of that name) (a failed build's log is kept as
     ``<name>.failed.log``). A cached build is used only when its recorded checksums
     still match (:func:`_cached`); a damaged one is rebuilt. The Verilog of a contract
     already generated for another build is reused, not regenerated. ``arch`` and
@@ -240,6 +245,20 @@ def build(
     cached = _cached(final, sim, top, traced, key, design, harness)
     if cached is not None:
         return cached
+    with build_lock(final):  # one build per key: another process's may be done now
+        cached = _cached(final, sim, top, traced, key, design, harness)
+        if cached is not None:
+            return cached
+        remove_stale(final)  # what a killed builder left: nobody else builds it now
+        return _make(contract, final, sim, top, traced, key, key_fields, design, digest,
+                     harness, coverage)
+
+
+def _make(contract: ArrayContract, final: Path, sim: str, top: str, traced: bool, key: str,
+          key_fields: dict, design: CosimDesign, digest: str, harness: bool,
+          coverage: bool) -> SimBuild:
+    """Build ``final`` (holding its :func:`build_lock`); see :func:`build`."""
+    base = final.parent
     root = final.with_name(f"{final.name}.tmp{os.getpid()}")
     shutil.rmtree(root, ignore_errors=True)
     # GNU make (Verilator's C++ build) refuses folders with spaces, and a vvp file cannot
@@ -257,9 +276,12 @@ def build(
 
     try:
         stage.mkdir(parents=True, exist_ok=True)
-        paths, gen = (_reuse_verilog(base, digest, top, stage)
-                      or design.write(contract, stage))
+        reused = _reuse_verilog(base, digest, top, stage)
+        if reused is None:
+            note(f"generating the Verilog of {final.name}")
+        paths, gen = reused or design.write(contract, stage)
         t0 = time.perf_counter()
+        note(f"building {final.name} with {sim} (once per design; its log: {log})")
         port_map = json.loads(paths["ports_json"].read_text())
         sources, hdl_top = [paths["verilog"]], top
         ports = [p["name"] for p in port_map["ports"]]
@@ -303,8 +325,17 @@ def build(
     done = _cached(final, sim, top, traced, key, design, harness)
     if done is None:
         raise ToolError(f"{sim} build folder {final} vanished or is damaged")
+    note(f"built {final.name} in {build_seconds:.0f} s")
     return dataclasses.replace(done, generate_seconds=gen.seconds,
                                build_seconds=build_seconds, cached=False)
+
+
+def note(text: str) -> None:
+    """One progress line on stderr (above any progress bar): a build's phases say what is
+    happening, so a minutes-long compile is never a silent wait."""
+    from tqdm import tqdm
+
+    tqdm.write(f"rvsm: {text}", file=sys.stderr)
 
 
 def _build_files(sim: str, top: str, harness: bool = False) -> list[str]:
