@@ -122,7 +122,7 @@ class StreamProperties(StreamHarness):
     #: The accumulator memories start with any contents (RAM at power-up): every
     #: property must hold from any RAM state, and a clear that misses a bank shows
     #: within the bound (``state.fresh_after_clear`` in the first frame).
-    power_up_memories = ("dut.state.acc_s*",)
+    power_up_memories = ("dut.state_stage.acc_s*",)
 
     def smtbmc_options(self, mode: str) -> tuple[str, ...]:
         """``--syn`` in bmc and cover mode when every chosen group is one of
