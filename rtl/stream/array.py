@@ -234,19 +234,18 @@ class RvsmStreamArray(wiring.Component):
         m = Module()
         geo, mutation = self.geometry, self.mutation
         target = self.memory if self.memory is not None else memory_target(platform)
-        stages = {
-            "input": InputStage(self.contract.adc_bits, geo.lanes, mutation),
-            "window": WindowStage(geo, mutation),
-            "sums": SumStage(geo),
-            "position": PositionStage(geo),
-            "state": StateStage(geo, target, mutation),
-            "output": OutputStage(geo, target, mutation),
+        stages = {  # submodule names: the stages' module names (dut.state_stage.acc_s0, ...)
+            "input_stage": InputStage(self.contract.adc_bits, geo.lanes, mutation),
+            "window_stage": WindowStage(geo, mutation),
+            "sum_stage": SumStage(geo),
+            "position_stage": PositionStage(geo),
+            "state_stage": StateStage(geo, target, mutation),
+            "output_stage": OutputStage(geo, target, mutation),
         }
         for name, stage in stages.items():
             m.submodules[name] = stage
         self._stages = stages
-        inp, win, sums, pos = (stages[k] for k in ("input", "window", "sums", "position"))
-        state, out = stages["state"], stages["output"]
+        inp, win, sums, pos, state, out = stages.values()
         wiring.connect(m, wiring.flipped(self.codes), inp.codes)
         wiring.connect(m, wiring.flipped(self.thr), state.thr)
         wiring.connect(m, inp.ctl, win.ctl, sums.ctl, pos.ctl, state.ctl, out.ctl)
@@ -269,16 +268,13 @@ class RvsmStreamArray(wiring.Component):
         and its stages are elaborated (an ``ElaborateAfter`` beside it)."""
         if self._stages is None:
             raise RuntimeError("the stream array's probes exist once it is elaborated")
-        st = self._stages
-        ctl, pos = st["input"].ctl, st["position"]
+        inp, win, sums, pos, state, out = self._stages.values()
+        ctl = inp.ctl
         c, geo = self.contract, self.geometry
-        window = st["window"].window
         return StreamProbes(
             ctl.advance, ctl.clear, pos.read.addr, ctl.advance & pos.read.valid,
-            pos.write.en, pos.write.addr, st["output"].lanes,
-            st["state"].threshold_memories,
-            {cell: window[k] for k, cell in enumerate(geo.window_cells())},
+            pos.write.en, pos.write.addr, out.lanes, state.threshold_memories,
+            {cell: win.window[k] for k, cell in enumerate(geo.window_cells())},
             pos.valid_at[1],
-            [[st["sums"].sums[i][f"s{s}"] for i in range(geo.lanes)]
-             for s in range(c.num_scales)],
+            [[sums.sums[i][f"s{s}"] for i in range(geo.lanes)] for s in range(c.num_scales)],
             pos.valid_at[geo.sum_stage])

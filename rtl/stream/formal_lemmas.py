@@ -1,7 +1,7 @@
 """The compositional form of the streaming array's bounded equivalence (``rvsm formal
 --arch stream --check window sums composed``).
 
-The end-to-end miter (:class:`~rvsm.rtl.stream.harnesses.StreamEquivalence`) makes the
+The end-to-end miter (:class:`~rvsm.rtl.stream.equivalence_harness.StreamEquivalence`) makes the
 solver prove, at every compared position of both frames, that the stream's pipelined
 receptive sums (orbit sums shared by the scales, retimed CSD trees:
 :mod:`rvsm.rtl.stream.pipelined_sum`) equal the parallel array's (equal-weight groups,
@@ -53,14 +53,15 @@ from rvsm.rtl.parallel.array import RvsmArray, accumulator_index, receptive_taps
 from rvsm.rtl.receptive_sum import weighted_sum
 from rvsm.rtl.stream.array import RvsmStreamArray, StreamProbes
 from rvsm.rtl.stream.dimensions import StreamGeometry
-from rvsm.rtl.stream.harnesses import StreamEquivalence, _StreamHarness
+from rvsm.rtl.stream.equivalence_harness import StreamEquivalence
+from rvsm.rtl.stream.harness_base import StreamHarness
 from rvsm.rtl.stream.pipelined_sum import Pipeline, Timed
 
 __all__ = ["ComposedEquivalence", "StreamSumLemma", "StreamWindowLemma",
            "composed_equivalence", "sum_lemma", "window_lemma"]
 
 
-class StreamWindowLemma(_StreamHarness):
+class StreamWindowLemma(StreamHarness):
     """``window.codes``: the masked window registers hold their pixels' codes (0 outside
     the array) whenever stage 1 holds a position; the stream runs back to back as in
     :class:`StreamEquivalence` (thresholds are outside the window's cone: not driven)."""

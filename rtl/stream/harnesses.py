@@ -3,9 +3,11 @@
 Five checks, each one sby run of a harness driving
 :class:`~rvsm.rtl.stream.array.RvsmStreamArray` from free inputs (``AnySeq``: codes,
 ``codes.valid``, ``clear``, threshold writes; no domain reset, which does what ``clear``
-does), checked by bounded model checking to :attr:`_StreamHarness.depth` = two frames
-plus the lag plus two cycles (``2*H*G + lag + 2``): every input sequence of that many
-clock cycles.
+does; :class:`~rvsm.rtl.stream.harness_base.StreamHarness`), checked by bounded model
+checking to two frames plus the lag plus two cycles (``2*H*G + lag + 2``): every input
+sequence of that many clock cycles. This module holds the four property groups and the
+factories of every check; the fifth, the miter with the parallel array, is
+:class:`~rvsm.rtl.stream.equivalence_harness.StreamEquivalence`.
 
 :class:`StreamProperties` states the protocol and the tail's arithmetic from the
 harness's own bookkeeping (beats counted at the ports, shadows of one symbolic word of
@@ -14,7 +16,8 @@ accumulator memories start with any contents, as RAM at power-up), observing the
 internal :class:`~rvsm.rtl.stream.array.StreamProbes`. Stalls,
 clears and threshold writes are free at every cycle. Its properties come in four groups
 (:data:`PROPERTY_GROUPS`), each its own check so that sby keeps only that group's cone of
-logic:
+logic, and each stated by its own method (:meth:`StreamProperties._protocol`,
+``_state``, ``_thresholds``, ``_tail``) from the bookkeeping they share (:class:`_Watch`):
 
 * ``protocol``: ``handshake.ready`` (``codes.ready`` is low exactly while ``clear`` is
   high); ``output.one_per_beat`` (an output beat and its write-back exactly for each
@@ -44,100 +47,26 @@ logic:
   lane, the low rail on some scale (from a cleared accumulator it takes a surround's
   large negative sums), a clear in mid-frame, a threshold write meeting the read of its
   word.
-
-:class:`StreamEquivalence` (check ``"equivalence"``) is a miter: the same symbolic codes
-and thresholds drive the streaming array and the fully parallel
-:class:`~rvsm.rtl.parallel.array.RvsmArray` (itself proven against the contract's integer
-rules by :mod:`rvsm.rtl.parallel.harnesses`), which gets each frame at once when its last
-beat is accepted. Every accumulator the stream writes back and every spike it outputs
-must equal the parallel array's for the same frame and position
-(``equivalence.accumulators``, ``equivalence.spikes``; ``..._early`` for positions the
-stream finishes before the parallel array has their frame, when ``lag < H*G``).
-Thresholds are written (free scale, word, lane and value) while no beat has been
-accepted since the start. The stream runs back to back (``codes.valid`` high, no clear):
-with free stalls the solver must relate every alignment of beats to cycles and the
-check does not finish in minutes; stalls and clears are the protocol, state and
-threshold checks' subject, and :attr:`StreamEquivalence.inputs` allows them for a longer
-run.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from amaranth.asserts import AnyConst, AnySeq
-from amaranth.hdl import Array, Cat, Module, Mux, ResetSignal, Signal, Value, signed
+from amaranth.hdl import Array, Cat, Module, Mux, Signal, Value, signed
 
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.widths import signed_range
 from rvsm.rtl.capabilities import require_spike_sensor
-from rvsm.rtl.formal_harness import ElaborateAfter, FormalHarness
-from rvsm.rtl.mutations import check_mutation
-from rvsm.rtl.parallel.array import RvsmArray
+from rvsm.rtl.formal_harness import ElaborateAfter
 from rvsm.rtl.stream.array import RvsmStreamArray, StreamProbes
-from rvsm.rtl.stream.dimensions import StreamGeometry
+from rvsm.rtl.stream.equivalence_harness import StreamEquivalence
+from rvsm.rtl.stream.harness_base import StreamHarness
 from rvsm.rtl.stream.signatures import threshold_word_bits, top_threshold_word
 
-__all__ = ["PROPERTY_GROUPS", "StreamEquivalence", "StreamProperties", "stream_check",
+__all__ = ["PROPERTY_GROUPS", "SYNTHESISED_GROUPS", "StreamProperties", "stream_check",
            "stream_equivalence"]
-
-
-class _StreamHarness(FormalHarness):
-    """What both harnesses share: the array, its free inputs and the beat bookkeeping."""
-
-    provable = False
-
-    def __init__(self, contract: ArrayContract, lanes: int = 1,
-                 mutation: str | None = None) -> None:
-        super().__init__()
-        self.contract = contract
-        self.geometry = StreamGeometry(contract, lanes)
-        self.mutation = check_mutation(mutation, "stream")
-        #: The most cycles with a stall (``codes.valid`` low) and with ``clear`` high
-        #: within the bound (``"stalls"``, ``"clears"``; a missing key: any number).
-        self.inputs: dict[str, int] = {}
-        geo = self.geometry
-        #: Two frames plus the lag, plus the two cycles from acceptance to output.
-        self.depth = 2 * geo.beats_per_frame + geo.lag + 2
-        self.cover_depth = self.depth
-
-    def _array(self, m: Module) -> RvsmStreamArray:
-        dut = RvsmStreamArray(self.contract, self.geometry.lanes, mutation=self.mutation)
-        m.submodules.dut = dut
-        self.check(m, "assume.no_domain_reset", ~ResetSignal("sync"),
-                   "the domain reset is not used (it restarts the stream like clear)",
-                   "assume")
-        valid, clear = AnySeq(1), AnySeq(1)
-        m.d.comb += [dut.codes.payload.eq(AnySeq(len(dut.codes.payload.as_value()))),
-                     dut.codes.valid.eq(valid), dut.clear.eq(clear)]
-        for name, event in (("stalls", ~valid), ("clears", clear)):
-            limit = self.inputs.get(name)
-            if limit is None:
-                continue
-            count = Signal(range(limit + 2), name=f"{name}_so_far")
-            with m.If(event & (count <= limit)):
-                m.d.sync += count.eq(count + 1)
-            self.check(m, f"assume.{name}", ~event | (count < limit),
-                       f"at most {limit} cycles with {name[:-1]} in the bound", "assume")
-        return dut
-
-    def _counter(self, m: Module, name: str, clear: Value, step: Value,
-                 modulo: int) -> Signal:
-        """A counter of ``step`` s modulo ``modulo``, 0 after ``clear``."""
-        count = Signal(range(modulo), name=name)
-        with m.If(clear):
-            m.d.sync += count.eq(0)
-        with m.Elif(step):
-            m.d.sync += count.eq(Mux(count == modulo - 1, 0, count + 1))
-        return count
-
-    def _beats(self, m: Module, dut: RvsmStreamArray, lag: int) -> Value:
-        """``accepted beats since the last clear >= lag`` (a counter saturating at lag)."""
-        seen = Signal(range(lag + 1), name=f"beats_to_{lag}")
-        taken = dut.codes.valid & dut.codes.ready
-        with m.If(dut.clear):
-            m.d.sync += seen.eq(0)
-        with m.Elif(taken & (seen < lag)):
-            m.d.sync += seen.eq(seen + 1)
-        return seen >= lag
 
 
 #: The property groups of :class:`StreamProperties`, each its own check (sby run).
@@ -156,7 +85,27 @@ _GROUP_PREFIXES = {
 SYNTHESISED_GROUPS = frozenset({"protocol", "thresholds", "tail"})
 
 
-class StreamProperties(_StreamHarness):
+@dataclass(frozen=True)
+class _Watch:
+    """What the property groups share: the probes, the accepted beats (``taken``), the
+    next output position (``out_pos``), the expected write-back (``e1``, its position and
+    whether it is in the first frame after a clear) and output (``e2``), the watched word
+    and scale (``AnyConst``) and ``watched`` (the watched word is written back now)."""
+
+    probes: StreamProbes
+    taken: Value
+    out_pos: Signal
+    e1: Signal
+    e1_pos: Signal
+    e1_first: Signal
+    e2: Signal
+    e2_pos: Signal
+    watch: Signal
+    scale: Signal
+    watched: Value
+
+
+class StreamProperties(StreamHarness):
     """The streaming array's protocol, memory and tail properties (module docstring);
     ``groups`` (:data:`PROPERTY_GROUPS`) chooses which are stated: a group's cone of
     logic is all sby keeps, so one group per check keeps each query small."""
@@ -173,7 +122,7 @@ class StreamProperties(_StreamHarness):
     #: The accumulator memories start with any contents (RAM at power-up): every
     #: property must hold from any RAM state, and a clear that misses a bank shows
     #: within the bound (``state.fresh_after_clear`` in the first frame).
-    power_up_memories = ("dut.state.acc_s*",)
+    power_up_memories = ("dut.state_stage.acc_s*",)
 
     def smtbmc_options(self, mode: str) -> tuple[str, ...]:
         """``--syn`` in bmc and cover mode when every chosen group is one of
@@ -215,19 +164,32 @@ class StreamProperties(_StreamHarness):
         return m
 
     def _properties(self, dut: RvsmStreamArray) -> Module:
+        """Every group's properties (:meth:`check` keeps the chosen groups'), once the
+        array is elaborated (its probes)."""
         m = Module()
+        w = self._bookkeeping(m, dut)
+        self._protocol(m, dut, w)
+        self._thresholds(m, dut, w)
+        c = self.contract
+        # every lane's total and accumulator one advance earlier, at the write-back
+        delayed = [[self._delayed(m, s, i, lane, w.probes.advance)
+                    for i, lane in enumerate(lanes)] for s, lanes in enumerate(w.probes.lanes)]
+        self._state(m, w, delayed)
+        below = self._tail(m, w, delayed)
+        if c.signed:
+            # from a cleared accumulator the low rail takes a surround's large negative
+            # sums: within two frames some scales (dog2's centre) cannot reach it
+            self.check(m, "cover.saturate_low", Cat(*below).any(),
+                       "a total below the low rail (some scale and lane)", "cover")
+        return m
+
+    def _bookkeeping(self, m: Module, dut: RvsmStreamArray) -> _Watch:
+        """The output beats expected from the accepted ones, and the watched word and
+        scale (:class:`_Watch`)."""
         c, geo = self.contract, self.geometry
-        probes: StreamProbes = dut.probes
-        p, words, wa, tw = geo.lanes, geo.beats_per_frame, c.accumulator_bits, \
-            c.threshold_bits
-        wb = threshold_word_bits(words)
-        lo, hi = signed_range(wa)
+        words = geo.beats_per_frame
         taken = dut.codes.valid & dut.codes.ready
         clear = dut.clear
-
-        self.check(m, "handshake.ready", dut.codes.ready == ~clear,
-                   "codes.ready is low exactly while clear is high")
-
         # Output beats: accepted beat b >= lag releases position (b - lag) mod H*G at
         # the next edge (the write-back, e1) and presents it one cycle later (e2).
         releases = taken & self._beats(m, dut, geo.lag)
@@ -243,17 +205,39 @@ class StreamProperties(_StreamHarness):
         e1_first = Signal(name="exp_write_first")
         m.d.sync += [e1.eq(releases), e1_pos.eq(out_pos), e1_first.eq(first),
                      e2.eq(e1), e2_pos.eq(e1_pos)]
+        # Memories: one symbolic word and scale (``AnyConst``: the checks hold for
+        # every word) is shadowed: thresholds as written (top rail at start) and, per
+        # position, the word it must have read (at the edge after accepting beat
+        # p + threshold_lag); accumulators as written back.
+        watch = Signal(range(words), name="watch_word")
+        m.d.comb += watch.eq(AnyConst(len(watch)))
+        self.check(m, "assume.watch_word", watch < words,
+                   "the watched word exists", "assume")
+        # ... and one symbolic scale: a shadow word of each kind in all.
+        scale = Signal(range(max(2, c.num_scales)), name="watch_scale")
+        m.d.comb += scale.eq(AnyConst(len(scale)))
+        self.check(m, "assume.watch_scale", scale < c.num_scales,
+                   "the watched scale exists", "assume")
+        return _Watch(dut.probes, taken, out_pos, e1, e1_pos, e1_first, e2, e2_pos, watch,
+                      scale, e1 & (e1_pos == watch))
+
+    def _protocol(self, m: Module, dut: RvsmStreamArray, w: _Watch) -> None:
+        """``handshake.*``, ``output.*``, ``rmw.*``, ``cover.clear_mid_frame``."""
+        geo, probes = self.geometry, w.probes
+        words = geo.beats_per_frame
+        clear = dut.clear
+        self.check(m, "handshake.ready", dut.codes.ready == ~clear,
+                   "codes.ready is low exactly while clear is high")
         self.check(m, "output.one_per_beat",
-                   (dut.spikes.valid == e2) & (probes.acc_write_en == e1),
+                   (dut.spikes.valid == w.e2) & (probes.acc_write_en == w.e1),
                    "an output beat (and its write-back) for each accepted beat from the "
                    "lag-th after a clear on, two cycles after its acceptance")
         out = dut.spikes.payload
         self.check(m, "output.raster_order",
-                   ~dut.spikes.valid | ((out.row * geo.groups + out.group == e2_pos)
-                                        & (out.last == (e2_pos == words - 1))),
+                   ~dut.spikes.valid | ((out.row * geo.groups + out.group == w.e2_pos)
+                                        & (out.last == (w.e2_pos == words - 1))),
                    "output positions advance in raster order from 0 after a clear; last "
                    "marks a frame's last position")
-
         # Read-modify-write: a word read is pending until written back (or flushed).
         pending = Signal(words, name="acc_pending")
         read, write = probes.acc_read_valid, probes.acc_write_en
@@ -268,19 +252,21 @@ class StreamProperties(_StreamHarness):
                 m.d.sync += pending[a].eq(1)
             with m.Elif(write & (probes.acc_write_addr == a)):
                 m.d.sync += pending[a].eq(0)
+        mid = clear & (w.out_pos != 0)
+        self.check(m, "cover.clear_mid_frame", mid,
+                   "a clear after some positions of a frame were output", "cover")
 
-        # Memories: one symbolic word and scale (``AnyConst``: the checks hold for
-        # every word) is shadowed: thresholds as written (top rail at start) and, per
-        # position, the word it must have read (at the edge after accepting beat
-        # p + threshold_lag); accumulators as written back.
-        watch = Signal(range(words), name="watch_word")
-        m.d.comb += watch.eq(AnyConst(len(watch)))
-        self.check(m, "assume.watch_word", watch < words,
-                   "the watched word exists", "assume")
+    def _thresholds(self, m: Module, dut: RvsmStreamArray, w: _Watch) -> None:
+        """``threshold.*`` and ``cover.threshold_write_meets_read``: the watched word's
+        shadow as written, and as each position read it."""
+        c, geo, probes = self.contract, self.geometry, w.probes
+        p, words, tw = geo.lanes, geo.beats_per_frame, c.threshold_bits
+        wb = threshold_word_bits(words)
+        watch, scale = w.watch, w.scale
         top_word = top_threshold_word(tw, p)
         bus = dut.thr
-        reads = taken & self._beats(m, dut, geo.threshold_lag)
-        read_pos = self._counter(m, "thr_read_pos", clear, reads, words)
+        reads = w.taken & self._beats(m, dut, geo.threshold_lag)
+        read_pos = self._counter(m, "thr_read_pos", dut.clear, reads, words)
         r1, r1_pos = Signal(name="thr_read"), Signal(range(words), name="thr_read_word")
         m.d.sync += [r1.eq(reads), r1_pos.eq(read_pos)]
         self.check(m, "threshold.read_timing",
@@ -292,16 +278,6 @@ class StreamProperties(_StreamHarness):
         self.check(m, "cover.threshold_write_meets_read",
                    r1 & p_we & (p_addr[:wb] == r1_pos),
                    "a threshold write lands at the edge that reads its word", "cover")
-        mid = clear & (out_pos != 0)
-        self.check(m, "cover.clear_mid_frame", mid,
-                   "a clear after some positions of a frame were output", "cover")
-
-        # ... and one symbolic scale: a shadow word of each kind in all.
-        scale = Signal(range(max(2, c.num_scales)), name="watch_scale")
-        m.d.comb += scale.eq(AnyConst(len(scale)))
-        self.check(m, "assume.watch_scale", scale < c.num_scales,
-                   "the watched scale exists", "assume")
-        watched = e1 & (e1_pos == watch)
         shadow = Signal(p * tw, init=top_word, name="thr_shadow")
         with m.If(bus.we & (bus.addr[:wb] == watch)
                   & ((bus.addr[wb:] == scale) if c.num_scales > 1 else 1)):
@@ -326,7 +302,7 @@ class StreamProperties(_StreamHarness):
             m.d.sync += [line[0].eq(shadow)] + [line[k].eq(line[k - 1])
                                                for k in range(1, len(line))]
         seen = line[-1]
-        by_scale = [probes.lanes[s] for s in range(c.num_scales)]
+        by_scale = probes.lanes
         thr2 = Array(Cat(*[lane["thr2"] for lane in lanes]) for lanes in by_scale)[scale]
         # more stepping stones: the watched position's threshold word at each stage
         # of the tail (memory output after READ_STAGES advance edges from the read,
@@ -346,234 +322,86 @@ class StreamProperties(_StreamHarness):
         thr1 = Array(Cat(*[lane["thr1"] for lane in lanes]) for lanes in by_scale)[scale]
         self.check(m, "threshold.compare_stage", ~tags[rs] | (thr1 == line[rs]),
                    "the tail's first stage holds the watched position's threshold word")
-        self.check(m, "threshold.timing", ~watched | (thr2 == seen),
+        self.check(m, "threshold.timing", ~w.watched | (thr2 == seen),
                    "a position compares against the threshold written last before the "
                    "edge after accepting beat p + threshold_lag")
-        acc_shadow = Signal(p * wa, name="acc_shadow")
-        after = Array(Cat(*[lane["after"].as_unsigned()[:wa] for lane in lanes])
-                      for lanes in by_scale)[scale]
-        with m.If(watched):
-            m.d.sync += acc_shadow.eq(after)
-        below = [self._lane(m, s, i, lane, probes, e1, e1_first, watched & (scale == s),
-                            acc_shadow[i * wa:(i + 1) * wa].as_signed(), lo, hi)
-                 for s, lanes in enumerate(by_scale) for i, lane in enumerate(lanes)]
-        if c.signed:
-            # from a cleared accumulator the low rail takes a surround's large negative
-            # sums: within two frames some scales (dog2's centre) cannot reach it
-            self.check(m, "cover.saturate_low", Cat(*below).any(),
-                       "a total below the low rail (some scale and lane)", "cover")
-        return m
 
-    def _lane(self, m: Module, s: int, i: int, lane: dict[str, Value],
-              probes: StreamProbes, e1: Signal, e1_first: Signal, watched: Value,
-              previous: Value, lo: int, hi: int) -> Value:
-        """One lane's tail properties in the cycle its position is written back (e1):
-        ``p_total`` / ``p_acc`` are the total and accumulator one advance earlier.
-        Returns "this lane's total is below the low rail now"."""
-        c = self.contract
-        total, thr, sat = lane["total"], lane["thr2"], lane["sat"]
-        pos, neg, after = lane["pos"], lane["neg"], lane["after"]
+    def _delayed(self, m: Module, s: int, i: int, lane: dict[str, Value],
+                 advance: Value) -> tuple[Signal, Signal]:
+        """``(p_total, p_acc)``: lane ``i`` of scale ``s``'s total and accumulator one
+        advance earlier, what the write-back cycle (e1) compares against."""
+        total, wa = lane["total"], self.contract.accumulator_bits
         p_total = Signal.like(total, name=f"p_total_s{s}_l{i}")
-        acc = Signal(signed(c.accumulator_bits), name=f"acc_s{s}_l{i}")  # with total
-        p_acc = Signal(signed(c.accumulator_bits), name=f"p_acc_s{s}_l{i}")
-        with m.If(probes.advance):
+        acc = Signal(signed(wa), name=f"acc_s{s}_l{i}")  # with total
+        p_acc = Signal(signed(wa), name=f"p_acc_s{s}_l{i}")
+        with m.If(advance):
             m.d.sync += [p_total.eq(total), acc.eq(lane["acc"]), p_acc.eq(acc)]
-        self.check(m, "state.fresh_after_clear", ~e1 | ~e1_first | (p_acc == 0),
-                   "in the first frame after a clear every accumulator reads as 0")
-        self.check(m, "state.read_back", ~watched | e1_first | (p_acc == previous),
-                   "after the first frame a position adds to exactly what the previous "
-                   "frame wrote back to its word")
-        clamped = Mux(p_total > hi, hi, Mux(p_total < lo, lo, p_total))
-        self.check(m, "saturation.clamps", ~e1 | (sat == clamped),
-                   "the saturated total is the total clamped to the rails (never wraps)")
-        fired_ok = ~pos | (p_total >= thr)
-        fired_ok &= ~neg | ((p_total <= -thr) & ~pos) if c.signed else ~neg
-        self.check(m, "fire.spike_implies_threshold", ~e1 | fired_ok,
-                   "a +1 spike only when the pre-saturation total reached the threshold, "
-                   "a -1 only when it reached minus the threshold, never both")
-        # (the converse for -1, a total at or below minus the threshold fires -1, made
-        # this check take minutes instead of seconds: the equivalence check covers it)
-        self.check(m, "fire.threshold_implies_spike", ~e1 | (p_total < thr) | pos,
-                   "a total at or above the threshold fires +1")
-        if c.reset == "zero":
-            expected = Mux(pos | neg, 0, sat)
-        else:
-            expected = Mux(pos, sat - thr, Mux(neg, sat + thr, sat))
-        self.check(m, f"reset.{c.reset}",
-                   ~e1 | (after.as_unsigned()[:c.accumulator_bits]
-                          == expected.as_unsigned()[:c.accumulator_bits]),
-                   f"the word written back is what reset mode {c.reset!r} leaves")
-        self.check(m, "cover.spike_pos", e1 & pos,
-                   "a +1 spike on every scale and lane", "cover")
-        if c.signed:
-            self.check(m, "cover.spike_neg", e1 & neg,
-                       "a -1 spike on every scale and lane", "cover")
-        self.check(m, "cover.saturate_high", e1 & (p_total > hi),
-                   "a total above the high rail (every scale and lane)", "cover")
-        return e1 & (p_total < lo)
+        return p_total, p_acc
 
+    def _state(self, m: Module, w: _Watch,
+               delayed: list[list[tuple[Signal, Signal]]]) -> None:
+        """``state.*``: the accumulator each position adds to (0 in a fresh frame, else
+        what the previous frame wrote back to the watched word)."""
+        wa = self.contract.accumulator_bits
+        acc_shadow = Signal(self.geometry.lanes * wa, name="acc_shadow")
+        after = Array(Cat(*[lane["after"].as_unsigned()[:wa] for lane in lanes])
+                      for lanes in w.probes.lanes)[w.scale]
+        with m.If(w.watched):
+            m.d.sync += acc_shadow.eq(after)
+        for s, lanes in enumerate(delayed):
+            for i, (_, p_acc) in enumerate(lanes):
+                previous = acc_shadow[i * wa:(i + 1) * wa].as_signed()
+                self.check(m, "state.fresh_after_clear", ~w.e1 | ~w.e1_first | (p_acc == 0),
+                           "in the first frame after a clear every accumulator reads as 0")
+                self.check(m, "state.read_back",
+                           ~(w.watched & (w.scale == s)) | w.e1_first | (p_acc == previous),
+                           "after the first frame a position adds to exactly what the "
+                           "previous frame wrote back to its word")
 
-class StreamEquivalence(_StreamHarness):
-    """The miter of the streaming and the parallel array (module docstring): a
-    back-to-back stream (``codes.valid`` high, no ``clear`` after the start) unless
-    ``inputs`` allows stalls and clears."""
-
-    def __init__(self, contract: ArrayContract, lanes: int = 1,
-                 mutation: str | None = None,
-                 inputs: dict[str, int] | None = None) -> None:
-        super().__init__(contract, lanes, mutation)
-        self.inputs = {"stalls": 0, "clears": 0} if inputs is None else dict(inputs)
-
-    def elaborate(self, platform: object) -> Module:
-        m = Module()
-        dut = self._array(m)
-        c, geo = self.contract, self.geometry
-        p, n, tw = geo.lanes, c.adc_bits, c.threshold_bits
-        words, hw = geo.beats_per_frame, c.height * c.width
-        wb = threshold_word_bits(words)
-        ref = RvsmArray(c)
-        m.submodules.ref = ref
-        taken = dut.codes.valid & dut.codes.ready
-        clear = dut.clear
-        m.d.comb += ref.clear.eq(clear)
-
-        # Threshold writes: one threshold (scale, word, lane, value) while loading.
-        loading = ~self._beats(m, dut, 1)
-        we = AnySeq(1)
-        scale, word = AnySeq(max(1, (c.num_scales - 1).bit_length())), AnySeq(wb)
-        lane, value = AnySeq(max(1, (p - 1).bit_length())), AnySeq(tw)
-        self.check(m, "assume.threshold_write",
-                   ~we | (loading & ~taken & (value != 0) & (scale < c.num_scales)
-                          & (word < words) & (lane < p)),
-                   "thresholds (1 .. 2**(W-1)-1) are written only while no beat was "
-                   "accepted since the last clear", "assume")
-        shadow = [Array(Signal(p * tw, init=top_threshold_word(tw, p),
-                               name=f"thr_shadow_s{s}_w{w}") for w in range(words))
-                  for s in range(c.num_scales)]
-        word_now = Signal(p * tw, name="thr_word_now")
-        m.d.comb += word_now.eq(Array(shadow)[scale][word])
-        data = Cat(*[Mux(lane == i, value, word_now[i * tw:(i + 1) * tw])
-                     for i in range(p)])
-        m.d.comb += [dut.thr.we.eq(we), dut.thr.addr.eq(Cat(word, scale) if c.num_scales > 1
-                                                         else word),
-                     dut.thr.data.eq(data),
-                     ref.cfg.we.eq(we), ref.cfg.addr.eq(scale * hw + word * p + lane),
-                     ref.cfg.data.eq(value)]
-        for s in range(c.num_scales):
-            with m.If(we & (scale == s)):
-                m.d.sync += shadow[s][word].eq(data)
-
-        # The reference gets a frame when its last beat is accepted.
-        in_pos = self._counter(m, "in_pos", clear, taken, words)
-        frame = [Signal(p * n, name=f"frame_w{w}") for w in range(words)]
-        beat = dut.codes.payload.as_value()
-        for w in range(words):
-            with m.If(taken & (in_pos == w)):
-                m.d.sync += frame[w].eq(beat)
-        m.d.comb += [ref.codes.eq(Cat(*frame[:-1], beat)),
-                     ref.strobe.eq(taken & (in_pos == words - 1))]
-
-        m.submodules.compare = ElaborateAfter(lambda platform: self._compare(dut, ref))
-        return m
-
-    def _compare(self, dut: RvsmStreamArray, ref: RvsmArray) -> Module:
-        """The comparison, once both arrays are elaborated (the cells, the probes)."""
-        m = Module()
-        c, geo = self.contract, self.geometry
-        p, words, hw = geo.lanes, geo.beats_per_frame, c.height * c.width
-        clear = dut.clear
-        # Reference frames (spikes and the accumulators after them) wait in a ring
-        # until the stream outputs the same frame.
-        depth = geo.lag // words + 2
-        n_acc = c.num_scales * hw
-        wa = c.accumulator_bits
-        cells = [ref.cells[k] for k in range(n_acc)]
-        record = Cat(ref.spike_pos, ref.spike_neg, *[cell.acc for cell in cells])
-        ring = Array(Signal(len(record), name=f"ref_frame{k}") for k in range(depth))
-        head = Signal(range(depth), name="ref_head")   # next frame the reference gives
-        with m.If(ref.valid):
-            m.d.sync += [ring[head].eq(record),
-                         head.eq(Mux(head == depth - 1, 0, head + 1))]
-
-        def fields(frame: Value, w: int) -> tuple[Value, Value, Value]:
-            """(pos, neg, accumulators) of position ``w`` in a ring entry, in the
-            stream's order: scale-major, then lane."""
-            ks = [s * hw + w * p + i for s in range(c.num_scales) for i in range(p)]
-            return (Cat(*[frame[k] for k in ks]), Cat(*[frame[n_acc + k] for k in ks]),
-                    Cat(*[frame[2 * n_acc + k * wa:2 * n_acc + (k + 1) * wa] for k in ks]))
-
-        # Write-back (probes, the cycle before the output) and output: each has a
-        # pointer to the ring entry of the frame it is in and a count of frames the
-        # reference has given and it has not finished.
-        out = dut.spikes.payload
-        probes: StreamProbes = dut.probes
-        wr_pos = Signal(range(words), name="wr_pos")
-        m.d.comb += wr_pos.eq(probes.acc_write_addr)
-        after = Cat(*[lane["after"].as_unsigned()[:wa]
-                      for lanes in probes.lanes for lane in lanes])
-        spikes = Cat(out.pos, out.neg)
-        clear_d = Signal(name="clear_d")
-        m.d.sync += clear_d.eq(clear)
-        compared = Signal(range(3), name="frames_compared")
-        for kind, (event, position, value) in {
-                "accumulators": (probes.acc_write_en, wr_pos, after),
-                "spikes": (dut.spikes.valid, out.row * geo.groups + out.group,
-                           spikes)}.items():
-            part = 2 if kind == "accumulators" else slice(0, 2)
-
-            def reference(frame: Value, w: int, part=part) -> Value:
-                return Cat(*fields(frame, w)[part]) if isinstance(part, slice) \
-                    else fields(frame, w)[part]
-
-            tail = Signal(range(depth), name=f"{kind}_frame")
-            ready = Signal(range(depth + 1), name=f"{kind}_ready")
-            # compared at the event when the reference has the frame (lag >= H*G) ...
-            here = Array(reference(ring[tail], w) for w in range(words))[position]
-            what = ("every spike the stream outputs" if kind == "spikes" else
-                    "every accumulator the stream writes back")
-            description = (f"{what} equals the parallel array's for the same frame and "
-                           "position (same codes and thresholds)")
-            same = ~event | (ready == 0) | (value == here)
-            if kind == "spikes":  # one statement per source line: sby names lines
-                self.check(m, "equivalence.spikes", same, description)
-            else:
-                self.check(m, "equivalence.accumulators", same, description)
-            # ... else kept until the reference gives the frame (lag < H*G)
-            got = [Signal(len(value), name=f"{kind}_got_w{w}") for w in range(words)]
-            emitted = Signal(words, name=f"{kind}_emitted")
-            early = event & (ready == 0)
-            for w in range(words):
-                with m.If(early & (position == w)):
-                    m.d.sync += [got[w].eq(value), emitted[w].eq(1)]
-            late = ref.valid & (ready == 0)
-            now_ok = ~event | (value == Array(reference(record, w)
-                                              for w in range(words))[position])
-            same = ~late | (now_ok & Cat(*[
-                ~emitted[w] | (got[w] == reference(record, w)) for w in range(words)
-            ]).all())
-            description += (", for positions the stream finished before the parallel "
-                            "array had their frame (lag < H*G): compared when it has")
-            if kind == "spikes":
-                self.check(m, "equivalence.spikes_early", same, description)
-            else:
-                self.check(m, "equivalence.accumulators_early", same, description)
-            done = event & (position == words - 1)
-            with m.If(clear_d):
-                # a clear drops the frames in flight: realign one cycle later (beats
-                # accepted before it are still output in the cycle after the clear)
-                m.d.sync += [tail.eq(head), ready.eq(ref.valid), emitted.eq(0)]
-            with m.Else():
-                with m.If(done):
-                    m.d.sync += [tail.eq(Mux(tail == depth - 1, 0, tail + 1)),
-                                 emitted.eq(0)]
-                m.d.sync += ready.eq(ready + ref.valid - done)
-            if kind == "spikes":
-                with m.If(done & (compared != 2)):
-                    m.d.sync += compared.eq(compared + 1)
-                self.check(m, "cover.two_frames_compared", done & (compared == 1),
-                           "the bound reaches the end of a second frame's comparison",
-                           "cover")
-        return m
+    def _tail(self, m: Module, w: _Watch,
+              delayed: list[list[tuple[Signal, Signal]]]) -> list[Value]:
+        """``saturation.*``, ``fire.*``, ``reset.*`` and the tail's covers, per lane in the
+        cycle its position is written back (e1). Returns per lane "its total is below the
+        low rail now"."""
+        c = self.contract
+        lo, hi = signed_range(c.accumulator_bits)
+        e1, below = w.e1, []
+        for lanes, delays in zip(w.probes.lanes, delayed, strict=True):
+            for lane, (p_total, _) in zip(lanes, delays, strict=True):
+                thr, sat = lane["thr2"], lane["sat"]
+                pos, neg, after = lane["pos"], lane["neg"], lane["after"]
+                clamped = Mux(p_total > hi, hi, Mux(p_total < lo, lo, p_total))
+                self.check(m, "saturation.clamps", ~e1 | (sat == clamped),
+                           "the saturated total is the total clamped to the rails (never "
+                           "wraps)")
+                fired_ok = ~pos | (p_total >= thr)
+                fired_ok &= ~neg | ((p_total <= -thr) & ~pos) if c.signed else ~neg
+                self.check(m, "fire.spike_implies_threshold", ~e1 | fired_ok,
+                           "a +1 spike only when the pre-saturation total reached the "
+                           "threshold, a -1 only when it reached minus the threshold, never "
+                           "both")
+                # (the converse for -1, a total at or below minus the threshold fires -1,
+                # made this check take minutes instead of seconds: the equivalence check
+                # covers it)
+                self.check(m, "fire.threshold_implies_spike", ~e1 | (p_total < thr) | pos,
+                           "a total at or above the threshold fires +1")
+                if c.reset == "zero":
+                    expected = Mux(pos | neg, 0, sat)
+                else:
+                    expected = Mux(pos, sat - thr, Mux(neg, sat + thr, sat))
+                self.check(m, f"reset.{c.reset}",
+                           ~e1 | (after.as_unsigned()[:c.accumulator_bits]
+                                  == expected.as_unsigned()[:c.accumulator_bits]),
+                           f"the word written back is what reset mode {c.reset!r} leaves")
+                self.check(m, "cover.spike_pos", e1 & pos,
+                           "a +1 spike on every scale and lane", "cover")
+                if c.signed:
+                    self.check(m, "cover.spike_neg", e1 & neg,
+                               "a -1 spike on every scale and lane", "cover")
+                self.check(m, "cover.saturate_high", e1 & (p_total > hi),
+                           "a total above the high rail (every scale and lane)", "cover")
+                below.append(e1 & (p_total < lo))
+        return below
 
 
 def stream_check(group: str):

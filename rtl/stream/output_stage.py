@@ -67,8 +67,8 @@ class SpikeTail:
     def __init__(self, contract: ArrayContract, mutation: str | None = None):
         self.contract, self.mutation = contract, mutation
 
-    def lane(self, m: Module, acc: Value, ref: Value, fresh: Value, shifted: Value,
-             thr: Value, r: LaneRegisters) -> tuple[list, Value, Value, Value]:
+    def lane(self, acc: Value, ref: Value, fresh: Value, shifted: Value, thr: Value,
+             r: LaneRegisters) -> tuple[list, Value, Value, Value]:
         """``(statements, pos, neg, after)`` of one lane: ``acc`` is the accumulator (0
         in a fresh frame), ``shifted`` the shifted sum, ``thr`` the threshold read."""
         c, mutation = self.contract, self.mutation
@@ -136,8 +136,8 @@ class EventTail:
     def __init__(self, contract: ArrayContract, mutation: str | None = None):
         self.contract, self.mutation = contract, mutation
 
-    def lane(self, m: Module, acc: Value, ref: Value, fresh: Value, shifted: Value,
-             thr: Value, r: LaneRegisters) -> tuple[list, Value, Value, Value]:
+    def lane(self, acc: Value, ref: Value, fresh: Value, shifted: Value, thr: Value,
+             r: LaneRegisters) -> tuple[list, Value, Value, Value]:
         """``(statements, pos, neg, after)`` of one lane: ``ref`` is the reference read,
         ``fresh`` the capture flag, ``shifted`` the shifted sum, ``thr`` the threshold."""
         wa = self.contract.accumulator_bits
@@ -255,7 +255,7 @@ class OutputStage(wiring.Component):
                     Signal(unsigned(tw), name=f"thr2_s{s}_l{i}", **data),
                     Signal(name=f"pos_s{s}_l{i}", **data),
                     Signal(name=f"neg_s{s}_l{i}", **data))
-                lane, pos, neg, after = rule.lane(m, acc, ref, fresh, shifted,
+                lane, pos, neg, after = rule.lane(acc, ref, fresh, shifted,
                                                   self.words.thr[s][i * tw:(i + 1) * tw], regs)
                 stmts += lane
                 after_lanes.append(after.as_unsigned()[:wa])

@@ -33,10 +33,10 @@ from rvsm.rtl.stream.window_stage import position_signature
 __all__ = ["PositionStage", "read_tap_signature", "write_tap_signature"]
 
 
-def read_tap_signature(words: int, bank_words: int) -> wiring.Signature:
-    """The state memories' read (module docstring): ``addr``, ``valid``,
-    ``addr_next_adv`` / ``addr_next_hold`` and ``bank`` (``addr`` two stages on, divided
-    by ``bank_words``), driven by :class:`PositionStage`."""
+def read_tap_signature(words: int) -> wiring.Signature:
+    """The state memories' read of ``words``-word memories (module docstring): ``addr``,
+    ``valid``, ``addr_next_adv`` / ``addr_next_hold`` and ``bank`` (the bank of ``addr``
+    two stages on), driven by :class:`PositionStage`."""
     return wiring.Signature({
         "addr": Out(range(words)), "valid": Out(1),
         "addr_next_adv": Out(range(words)), "addr_next_hold": Out(range(words)),
@@ -71,7 +71,7 @@ class PositionStage(wiring.Component):
             "ctl": In(control_signature()),
             "centre": In(position_signature(c.height, geo.groups)),
             "centre_next_addr": In(range(geo.beats_per_frame)),
-            "read": Out(read_tap_signature(geo.beats_per_frame, geo.bank_words)),
+            "read": Out(read_tap_signature(geo.beats_per_frame)),
             "fresh": Out(1), "fresh_ahead": Out(1),
             "write": Out(write_tap_signature(c.height, geo.groups)),
         })

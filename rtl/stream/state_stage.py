@@ -82,7 +82,7 @@ class StateStage(wiring.Component):
         s, p, wa = c.num_scales, geo.lanes, c.accumulator_bits
         super().__init__({
             "ctl": In(control_signature()),
-            "read": In(read_tap_signature(geo.beats_per_frame, geo.bank_words)),
+            "read": In(read_tap_signature(geo.beats_per_frame)),
             "write": In(write_tap_signature(c.height, geo.groups)),
             "write_data": In(write_back_layout(s, p, wa)),
             "thr": In(threshold_write_signature(s, geo.beats_per_frame, p, c.threshold_bits)),
