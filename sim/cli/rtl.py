@@ -170,7 +170,8 @@ def _timing_text(ports_json: Path, gen: GeneratedVerilog) -> str:
         return f"latency {gen.latency} cycle(s)"
     lag, release = timing["lag"], timing.get("release_cycles", 2)
     return (f"lag {lag} beats (the spikes of input beat p come out {release} cycles after "
-            f"beat p + {lag} is accepted: {lag + release} cycles after beat p when "
+            f"beat p + {lag} is accepted: {lag + release - (0 if 'fifo_depth' in timing else 1)}"
+            f" cycles after beat p when "
             f"beats come back to back; the port map has every figure)")
 
 

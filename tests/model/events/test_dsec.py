@@ -12,7 +12,8 @@ import pytest
 from rvsm.model.events.dsec import is_dsec_layout, open_dsec_events
 from rvsm.model.events.event_list import EventListWriter
 from rvsm.model.infra.errors import RvsmError
-from rvsm.model.spikes.files import copy_source, load_any_spikes
+from rvsm.model.sensors.files import load_any_spikes
+from rvsm.model.spikes.files import copy_source
 from rvsm.model.spikes.source import array_source
 from rvsm.sim.cli import main
 

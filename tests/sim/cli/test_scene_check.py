@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from rvsm.model.scene.digest import scene_digest
-from rvsm.model.spikes.files import open_spikes
+from rvsm.model.sensors.files import open_spikes
 from rvsm.sim.cli import main
 
 
