@@ -4,6 +4,11 @@ Sections and keys come from the field declarations (:data:`FIELDS`, in file orde
 :func:`design_point_toml` writes every field with its comment and valid values (what
 ``rvsm config new`` prints); loading refuses unknown sections and keys and reports any
 refusal as ``<file>: <section.key> ...``. Missing keys take the defaults.
+
+A point file may also hold an ``[rtl]`` table: how the point is built
+(:class:`~rvsm.model.fixed.build_settings.BuildSettings`), not a field of the point.
+Loading checks it and leaves it out of the :class:`DesignPoint`
+(:func:`load_point_file` returns both); :func:`new_point_toml` shows it commented out.
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
+from rvsm.model.fixed.build_settings import BUILD_SECTION, BuildSettings, build_settings_toml
 from rvsm.model.fixed.design_point import FIELDS, DesignPoint
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError, shown
@@ -28,7 +34,8 @@ from rvsm.model.sampling.thresholds import DEFAULT_CALIBRATION_SCENE
 
 __all__ = [
     "SECTION_COMMENTS", "design_point_toml", "from_toml_dict", "load_design_point",
-    "parse_design_point", "save_design_point", "to_toml_dict",
+    "load_point_file", "new_point_toml", "parse_design_point", "parse_point_file",
+    "save_design_point", "to_toml_dict",
 ]
 
 #: What each section computes (the per-key comments come from the field declarations).
@@ -68,15 +75,17 @@ def to_toml_dict(point: DesignPoint) -> dict[str, dict[str, Any]]:
     return out
 
 
-def from_toml_dict(data: dict[str, Any], source: str = "design point") -> DesignPoint:
-    """Build from the nested TOML form; unknown sections or keys are refused."""
+def from_toml_dict(data: dict[str, Any], source: str = "design point",
+                   also: tuple[str, ...] = ()) -> DesignPoint:
+    """Build from the nested TOML form; unknown sections or keys are refused (``also``:
+    sections the caller reads itself, named among the valid ones in the refusal)."""
     known = {(f.section, f.key): f.name for f in FIELDS}
     kwargs: dict[str, Any] = {}
     for sec, table in data.items():
         if sec not in SECTIONS or not isinstance(table, dict):
             raise RvsmError(
                 f"{source}: unknown section [{shown(sec)}]; valid sections: "
-                f"{', '.join(sorted(SECTIONS))}"
+                f"{', '.join(sorted((*SECTIONS, *also)))}"
             )
         for key, value in table.items():
             if (sec, key) not in known:
@@ -119,19 +128,39 @@ def design_point_toml(point: DesignPoint) -> str:
     return "\n".join(lines) + "\n"
 
 
+def new_point_toml(point: DesignPoint) -> str:
+    """:func:`design_point_toml` followed by the ``[rtl]`` table commented out (what
+    ``rvsm config new`` writes; :func:`design_point_toml` alone stays the text that names
+    a point in sweeps and stimulus files)."""
+    return design_point_toml(point) + build_settings_toml()
+
+
 def load_design_point(path: str | os.PathLike) -> DesignPoint:
-    """Read and validate a design-point TOML file (errors name the file and the field)."""
+    """Read and validate a design-point TOML file (errors name the file and the field);
+    its ``[rtl]`` table is checked and left out (:func:`load_point_file` returns it)."""
+    return load_point_file(path)[0]
+
+
+def load_point_file(path: str | os.PathLike) -> tuple[DesignPoint, BuildSettings]:
+    """Read and validate a design-point TOML file: the point and its build settings."""
     p = Path(path)
-    return parse_design_point(read_utf8_text(p, "design point"), str(p))
+    return parse_point_file(read_utf8_text(p, "design point"), str(p))
 
 
 def parse_design_point(text: str, source: str = "design point") -> DesignPoint:
-    """Parse and validate design-point TOML text."""
+    """Parse and validate design-point TOML text (its ``[rtl]`` table checked, left out)."""
+    return parse_point_file(text, source)[0]
+
+
+def parse_point_file(text: str, source: str = "design point"
+                     ) -> tuple[DesignPoint, BuildSettings]:
+    """Parse and validate design-point TOML text: the point and its ``[rtl]`` table."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise RvsmError(f"{source}: not valid TOML: {exc}") from None
-    return from_toml_dict(data, source)
+    build = BuildSettings.from_table(data.pop(BUILD_SECTION, None), source)
+    return from_toml_dict(data, source, also=(BUILD_SECTION,)), build
 
 
 def save_design_point(path: str | os.PathLike, point: DesignPoint) -> None:

@@ -88,8 +88,9 @@ def run_config_new(args: argparse.Namespace) -> int:
     import dataclasses
 
     from rvsm.model.fixed.design_point import default_design_point
-    from rvsm.model.fixed.point_toml import design_point_toml, save_design_point
+    from rvsm.model.fixed.point_toml import new_point_toml
     from rvsm.model.fixed.sensor_rules import sensor_rules
+    from rvsm.model.infra.atomic import write_text_atomic
 
     check_outputs([args.output and Output(args.output, "-o", PLAIN)], force=args.force)
     kind = sensor_kind(args.sensor)
@@ -98,22 +99,28 @@ def run_config_new(args: argparse.Namespace) -> int:
     size = parse_size_arg(args.size)
     if size is not None:
         point = point.with_size(*size)
+    text = new_point_toml(point)  # with the [rtl] table commented out
     if args.output:
-        save_design_point(args.output, point)
+        write_text_atomic(args.output, text)
         print(f"wrote {args.output}", file=sys.stderr)
     else:
-        sys.stdout.write(design_point_toml(point))
+        sys.stdout.write(text)
     return 0
 
 
 def run_config_check(args: argparse.Namespace) -> int:
     """``rvsm config check``."""
-    from rvsm.model.fixed.point_toml import load_design_point
+    from rvsm.model.fixed.point_toml import load_point_file
+    from rvsm.rtl.fpga.build_settings import check_build_settings
 
-    p = load_design_point(args.point)
+    p, build = load_point_file(args.point)
+    check_build_settings(build, args.point)
     c = p.contract()
     print(f"{args.point}: valid design point, {p.model}{p.kind.suffix} on "
           f"{p.height}x{p.width}")
+    if build.given():
+        print("  built with " + ", ".join(f"{k} = {v!r}" for k, v in build.given().items())
+              + " ([rtl]; flags of rvsm verilog / verify / fpga win)")
     print(f"  {p.rules.describe_adc(p)}")
     print(f"  weights {p.weight_bits} bits / {p.weight_frac_bits} fraction "
           f"({p.weight_rounding}); shift {p.shift}; accumulator {p.accumulator_bits} bits")

@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
+
+#: Today's defaults of the settings a point's [rtl] table can set (docs/fpga.md).
+DEVICE, FREQ_MHZ, MEMORY = "ecp5-85", 125.0, "dp16kd"
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -31,25 +35,27 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("point", help="design point TOML (its size is the sensor's)")
     p.add_argument("--size", type=_size, metavar="HxW",
                    help="size of the array built (default: the design point's)")
-    add_arch_arguments(p)
-    p.add_argument("--device", choices=tuple(DEVICES), default="ecp5-85",
-                   help="ECP5 part (default ecp5-85)")
+    add_arch_arguments(p, from_point=True)
+    p.add_argument("--device", choices=tuple(DEVICES),
+                   help=f"ECP5 part (default: the point's [rtl] device, else {DEVICE})")
     p.add_argument("--speed", type=int, choices=(6, 7, 8), default=6,
                    help="ECP5 speed grade (default 6)")
-    p.add_argument("--freq", type=float, default=125.0, metavar="MHZ",
-                   help="clock target for place and route, MHz (default 125)")
+    p.add_argument("--freq", type=float, metavar="MHZ",
+                   help="clock target for place and route, MHz (default: the point's "
+                   f"[rtl] freq_mhz, else {FREQ_MHZ:g})")
     p.add_argument("--synth-only", action="store_true",
                    help="stop after synthesis: area from yosys, no Fmax")
     p.add_argument("--rtlil", action="store_true",
                    help="hand yosys Amaranth's RTLIL instead of Verilog (faster to read, "
                    "but yosys then keeps every inferred memory read port's read-first "
                    "behaviour and emulates it: see docs/fpga.md)")
-    p.add_argument("--memory", choices=("dp16kd", "inferred"), default="dp16kd",
+    p.add_argument("--memory", choices=("dp16kd", "inferred"),
                    help="state memories as DP16KD instances with the output register on "
-                   "(default) or inferred by yosys (the bank register in fabric)")
-    add_interface_arguments(p, "native (default): the bare array; axis: the AXI4-Stream / "
+                   "or inferred by yosys (the bank register in fabric); default: the "
+                   f"point's [rtl] memory, else {MEMORY}")
+    add_interface_arguments(p, "native: the bare array; axis: the AXI4-Stream / "
                             "AXI4-Lite IP around it, as rvsm verilog --interface axis "
-                            "builds it (docs/ip.md)")
+                            "builds it (docs/ip.md)", from_point=True)
     p.add_argument("--seed", type=int, default=1,
                    help="placer seed; with --seeds the first of N (default 1)")
     p.add_argument("--seeds", type=int, metavar="N",
@@ -73,13 +79,17 @@ def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.architectures.registry import get_architecture
     from rvsm.rtl.fpga.flow import build_component, run_fpga, run_fpga_seeds
+    from rvsm.sim.cli.build_choice import ARCH_DEFAULTS, choose_build
     from rvsm.sim.cli.rtl import command_architecture
 
-    arch, options = command_architecture(args)  # the IP with --interface axis
-    base = get_architecture(args.arch)
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be > 0 seconds, got {args.timeout}")
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
+    choice = choose_build(args, "fpga", args.point, {
+        **ARCH_DEFAULTS, "freq_mhz": ("freq", FREQ_MHZ), "device": ("device", DEVICE),
+        "memory": ("memory", MEMORY)})
+    arch, options = command_architecture(args)  # the IP with --interface axis
+    base = get_architecture(args.arch)
     point = load_design_point(args.point)
     contract = (point.with_size(*args.size) if args.size else point).contract()
     arch.check(contract, **options)
@@ -111,5 +121,9 @@ def _fpga(args: argparse.Namespace) -> int:
             raise RvsmError("--jobs applies to --seeds only")
         report = run_fpga(point, args.out, synth_only=args.synth_only, seed=args.seed,
                           **common)
-    print(report.to_json() if args.json else report.table())
+    if args.json:
+        print(json.dumps({**json.loads(report.to_json()),
+                          "settings": choice.record(options)}))
+    else:
+        print(report.table())
     return 0

@@ -20,6 +20,7 @@ from rvsm.rtl.architectures.registry import (
 from rvsm.rtl.capabilities import Architecture, Option
 from rvsm.rtl.flow_files import DEFAULT_CLOCK_MHZ
 from rvsm.sim.cli.args import add_force_argument, sized_contract
+from rvsm.sim.cli.build_choice import ARCH_DEFAULTS, choose_build
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 
 if TYPE_CHECKING:
@@ -39,17 +40,18 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "architecture's, " + ", ".join(
                        f"{a.default_top} for {a.name}" for a in ARCHITECTURES.values())
                    + ")")
-    add_arch_arguments(p)
-    add_interface_arguments(p, "native (default): the bare array's ports; axis: the "
+    add_arch_arguments(p, from_point=True)
+    add_interface_arguments(p, "native: the bare array's ports; axis: the "
                             "streaming array as IP, AXI4-Stream video in and spikes out, "
-                            "AXI4-Lite registers, plus <top>.regs.md/.json/.h (docs/ip.md)")
+                            "AXI4-Lite registers, plus <top>.regs.md/.json/.h (docs/ip.md)",
+                            from_point=True)
     p.add_argument("--lint", action="store_true",
                    help="lint the written files as a user would: verilator --lint-only "
                    "-Wall with the shipped <top>.vlt only, and iverilog -g2005 and -g2012 "
                    "(-Wall); any warning fails")
-    p.add_argument("--clock-mhz", type=float, default=DEFAULT_CLOCK_MHZ, metavar="MHZ",
-                   help="clock of the constraints template <top>.sdc (default "
-                   f"{DEFAULT_CLOCK_MHZ:g} MHz)")
+    p.add_argument("--clock-mhz", type=float, metavar="MHZ",
+                   help="clock of the constraints template <top>.sdc (default: the "
+                   f"point's [rtl] freq_mhz, else {DEFAULT_CLOCK_MHZ:g} MHz)")
     p.add_argument("--stats", action="store_true",
                    help="synthesise with yosys (generic gates, memories kept as memories) and "
                    "print cells, flip-flops and memory bits")
@@ -57,26 +59,43 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_verilog)
 
 
-def add_arch_arguments(p: argparse.ArgumentParser) -> None:
+#: How the help of a flag that the design point's ``[rtl]`` table can set ends.
+POINT_DEFAULT = "the point's [rtl] {key}, else {default}"
+
+
+def add_arch_arguments(p: argparse.ArgumentParser, from_point: bool = False) -> None:
     """``--arch`` (the registered architectures, default the streaming array) and one
-    ``--<option>`` per architecture option (default: not given)."""
-    p.add_argument("--arch", choices=tuple(ARCHITECTURES), default=DEFAULT_ARCHITECTURE,
+    ``--<option>`` per architecture option (default: not given). ``from_point``: the
+    command takes each one not given from the design point's ``[rtl]`` table
+    (:func:`~rvsm.sim.cli.build_choice.choose_build`), so ``--arch`` defaults to
+    ``None`` until then."""
+    def default(key: str, value: object) -> str:
+        return POINT_DEFAULT.format(key=key, default=value) if from_point else str(value)
+
+    p.add_argument("--arch", choices=tuple(ARCHITECTURES),
+                   default=None if from_point else DEFAULT_ARCHITECTURE,
                    help="array architecture: " + "; ".join(
                        f"{a.name}: the {a.title}" for a in ARCHITECTURES.values())
-                   + f" (default {DEFAULT_ARCHITECTURE})")
+                   + f" (default {default('arch', DEFAULT_ARCHITECTURE)})")
     for option, arch in _arch_options().items():
         _add_option(p, option, f"{option.help}; --arch {arch.name} only (default "
-                    f"{option.default})")
+                    f"{default(option.name, option.default)})")
 
 
-def add_interface_arguments(p: argparse.ArgumentParser, interface_help: str) -> None:
+def add_interface_arguments(p: argparse.ArgumentParser, interface_help: str,
+                            from_point: bool = False) -> None:
     """``--interface`` (``native`` and every registered wrapper's, with
     ``interface_help``) and one ``--<option>`` per option only a wrapper takes (the AXI
-    IP's ``--fifo-depth``, default: not given)."""
-    p.add_argument("--interface", choices=INTERFACES, default=NATIVE, help=interface_help)
+    IP's ``--fifo-depth``, default: not given). ``from_point``: as
+    :func:`add_arch_arguments` (``--interface`` defaults to ``None``)."""
+    if from_point:
+        interface_help += "; default: the point's [rtl] interface, else native"
+    p.add_argument("--interface", choices=INTERFACES, default=None if from_point else NATIVE,
+                   help=interface_help)
     for option, interface in _wrapper_options().items():
-        _add_option(p, option, f"--interface {interface}: {option.help} (default "
-                    f"{option.default})")
+        what = (POINT_DEFAULT.format(key=option.name, default=option.default) if from_point
+                else option.default)
+        _add_option(p, option, f"--interface {interface}: {option.help} (default {what})")
 
 
 def _add_option(p: argparse.ArgumentParser, option: Option, text: str) -> None:
@@ -129,6 +148,8 @@ def _verilog(args: argparse.Namespace) -> int:
         yosys_stats,
     )
 
+    choose_build(args, "verilog", args.point,
+                 {**ARCH_DEFAULTS, "freq_mhz": ("clock_mhz", DEFAULT_CLOCK_MHZ)})
     arch, options = command_architecture(args)
     if not args.clock_mhz > 0:
         raise RvsmError(f"--clock-mhz must be > 0, got {args.clock_mhz:g}")

@@ -25,6 +25,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures.registry import ARCHITECTURES, NATIVE, WRAPPERS, architectures_with
 from rvsm.rtl.capabilities import Architecture
 from rvsm.sim.cli.args import SceneRequest, add_scene_arguments, parse_size_arg
+from rvsm.sim.cli.build_choice import ARCH_DEFAULTS, choose_build
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 from rvsm.sim.cli.rtl import (
     add_arch_arguments,
@@ -107,10 +108,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="Verilator, --harness chunk: build line and toggle code coverage "
                    "in and keep the run's coverage.dat (docs/regressions.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    add_arch_arguments(p)
+    add_arch_arguments(p, from_point=True)
     add_interface_arguments(p, "axis: verify the AXI IP (rvsm verilog --interface axis) "
                             "with cocotbext-axi under random idle cycles and back-pressure "
-                            "(docs/ip.md); with SCENE, --stimulus or --random")
+                            "(docs/ip.md); with SCENE, --stimulus or --random",
+                            from_point=True)
     p.add_argument("--policy", choices=("stall", "drop"), default="stall",
                    help="--interface axis: output policy; drop streams without clears and "
                    "checks the drops against the IP's cycle model (default stall)")
@@ -270,6 +272,7 @@ def _verify_wrapper(args: argparse.Namespace, sim: str, work: str, waves: bool,
     if as_json:
         r = dict(r)
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]
+        r["settings"] = args.build_choice.record(options)
         print(json.dumps(r))
     else:
         c = r["counters"]
@@ -352,6 +355,7 @@ def _verify(args: argparse.Namespace) -> int:
                   [args.scene, args.fixed, args.stimulus])
     if args.steps is not None and args.steps < 1:
         raise RvsmError(f"--steps must be >= 1, got {args.steps}")
+    args.build_choice = choose_build(args, "verify", args.fixed, ARCH_DEFAULTS)
     if args.interface != NATIVE:
         return _verify_wrapper(args, args.sim, args.work, args.waves, args.json)
     arch, options = command_architecture(args)
@@ -367,6 +371,7 @@ def _verify(args: argparse.Namespace) -> int:
     if args.json:
         r = dict(r)
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]
+        r["settings"] = args.build_choice.record(options)
         print(json.dumps(r))
     else:
         _print_result(r, arch, args.sim, args.protocol)
@@ -418,6 +423,7 @@ def _verify_shards(args: argparse.Namespace, arch: Architecture, options: dict[s
     if args.json:
         r = dict(r)
         r["mismatch_list"] = r["mismatch_list"][:10]
+        r["settings"] = args.build_choice.record(options)
         print(json.dumps(r))
     else:
         print(f"{args.sim}, {arch_text(r['arch'], r['options'])}: {r['steps']} steps in "

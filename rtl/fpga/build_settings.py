@@ -1,0 +1,60 @@
+"""A design point's ``[rtl]`` table checked against what the RTL offers.
+
+:class:`~rvsm.model.fixed.build_settings.BuildSettings` (the model layer) checks keys and
+types; here each name is checked against its registry: ``arch`` an ``--arch`` choice
+(:data:`~rvsm.rtl.architectures.registry.ARCHITECTURES`), ``interface`` one registered
+for that architecture, ``device`` an FPGA part ``rvsm fpga`` places
+(:data:`~rvsm.rtl.fpga.devices.DEVICES`), ``memory`` one of
+:data:`~rvsm.rtl.fpga.flow.MEMORIES`; ``lanes`` and ``fifo_depth`` must be options of the
+architecture the table names (default the streaming array, natively).
+"""
+
+from __future__ import annotations
+
+from rvsm.model.fixed.build_settings import BUILD_SECTION, BuildSettings
+from rvsm.model.infra.errors import RvsmError, shown
+from rvsm.rtl.architectures.registry import (
+    ARCHITECTURES,
+    DEFAULT_ARCHITECTURE,
+    INTERFACES,
+    NATIVE,
+    WRAPPERS,
+)
+from rvsm.rtl.fpga.devices import DEVICES
+from rvsm.rtl.fpga.flow import MEMORIES
+
+__all__ = ["check_build_settings"]
+
+
+def _refuse(source: str, key: str, value: object, valid: str) -> RvsmError:
+    return RvsmError(f"{source}: {BUILD_SECTION}.{key} = {shown(repr(value))} is not valid; "
+                     f"{valid}")
+
+
+def check_build_settings(settings: BuildSettings, source: str = "design point") -> None:
+    """Refuse (:class:`RvsmError`, one line naming ``rtl.<key>`` and what is valid) a
+    name no registry knows, an interface not offered for the architecture, or an option
+    (``lanes``, ``fifo_depth``) that architecture does not take."""
+    s = settings
+    if s.arch is not None and s.arch not in ARCHITECTURES:
+        raise _refuse(source, "arch", s.arch, f"choose one of {', '.join(ARCHITECTURES)}")
+    arch = s.arch or DEFAULT_ARCHITECTURE
+    if s.interface is not None and s.interface not in INTERFACES:
+        raise _refuse(source, "interface", s.interface,
+                      f"choose one of {', '.join(INTERFACES)}")
+    interface = s.interface or NATIVE
+    offered = [NATIVE, *(i for a, i in WRAPPERS if a == arch)]
+    if interface not in offered:
+        raise _refuse(source, "interface", s.interface,
+                      f"arch {arch} is offered with {', '.join(offered)}")
+    if s.device is not None and s.device not in DEVICES:
+        raise _refuse(source, "device", s.device, f"choose one of {', '.join(DEVICES)}")
+    if s.memory is not None and s.memory not in MEMORIES:
+        raise _refuse(source, "memory", s.memory, f"choose one of {', '.join(MEMORIES)}")
+    built = ARCHITECTURES[arch] if interface == NATIVE else WRAPPERS[arch, interface]
+    for key in ("lanes", "fifo_depth"):
+        value = getattr(s, key)
+        if value is not None and not built.takes(key):
+            takes = ", ".join(o.name for o in built.options) or "no options"
+            raise _refuse(source, key, value,
+                          f"arch {arch} with interface {interface} takes {takes}")
