@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep lint diagrams clean
+.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep bench-fpga lint diagrams clean
 
 setup: $(STAMP)
 
@@ -91,6 +91,16 @@ bench-rtl: setup
 # sweep speed-up 1 -> 2 workers on sweeps/example.toml (about 4 minutes per round)
 bench-sweep: setup
 	$(BIN)/python scripts/bench_sweep.py --rounds $(or $(ROUNDS),1)
+
+# place and route of a design point at its own size and [rtl] settings: each phase's wall
+# time and peak memory, LUT4/FF/DP16KD against the device and Fmax against the camera's
+# clock, from nextpnr's report (docs/fpga.md, "Benchmark"); figures also in
+# build/bench-fpga/bench.json. A full-size run is far longer than a test may be.
+# POINT=... another point, SIZE=HxW a smaller array, ARGS="--lanes 2" more rvsm fpga options
+POINT ?= points/ecp5-85-40khz.toml
+bench-fpga: setup
+	$(BIN)/python scripts/bench_fpga.py $(POINT) -o build/bench-fpga \
+	  $(if $(SIZE),--size $(SIZE)) $(ARGS)
 
 # the guides' timing diagrams, recorded from amaranth.sim (docs/integration.md, docs/ip.md)
 diagrams: setup

@@ -30,7 +30,7 @@ BUILD_KEYS: dict[str, tuple[str, Any]] = {
     "freq_mhz": ("clock target, MHz (rvsm fpga --freq, rvsm verilog --clock-mhz)", 100.0),
     "device": ("FPGA part that rvsm fpga places (--device)", "ecp5-85"),
     "memory": ("state memories: dp16kd | inferred (rvsm fpga --memory)", "dp16kd"),
-    "fifo_depth": ("output FIFO depth in beats, interface axis only (--fifo-depth)", 32),
+    "fifo_depth": ("output FIFO depth in beats, interface axis only (--fifo-depth)", 16),
 }
 _NAMES = ("arch", "interface", "device", "memory")
 _COUNTS = ("lanes", "fifo_depth")
