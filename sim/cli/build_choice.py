@@ -99,7 +99,9 @@ def choose_build(args: argparse.Namespace, command: str, point: str | None,
             dest, _ = dests[key]
             if getattr(args, dest) is not None or key not in given:
                 continue
-            if built is not None and built.takes(key):
+            if built is None:
+                continue  # refused by the command next: nothing to say about options
+            if built.takes(key):
                 setattr(args, dest, given[key])
                 taken.append(key)
             else:

@@ -7,7 +7,7 @@ The command's edge reads the command line once: the architecture
 (:class:`~rvsm.sim.cosim.run_point.RunPoint`, its TOML parsed once, its contract built
 once); the co-simulation functions get those values, not the ``argparse`` namespace.
 
-Why one module of about 470 lines: it is one command whose arguments and their refusals
+Why one module of about 480 lines: it is one command whose arguments and their refusals
 (every way to name a stimulus, the interface, the long-run harness and its shards) read
 together; the work itself lives in :mod:`rvsm.sim.cosim`.
 """

@@ -132,3 +132,17 @@ def test_verify_honours_the_point_lanes(tmp_path: Path, capsys: pytest.CaptureFi
     assert main(["verify", "--random", "1", "--fixed", bad, "--size", "4x4", "--steps", "16",
                  "--work", str(tmp_path / "w")]) == 2
     assert "lanes" in capsys.readouterr().err
+
+
+def test_config_check_names_the_settings_and_refuses_a_bad_name(
+        tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    point = _point(tmp_path, 'lanes = 4\ninterface = "axis"\nfifo_depth = 8\n')
+    assert main(["config", "check", point]) == 0
+    assert ("built with lanes = 4, interface = 'axis', fifo_depth = 8 ([rtl]"
+            in capsys.readouterr().out)
+    bad = _point(tmp_path, 'arch = "parallel"\ninterface = "axis"\n')
+    assert main(["config", "check", bad]) == 2
+    assert capsys.readouterr().err == (f"rvsm: error: {bad}: rtl.interface = 'axis' is not "
+                                       "valid; arch parallel is offered with native\n")
+    assert main(["config", "new"]) == 0
+    assert "\n# [rtl]\n# arch: " in capsys.readouterr().out
