@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rvsm.sim.cli import main
 from rvsm.sim.cli import datasheet as cli
+from rvsm.sim.cli import main
 from rvsm.sim.studies import point_quality
 from rvsm.sim.studies.datasheet import SECTIONS
 from rvsm.sim.studies.datasheet_inputs import load_point_file
