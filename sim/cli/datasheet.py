@@ -100,7 +100,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quality", metavar="FILE.json", help="saved rvsm quality POINT --json "
                    "(default: run the study)")
     p.add_argument("--verify", metavar="FILE.json", help="saved rvsm verify ... --json")
-    p.add_argument("--regress", metavar="FILE.xml", help="JUnit of rvsm regress ... --junit")
+    p.add_argument("--regress", metavar="FILE", help="rvsm regress results: its database "
+                   "(-o RESULTS.sqlite) or its JUnit XML (--junit FILE.xml)")
     p.add_argument("--picture-scene", metavar="SCENE",
                    help="scene of the reconstruction picture (default the first scored)")
     p.add_argument("--no-synthesis", action="store_true",
@@ -187,7 +188,7 @@ def _datasheet(args: argparse.Namespace) -> int:
                                          args.quality)
         _same_point(quality, pf.point, args.quality)
     verify = di.load_verify_result(args.verify) if args.verify else None
-    regress = di.load_regress_junit(args.regress) if args.regress else None
+    regress = di.load_regress(args.regress) if args.regress else None
     picture_scene = _scenes([args.picture_scene]) if args.picture_scene else None
     return _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,
                            picture_scene, settings)

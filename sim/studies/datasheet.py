@@ -303,7 +303,8 @@ def _quality_section(inputs: DatasheetInputs) -> tuple[list[str], dict[str, Any]
                   "![reconstructions](reconstructions.png)", ""]
     else:
         lines += ["No reconstruction picture: drawn for spike-camera points only.", ""]
-    lines += [f"Sources: {inputs.quality_source}; picture: `{inputs.command}`.", ""]
+    picture = f"; picture: `{inputs.command}`" if inputs.picture is not None else ""
+    lines += [f"Sources: {inputs.quality_source}{picture}.", ""]
     return lines, out
 
 
@@ -322,12 +323,12 @@ def _verification_section(inputs: DatasheetInputs) -> list[str]:
                      f"compared{'; ' + what if what else ''} |")
     r = inputs.regress
     if r is None:
-        lines.append("| regression plan | `rvsm regress PLAN.toml --junit FILE.xml` | "
+        lines.append("| regression plan | `rvsm regress PLAN.toml -o RESULTS.sqlite` | "
                      "not run |")
     else:
         n = len(r.cases)
-        lines.append(f"| regression {', '.join(r.suites)} | `rvsm regress ... --junit` saved "
-                     f"as `{inputs.regress_path}` | {r.count('pass')} of {n} pass, "
+        lines.append(f"| regression {', '.join(r.suites)} | `rvsm regress` results "
+                     f"`{inputs.regress_path}` | {r.count('pass')} of {n} pass, "
                      f"{r.count('fail')} fail, {r.count('error')} error |")
         bad = [c for c in r.cases if c[2] in ("fail", "error")]
         lines += [f"| - {c[1]} | | {c[2]} |" for c in bad[:20]]

@@ -7,7 +7,8 @@ results of other commands, each checked before anything is computed or written.
 - ``--fpga FILE.json``: ``rvsm fpga POINT --json`` (nextpnr's LUT4, FF, DP16KD, Fmax);
 - ``--quality FILE.json``: ``rvsm quality POINT --json``;
 - ``--verify FILE.json``: ``rvsm verify ... --json`` (spikes compared, mismatches);
-- ``--regress FILE.xml``: the JUnit XML of ``rvsm regress PLAN --junit FILE.xml``.
+- ``--regress FILE``: the results database of ``rvsm regress PLAN -o FILE.sqlite`` or its
+  JUnit XML (``--junit FILE.xml``).
 
 A missing or malformed file is an :class:`~rvsm.model.infra.errors.RvsmError` naming it
 (exit status 2), raised before the output folder is touched.
@@ -33,8 +34,8 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.text_files import read_utf8_text
 
 __all__ = ["PointFile", "RegressSummary", "load_fpga_report", "load_point_file",
-           "load_regress_junit", "load_verify_result", "read_json_object",
-           "read_result_text"]
+           "load_regress", "load_regress_database", "load_regress_junit",
+           "load_verify_result", "read_json_object", "read_result_text"]
 
 #: Largest saved result read (bytes): these are summaries of a few kB.
 MAX_RESULT_BYTES = 16 << 20
@@ -142,6 +143,39 @@ class RegressSummary:
     def count(self, status: str) -> int:
         """Cases with ``status``."""
         return sum(1 for c in self.cases if c[2] == status)
+
+
+def load_regress(path: str | os.PathLike) -> RegressSummary:
+    """The runs of a regression: its results database (SQLite, ``rvsm regress -o``) or
+    its JUnit XML (``--junit``)."""
+    p = Path(path)
+    if not p.is_file():
+        raise RvsmError(f"{p}: no such regression result file")
+    with open(p, "rb") as handle:
+        sqlite = handle.read(16) == b"SQLite format 3\x00"
+    return load_regress_database(p) if sqlite else load_regress_junit(p)
+
+
+def load_regress_database(path: str | os.PathLike) -> RegressSummary:
+    """The runs of an ``rvsm regress`` results database, opened read-only."""
+    import sqlite3
+
+    hint = "give the database rvsm regress PLAN.toml -o RESULTS.sqlite wrote"
+    try:
+        db = sqlite3.connect(f"{Path(path).resolve().as_uri()}?mode=ro", uri=True)
+        try:
+            kind = db.execute("SELECT value FROM meta WHERE key='kind'").fetchone()
+            if kind is None or kind[0] != "rvsm regression":
+                raise RvsmError(f"{path}: not a regression database; {hint}")
+            rows = db.execute("SELECT plan, label, status FROM runs ORDER BY plan, label"
+                              ).fetchall()
+        finally:
+            db.close()
+    except sqlite3.Error as exc:
+        raise RvsmError(f"{path}: cannot read the regression database ({exc}); {hint}") \
+            from None
+    plans = tuple(dict.fromkeys(str(r[0]) for r in rows))
+    return RegressSummary(plans, tuple((str(a), str(b), str(c)) for a, b, c in rows))
 
 
 def load_regress_junit(path: str | os.PathLike) -> RegressSummary:

@@ -3,17 +3,19 @@ figures follow the inputs given, and refused inputs leave nothing behind."""
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 from pathlib import Path
 
 import pytest
 
+from rvsm.model.infra.errors import RvsmError
 from rvsm.sim.cli import datasheet as cli
 from rvsm.sim.cli import main
 from rvsm.sim.studies import point_quality
 from rvsm.sim.studies.datasheet import SECTIONS
-from rvsm.sim.studies.datasheet_inputs import load_point_file
+from rvsm.sim.studies.datasheet_inputs import load_point_file, load_regress
 
 TINY = ["--size", "16x24", "--frames", "3", "--scenes", "coin", "--quiet"]
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -133,6 +135,27 @@ def test_datasheet_runs_the_study_and_says_what_is_missing(files, tmp_path, monk
     verification = md.split("## Verification")[1]
     assert verification.count("| not run |") == 2
     assert "rvsm quality" in md.split("## Image quality")[1]
+
+
+def test_regress_database_is_read(tmp_path):
+    from rvsm.sim.regress.store import RegressionStore
+
+    db = tmp_path / "r.sqlite"
+    with RegressionStore(db) as store:
+        store.db.executemany("INSERT INTO runs (key, plan, label, status) VALUES (?,?,?,?)",
+                             [("k1", "smoke", "a", "pass"), ("k2", "smoke", "b", "error"),
+                              ("k3", "smoke", "c", "pass")])
+        store.db.commit()
+    r = load_regress(db)
+    assert r.suites == ("smoke",) and (r.count("pass"), r.count("error")) == (2, 1)
+    other = tmp_path / "x.sqlite"
+    import sqlite3
+
+    with contextlib.closing(sqlite3.connect(other)) as con:
+        con.execute("CREATE TABLE t (a)")
+        con.commit()
+    with pytest.raises(RvsmError, match="not a regression database|cannot read"):
+        load_regress(other)
 
 
 @pytest.mark.parametrize("case", ["missing", "bad_json", "other_point", "bad_lanes",
