@@ -94,7 +94,10 @@ def logic_of(inputs: DatasheetInputs) -> LogicCost | None:
                          float(slope["ff_per_lane"]), float(slope["ff_fixed"]),
                          f"rvsm fpga --slope-lanes ({inputs.fpga_path})")
     if inputs.lane_cost:
-        return LogicCost.from_record(inputs.lane_cost)
+        rec = inputs.lane_cost
+        (h, w), (p1, p2) = rec["size"], rec["lanes"]
+        return LogicCost.from_record(rec, f"lane cost model (yosys synth_ecp5 at {h}x{w}, "
+                                          f"P = {p1} and {p2})")
     return None
 
 
