@@ -159,7 +159,7 @@ def test_regress_database_is_read(tmp_path):
 
 
 @pytest.mark.parametrize("case", ["missing", "bad_json", "other_point", "bad_lanes",
-                                  "bad_fpga", "device"])
+                                  "bad_fpga", "device", "bad_rtl"])
 def test_datasheet_refusals_leave_nothing(files, tmp_path, capsys, case):
     out = tmp_path / "sheet"
     other = tmp_path / "other.json"
@@ -179,8 +179,12 @@ def test_datasheet_refusals_leave_nothing(files, tmp_path, capsys, case):
     elif case == "bad_fpga":
         other.write_text(json.dumps({"lut4": {"used": 1}}))
         args += ["--fpga", str(other)]
-    else:
+    elif case == "device":
         args += ["--device", "no-such-chip"]
+    else:
+        point = tmp_path / "p.toml"
+        point.write_text(files["point"].read_text().replace("lanes = 4", "lanes = 0"))
+        args[1] = str(point)
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("rvsm: error: ")
