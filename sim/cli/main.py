@@ -17,6 +17,7 @@ from types import ModuleType
 from rvsm.model.infra.compile_notice import install_compile_notice
 from rvsm.model.infra.errors import RvsmError, ToolError, interrupt_behind
 from rvsm.sim.cli import (
+    datasheet,
     demo,
     events,
     fixed,
@@ -33,15 +34,16 @@ from rvsm.sim.cli import (
 )
 
 #: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
-#: co-simulation, formal checks, FPGA timing and area, paper studies, the demo, design sweeps.
+#: co-simulation, formal checks, FPGA timing and area, paper studies, a point's image quality
+#: and datasheet, the demo, design sweeps.
 FAMILIES: tuple[ModuleType, ...] = (sampling, events, scenes, fixed, rtl, verify, regress,
-                                    formal, mutate, fpga, studies, demo, sweep)
+                                    formal, mutate, fpga, studies, datasheet, demo, sweep)
 
 
 #: Commands that run numba kernels: a kernel compiling in them says so (first run).
 COMPILING_COMMANDS = frozenset({"simulate", "demo", "table", "robustness", "cost", "profile",
                                 "evaluate", "stimulus", "events", "verify", "regress",
-                                "sweep", "dat"})
+                                "sweep", "dat", "quality", "datasheet"})
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,359 @@
+"""The datasheet of a design point: one Markdown page for a hardware designer choosing a chip.
+
+:func:`build_datasheet` turns a :class:`DatasheetInputs` (the point, the device, the
+camera rate, and whatever was measured elsewhere) into the page's Markdown and its
+figures, section by section:
+
+1. **Design point** -- every field, and what each costs in state bits at the sensor's
+   size (:func:`~rvsm.rtl.fpga.camera.state_memory`: accumulators, thresholds, line
+   buffers) and in logic per lane (:mod:`rvsm.rtl.fpga.lane_cost`, or the slope of a
+   saved ``rvsm fpga --slope-lanes`` report);
+2. **Resources** -- measured by nextpnr (a saved ``rvsm fpga --json``) beside the
+   feasibility model's estimate at the sensor's size (:func:`~rvsm.rtl.fpga.feasibility.assess`
+   on :mod:`rvsm.rtl.fpga.devices` budgets), each labelled;
+3. **Clock** -- Fmax against the clock the camera needs, ``H * W/P * rate``;
+4. **Memory map and interfaces** -- the state memories at ``P`` lanes, the AXI4-Lite
+   register map of the IP (:func:`~rvsm.rtl.ip.register_map.ip_register_map`) and the
+   ports of the bare array and of the IP (the architectures' port maps, as ``rvsm
+   verilog`` writes them to ``ports.json``);
+5. **Image quality** -- the study of :mod:`rvsm.sim.studies.point_quality` and a picture of
+   the reconstructions;
+6. **Verification** -- saved ``rvsm verify --json`` and ``rvsm regress --junit`` results,
+   "not run" for what is not given.
+
+Every section ends with a "Sources" line naming the commands behind its figures.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from rvsm.model.fixed.point_toml import to_toml_dict
+from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.fpga.block_ram import StateLayout
+from rvsm.rtl.fpga.camera import clock_needed_hz, state_memory
+from rvsm.rtl.fpga.devices import DeviceBudget
+from rvsm.rtl.fpga.feasibility import Camera, Feasibility, LogicCost, MeasuredFmax, assess
+from rvsm.sim.studies import datasheet_figures as figs
+from rvsm.sim.studies.datasheet_inputs import PointFile, RegressSummary
+from rvsm.sim.studies.point_quality import PointQuality
+
+__all__ = ["Datasheet", "DatasheetInputs", "build_datasheet", "logic_of"]
+
+#: The page's file name and its section titles, in order.
+PAGE = "datasheet.md"
+SECTIONS = ("Design point", "Resources", "Clock", "Memory map and interfaces",
+            "Image quality", "Verification")
+
+
+@dataclass(frozen=True)
+class DatasheetInputs:
+    """Everything the page shows: the point file, ``device`` budget, camera ``rate_hz``,
+    ``lanes`` (None: the point's ``[rtl] lanes``, else the fewest that fit), state memory
+    ``organisation``, the quality study (and ``picture``: ``(scene, step, images)`` or
+    None) and the optional saved results with their paths; ``lane_cost``: a
+    :class:`~rvsm.rtl.fpga.lane_cost.LaneCost` record (None: not synthesised);
+    ``command``: the command line that made the page."""
+
+    point_file: PointFile
+    device: DeviceBudget
+    rate_hz: float
+    quality: PointQuality
+    quality_source: str
+    lanes: int | None = None
+    organisation: str = "rtl"
+    fifo_depth: int = 16
+    picture: tuple[str, int, dict[str, np.ndarray]] | None = None
+    fpga: dict[str, Any] | None = None
+    fpga_path: str | None = None
+    lane_cost: dict[str, Any] | None = None
+    verify: dict[str, Any] | None = None
+    verify_path: str | None = None
+    regress: RegressSummary | None = None
+    regress_path: str | None = None
+    command: str = "rvsm datasheet"
+
+
+@dataclass
+class Datasheet:
+    """The page's Markdown and its figures by file name (matplotlib figures)."""
+
+    markdown: str
+    figures: dict[str, Any] = field(default_factory=dict)
+
+
+def logic_of(inputs: DatasheetInputs) -> LogicCost | None:
+    """The logic model: the slope of the saved ``rvsm fpga --slope-lanes`` report if it
+    has one, else the lane cost synthesis, else None."""
+    slope = (inputs.fpga or {}).get("slope")
+    if isinstance(slope, dict) and "lut4_per_lane" in slope:
+        return LogicCost(float(slope["lut4_per_lane"]), float(slope["lut4_fixed"]),
+                         float(slope["ff_per_lane"]), float(slope["ff_fixed"]),
+                         f"rvsm fpga --slope-lanes ({inputs.fpga_path})")
+    if inputs.lane_cost:
+        rec = inputs.lane_cost
+        (h, w), (p1, p2) = rec["size"], rec["lanes"]
+        return LogicCost.from_record(rec, f"lane cost model (yosys synth_ecp5 at {h}x{w}, "
+                                          f"P = {p1} and {p2})")
+    return None
+
+
+def _assess(inputs: DatasheetInputs, logic: LogicCost | None) -> Feasibility:
+    point = inputs.point_file.point
+    h, w = point.shape
+    lanes = inputs.lanes or inputs.point_file.lanes
+    clock = None
+    if lanes is not None:
+        if w % lanes:
+            raise RvsmError(f"lanes {lanes} must divide the array width {w}")
+        clock = clock_needed_hz(h, w, lanes, inputs.rate_hz)  # pins P = lanes
+    measured = None
+    fp = inputs.fpga
+    if fp is not None and fp.get("fmax_mhz") and inputs.device.family == "ecp5":
+        measured = MeasuredFmax(float(fp["fmax_mhz"]), int(fp["lanes"]),
+                                f"rvsm fpga at {fp['height']}x{fp['width']}")
+    shared = getattr(point, "threshold_storage", "per-pixel") == "shared"
+    layout = StateLayout.from_contract(point.contract(), shared_thresholds=shared)
+    return assess(layout, inputs.device, Camera(h, w, inputs.rate_hz, clock), logic,
+                  measured=measured, organisation=inputs.organisation)
+
+
+def _bits(n: float) -> str:
+    return f"{n / 1e6:.3f} Mbit" if n >= 1e5 else f"{n / 1e3:.1f} Kbit" if n >= 1e3 \
+        else f"{n:.0f} bit"
+
+
+def _point_section(inputs: DatasheetInputs, logic: LogicCost | None,
+                   feas: Feasibility) -> list[str]:
+    pf, point = inputs.point_file, inputs.point_file.point
+    st = state_memory(point.contract())
+    s, (h, w) = st.num_scales, point.shape
+    shared = getattr(point, "threshold_storage", "per-pixel") == "shared"
+    lines = [f"## {SECTIONS[0]}", "", f"`{pf.path}`: {point.model} "
+             f"({point.sensor}), {h}x{w} pixels, {s} scale(s)"
+             + (f"; `[rtl]` {', '.join(f'{k} = {v}' for k, v in pf.rtl.items())}"
+                if pf.rtl else "") + ".", "", "| field | value |", "|---|---|"]
+    for sec, table in to_toml_dict(point).items():
+        lines += [f"| `{sec}.{k}` | {v} |" for k, v in table.items()]
+    thr = "shared registers, no memory" if shared else f"{_bits(st.thresholds)}"
+    per_lane = ("not estimated (no synthesis: see Sources)" if logic is None else
+                f"{logic.lut4_per_lane:,.0f} LUT4 and {logic.ff_per_lane:,.0f} FF per "
+                f"lane, {logic.lut4_base:,.0f} LUT4 fixed ({logic.source})")
+    lines += ["", f"What each choice costs at {h}x{w} ({s} scales, window radius "
+              f"L = {st.radius}):", "",
+              "| field | value | state it sets | bits | one more step costs |",
+              "|---|---|---|---|---|",
+              f"| `datapath.accumulator_bits` | {st.accumulator_bits} | accumulators "
+              f"S x H x W x A | {_bits(st.accumulators)} | {_bits(s * h * w)} per bit |",
+              f"| `datapath.accumulator_bits` | {st.threshold_bits} (A - 1) | thresholds "
+              f"S x H x W x (A-1) | {thr} | "
+              + ("0" if shared else f"{_bits(s * h * w)} per bit") + " |",
+              f"| `adc.bits` | {st.adc_bits} | line buffers 2L x W x N | "
+              f"{_bits(st.line_buffers)} | {_bits(2 * st.radius * w)} per bit |",
+              f"| `array.model` | {point.model} | S = {s} scales, L = {st.radius} | "
+              f"{_bits(st.total if not shared else st.total - st.thresholds)} in all | "
+              f"{_bits(h * w * (st.accumulator_bits + (0 if shared else st.threshold_bits)))}"
+              f" per scale |",
+              f"| `weights.bits`, `weights.frac_bits` | {point.weight_bits}, "
+              f"{point.weight_frac_bits} | logic only | - | {per_lane} |", "",
+              f"Block RAM at P = {feas.lanes} ({feas.organisation} organisation, "
+              f"{inputs.device.name}): {feas.packing.bram} {inputs.device.bram_kind.name}.",
+              "", f"Sources: this page's command (`{inputs.command}`) from "
+              "rtl/fpga/camera.py and rtl/fpga/block_ram.py; logic per lane: "
+              + ("the saved `rvsm fpga --slope-lanes` report" if inputs.fpga and
+                 (inputs.fpga.get("slope") or {}) else
+                 "lane_cost (yosys synth_ecp5 at 16x16, P = 1 and 2), as `rvsm sweep` "
+                 "measures it" if inputs.lane_cost else
+                 "not run (omit --no-synthesis, or give --fpga from `rvsm fpga POINT "
+                 "--slope-lanes 2 --json`)") + ".", ""]
+    return lines
+
+
+def _pct(used: float | None, avail: float | None) -> float | None:
+    return None if used is None or not avail else 100.0 * used / avail
+
+
+def _resources_section(inputs: DatasheetInputs, feas: Feasibility) -> tuple[list[str], Any]:
+    dev, fp = inputs.device, inputs.fpga
+    c = feas.checks
+    est = {"LUT4": c["lut4"].figure, "FF": c["ff"].figure, dev.bram_kind.name: c["memory"].figure}
+    avail = {"LUT4": dev.lut4, "FF": dev.ff, dev.bram_kind.name: dev.bram}
+    meas: dict[str, float | None] = {k: None for k in est}
+    if fp is not None:
+        meas = {"LUT4": fp["lut4"]["used"], "FF": fp["ff"]["used"],
+                dev.bram_kind.name: fp["bram"]["used"]}
+    where = (f"measured by nextpnr ({fp.get('mode', '?')}) at {fp['height']}x{fp['width']}, "
+             f"P = {fp['lanes']}, on {fp['device']}" if fp else "measured: not given")
+    lines = [f"## {SECTIONS[1]}", "", f"Device {dev.summary()}.", "",
+             f"| resource | measured | estimate (feasibility model) at "
+             f"{feas.camera.height}x{feas.camera.width}, P = {feas.lanes} | device | "
+             "estimate verdict |", "|---|---|---|---|---|"]
+    for k in est:
+        m = "not given" if meas[k] is None else f"{meas[k]:,.0f} ({_pct(meas[k], avail[k]):.1f} %)"
+        e = "not estimated" if est[k] is None else \
+            f"{est[k]:,.0f} ({_pct(est[k], avail[k]):.1f} %)"
+        check = {"LUT4": c["lut4"], "FF": c["ff"]}.get(k, c["memory"])
+        verdict = check.text() if check.ok is not None else \
+            "unknown: no logic figure (see Sources)"
+        lines.append(f"| {k} | {m} | {e} | {avail[k]:,} | {verdict} |")
+    lines += ["", f"Measured column: {where}. The estimate is the feasibility model "
+              "(rtl/fpga/feasibility.py): state packed into the device's block RAM, "
+              "logic = fixed + P x per lane, at most "
+              f"{c['lut4'].budget / dev.lut4 * 100 if c['lut4'].budget else 80:.0f} % of "
+              "the LUT4 and FF; it is an **estimate**, not a placed design. "
+              f"Verdict of the estimate: {feas.summary()}.", "",
+              "![resources](resources.png)", "",
+              "Sources: measured: " + (f"`rvsm fpga {inputs.point_file.path} --json` saved "
+                                       f"as `{inputs.fpga_path}`" if fp else "not run "
+                                       f"(`rvsm fpga {inputs.point_file.path} --json > "
+                                       "fpga.json`, then --fpga fpga.json)")
+              + f"; estimate: `{inputs.command}`.", ""]
+    rows = [(k, _pct(meas[k], avail[k]), _pct(est[k], avail[k])) for k in est]
+    return lines, figs.resources_figure(rows, dev.name)
+
+
+def _clock_section(inputs: DatasheetInputs, feas: Feasibility) -> tuple[list[str], Any]:
+    h, w = inputs.point_file.point.shape
+    fmax = feas.checks["fmax"]
+    lanes = [p for p in range(1, w + 1) if w % p == 0]
+    clocks = [clock_needed_hz(h, w, p, inputs.rate_hz) / 1e6 for p in lanes]
+    how = fmax.detail.split("; ", 1)[-1]
+    lanes_from = ("--lanes" if inputs.lanes else "[rtl] lanes of the point"
+                  if inputs.point_file.lanes else "the fewest lanes that fit")
+    lines = [f"## {SECTIONS[2]}", "",
+             f"Camera {h}x{w} at {inputs.rate_hz:,.0f} steps/s: clock = H x W/P x rate = "
+             f"{h} x {w}/{feas.lanes} x {inputs.rate_hz:,.0f} = "
+             f"**{feas.clock_needed_hz / 1e6:.1f} MHz** at P = {feas.lanes} lanes "
+             f"({lanes_from}).", "",
+             "Fmax: " + ("unknown" if fmax.budget is None else f"**{fmax.budget:.1f} MHz**")
+             + f" ({how}); " + {True: "the clock is met.", False: "the clock is NOT met.",
+                                None: "not known whether the clock is met."}[fmax.ok], "",
+             "| P | clock needed (MHz) |", "|---|---|"]
+    near = [i for i, p in enumerate(lanes) if p == feas.lanes]
+    idx = sorted(set(range(max(0, near[0] - 3), min(len(lanes), near[0] + 4)))) if near else []
+    lines += [f"| {lanes[i]}{' (chosen)' if lanes[i] == feas.lanes else ''} | "
+              f"{clocks[i]:.1f} |" for i in idx]
+    measured = "the saved `rvsm fpga` report" if inputs.fpga and inputs.fpga.get("fmax_mhz") \
+        else "no place and route given: the device's timing model (rtl/fpga/devices.py)"
+    lines += ["", "![clock](clock.png)", "",
+              f"Sources: Fmax from {measured}; clock from rtl/fpga/camera.py "
+              f"(`{inputs.command}`).", ""]
+    label = "Fmax" + ("" if fmax.budget is None else f" {fmax.budget:.0f} MHz")
+    return lines, figs.clock_figure(lanes, clocks, fmax.budget, feas.lanes, label)
+
+
+def _interfaces_section(inputs: DatasheetInputs, feas: Feasibility) -> list[str]:
+    from rvsm.model.infra.versions import rvsm_version
+    from rvsm.rtl.architectures.registry import get_architecture
+    from rvsm.rtl.flow_files import design_point_digest
+    from rvsm.rtl.ip.register_map import ip_register_map
+    from rvsm.rtl.ip.wrapper import IP_ARCH
+    from rvsm.rtl.rtl_digest import rtl_digest
+
+    contract = inputs.point_file.point.contract()
+    p, fifo = feas.lanes, inputs.fifo_depth
+    opts = {"lanes": p, "fifo_depth": fifo}
+    regmap = ip_register_map(contract, p, fifo, rtl_digest(contract, IP_ARCH, opts),
+                             design_point_digest(contract), rvsm_version())
+    lines = [f"## {SECTIONS[3]}", "", f"State memories at P = {p} ({feas.organisation} "
+             f"organisation) on {inputs.device.name}:", ""]
+    lines += [f"- {r}" for r in feas.packing.rows()]
+    lines += ["", f"AXI4-Lite registers of the IP (`--interface axis`, P = {p}, output "
+              f"FIFO {fifo} beats; 32-bit, byte offsets, {1 << regmap.addr_bits} B window):",
+              "", "| offset | register | access | reset | meaning |", "|---|---|---|---|---|"]
+    lines += [f"| 0x{r.offset:03X} | `{r.name}` | {r.access} | 0x{r.reset:08X} | {r.desc} |"
+              for r in regmap.registers]
+    for title, arch, options in (("bare streaming array (`--interface native`)",
+                                  get_architecture("stream"), {"lanes": p}),
+                                 ("AXI IP (`--interface axis`)",
+                                  get_architecture("stream", "axis"), opts)):
+        lines += ["", f"Ports of the {title}:", "", "| port | dir | width | meaning |",
+                  "|---|---|---|---|"]
+        lines += [f"| `{r['name']}` | {r['dir']} | {r['width']} | {r['desc']} |"
+                  for r in arch.port_map(contract, **options)]
+    path = inputs.point_file.path
+    lines += ["", f"Sources: `rvsm verilog {path} --lanes {p} --interface axis -o build` "
+              "writes the same register map (`rvsm_axis_ip.regs.md/.json/.h`) and ports "
+              f"(`rvsm_axis_ip.ports.json`); `rvsm verilog {path} --lanes {p}` the bare "
+              "array's `ports.json`; state memories from rtl/fpga/block_ram.py.", ""]
+    return lines
+
+
+def _quality_section(inputs: DatasheetInputs) -> tuple[list[str], dict[str, Any]]:
+    q = inputs.quality
+    h, w = q.size
+    out: dict[str, Any] = {"quality_costs.png": figs.costs_figure(q)}
+    lines = [f"## {SECTIONS[4]}", "",
+             f"PSNR (dB) and SSIM against the ground truth on {len({r.scene for r in q.rows})}"
+             f" built-in scene(s) at {h}x{w}, {q.steps} steps ({q.frames} frames x "
+             f"{q.steps_per_frame}), seed {q.point.get('seed')}, {q.method} reconstruction, "
+             f"{q.match} brightness matching. **Quantisation cost** = own float - twin (what "
+             "the fixed point costs); **chip cost** = float dog4 (the default design point) "
+             "- twin (what this chip costs a user against the default float model).", ""]
+    for noise in (False, True):
+        if q.rows_with(noise):
+            lines += [f"Noise {'on' if noise else 'off'}:", "", *q.markdown(noise), ""]
+    lines += ["![costs per scene](quality_costs.png)", ""]
+    if inputs.picture is not None:
+        scene, step, images = inputs.picture
+        out["reconstructions.png"] = figs.reconstruction_figure(
+            images, f"{scene}, step {step}, {h}x{w}, noise off")
+        lines += [f"Reconstructions of {scene} at step {step} (noise off): ground truth, "
+                  "float dog4, own float, fixed twin.", "",
+                  "![reconstructions](reconstructions.png)", ""]
+    else:
+        lines += ["No reconstruction picture: drawn for spike-camera points only.", ""]
+    picture = f"; picture: `{inputs.command}`" if inputs.picture is not None else ""
+    lines += [f"Sources: {inputs.quality_source}{picture}.", ""]
+    return lines, out
+
+
+def _verification_section(inputs: DatasheetInputs) -> list[str]:
+    lines = [f"## {SECTIONS[5]}", "", "| check | command | result |", "|---|---|---|"]
+    v = inputs.verify
+    if v is None:
+        lines.append("| RTL against the twin | `rvsm verify SCENE --fixed POINT --json` | "
+                     "not run |")
+    else:
+        verdict = "PASS" if v["mismatches"] == 0 else f"FAIL ({v['mismatches']} mismatches)"
+        what = ", ".join(f"{k} {v[k]}" for k in ("sim", "arch", "steps", "harness")
+                         if k in v)
+        lines.append(f"| RTL against the twin | `rvsm verify ... --json` saved as "
+                     f"`{inputs.verify_path}` | {verdict}: {v['compared']:,} spikes "
+                     f"compared{'; ' + what if what else ''} |")
+    r = inputs.regress
+    if r is None:
+        lines.append("| regression plan | `rvsm regress PLAN.toml -o RESULTS.sqlite` | "
+                     "not run |")
+    else:
+        n = len(r.cases)
+        lines.append(f"| regression {', '.join(r.suites)} | `rvsm regress` results "
+                     f"`{inputs.regress_path}` | {r.count('pass')} of {n} pass, "
+                     f"{r.count('fail')} fail, {r.count('error')} error |")
+        bad = [c for c in r.cases if c[2] in ("fail", "error")]
+        lines += [f"| - {c[1]} | | {c[2]} |" for c in bad[:20]]
+    lines += ["", "Sources: the saved results named above (--verify, --regress); a check "
+              "without one says \"not run\".", ""]
+    return lines
+
+
+def build_datasheet(inputs: DatasheetInputs) -> Datasheet:
+    """The page and its figures (module docstring)."""
+    logic = logic_of(inputs)
+    feas = _assess(inputs, logic)
+    point = inputs.point_file.point
+    lines = [f"# Datasheet: {point.model} {point.shape[0]}x{point.shape[1]} on "
+             f"{inputs.device.name}", "",
+             f"Made by `{inputs.command}`. Contents: "
+             + ", ".join(SECTIONS) + ".", ""]
+    lines += _point_section(inputs, logic, feas)
+    res, res_fig = _resources_section(inputs, feas)
+    clk, clk_fig = _clock_section(inputs, feas)
+    lines += res + clk + _interfaces_section(inputs, feas)
+    qual, qual_figs = _quality_section(inputs)
+    lines += qual + _verification_section(inputs)
+    return Datasheet("\n".join(lines), {"resources.png": res_fig, "clock.png": clk_fig,
+                                        **qual_figs})
