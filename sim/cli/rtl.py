@@ -20,6 +20,7 @@ from rvsm.rtl.architectures.registry import (
 from rvsm.rtl.capabilities import Architecture, Option
 from rvsm.rtl.flow_files import DEFAULT_CLOCK_MHZ
 from rvsm.sim.cli.args import add_force_argument, sized_contract
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 
 if TYPE_CHECKING:
@@ -28,7 +29,7 @@ if TYPE_CHECKING:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``verilog`` sub-command."""
-    p = sub.add_parser("verilog", help="generate the pixel array's Verilog and port map",
+    p = sub.add_parser("verilog", help=summary("verilog"),
                        description="Generate Verilog (readable ports, no src attributes) "
                        "and a port map (JSON, Markdown) for a design point.")
     p.add_argument("point", help="design point TOML")

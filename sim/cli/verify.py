@@ -25,6 +25,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures.registry import ARCHITECTURES, NATIVE, WRAPPERS, architectures_with
 from rvsm.rtl.capabilities import Architecture
 from rvsm.sim.cli.args import SceneRequest, add_scene_arguments, parse_size_arg
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 from rvsm.sim.cli.rtl import (
     add_arch_arguments,
@@ -42,7 +43,7 @@ if TYPE_CHECKING:
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``verify`` sub-command."""
     p = sub.add_parser(
-        "verify", help="simulate the RTL and compare every spike with the fixed twin",
+        "verify", help=summary("verify"),
         description="Build the generated Verilog on Icarus or Verilator, drive a stimulus, "
         "compare every spike. Either SCENE --fixed POINT.toml (the fixed twin makes the "
         "stimulus), --stimulus FILE (replay a file written by `rvsm stimulus`) or "
