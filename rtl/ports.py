@@ -79,7 +79,8 @@ PORTS_JSON_MAX_BYTES = 4 << 20
 
 def load_ports_json(path: str | os.PathLike) -> dict:
     """Read a ``<top>.ports.json`` (``rvsm verilog``, build caches) and check its shape:
-    an object with ``top`` (text), ``arch`` (text), ``latency`` (integer >= 0) and
+    an object with ``top`` (text), ``arch`` (text), ``latency`` (integer >= 0), an
+    optional ``pixel_to_spike`` (integer >= 0; older maps have none) and
     ``ports`` (a list of ``name``/``dir``/``width``/``desc`` with optional ``fields`` of
     ``name``/``offset``/``width`` inside the port); :class:`RvsmError` naming the file and
     the first bad entry."""
@@ -114,6 +115,8 @@ def _check_ports_meta(data: object, source: str) -> None:
             raise bad(f"{key!r} must be an identifier")
     if not _is_int(data.get("latency"), 0, 1 << 20):
         raise bad("'latency' must be an integer >= 0")
+    if "pixel_to_spike" in data and not _is_int(data["pixel_to_spike"], 0, 1 << 40):
+        raise bad("'pixel_to_spike' must be an integer >= 0")
     ports = data.get("ports")
     if not isinstance(ports, list) or not ports:
         raise bad("'ports' must be a non-empty list")

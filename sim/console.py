@@ -1,6 +1,7 @@
-"""The ``rvsm`` console script: signal handlers first, then the (slow) command imports.
+"""The ``rvsm`` console script: signal handlers first, then the command imports.
 
-Importing the command families (numpy, matplotlib, amaranth, ...) takes a second or more;
+Importing a command family (numpy, matplotlib, amaranth, ...) takes a second or more
+(``rvsm --help`` and ``--version`` import none: :mod:`rvsm.sim.cli.commands`);
 SIGTERM and SIGHUP are turned into interrupts before that, so a signal during start-up
 also ends with status 130 and one line instead of a traceback or a bare kill. The
 commands themselves are :func:`rvsm.sim.cli.main.main`.

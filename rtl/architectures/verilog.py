@@ -130,11 +130,13 @@ def generate_verilog(
 
 
 def ports_meta(arch: str | Architecture, component: wiring.Component, top: str) -> dict:
-    """The ``ports.json`` content (without timings): ``top``, ``arch``, ``latency``, the
+    """The ``ports.json`` content (without timings): ``top``, ``arch``, ``latency``,
+    ``pixel_to_spike`` (the component's cycles from a pixel's input to its spikes), the
     architecture's own entries (:attr:`Architecture.describe`) and ``ports``."""
     a = get_architecture(arch)
     options = {o.name: getattr(component, o.name) for o in a.options}
     return {"top": top, "arch": a.name, "latency": component.latency,
+            "pixel_to_spike": component.pixel_to_spike,
             **a.describe(component), "ports": a.port_map(component.contract, **options)}
 
 

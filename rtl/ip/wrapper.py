@@ -154,6 +154,13 @@ class RvsmAxisIp(wiring.Component):
         return self.geometry.latency + self.RELEASE_CYCLES - 2
 
     @property
+    def pixel_to_spike(self) -> int:
+        """Cycles from the edge accepting a pixel's beat on ``s_axis`` to its spikes on
+        ``m_axis`` (beats back to back, FIFO empty): ``lag + RELEASE_CYCLES``, one more
+        than ``window_lag + latency`` (the input register before the array)."""
+        return self.lag + self.RELEASE_CYCLES
+
+    @property
     def init_cycles(self) -> int:
         """Cycles after ``rst`` during which the thresholds are set (``S*H*G``)."""
         return self.contract.num_scales * self.geometry.beats_per_frame

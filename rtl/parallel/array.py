@@ -103,6 +103,12 @@ class RvsmArray(wiring.Component):
         """Clock cycles from the strobe edge sampling ``codes`` to valid spike outputs."""
         return self.LATENCY
 
+    @property
+    def pixel_to_spike(self) -> int:
+        """Clock cycles from the edge sampling a pixel's code to its spikes: every pixel
+        of a step is strobed at once, so :attr:`latency`."""
+        return self.latency
+
     @classmethod
     def port_docs(cls, contract: ArrayContract) -> dict[str, str]:
         """Meaning of every Verilog port (names as :func:`rvsm.rtl.ports.port_map`)."""

@@ -220,6 +220,11 @@ class RvsmStreamArray(wiring.Component):
         return self.geometry.latency
 
     @property
+    def pixel_to_spike(self) -> int:
+        """:attr:`StreamGeometry.pixel_to_spike` (clock cycles, back-to-back beats)."""
+        return self.geometry.pixel_to_spike
+
+    @property
     def lag(self) -> int:
         """:attr:`StreamGeometry.lag` (beats)."""
         return self.geometry.lag

@@ -97,6 +97,12 @@ class StreamGeometry:
         return self.window_lag + self.pipeline_depth
 
     @property
+    def pixel_to_spike(self) -> int:
+        """Clock cycles from the edge accepting a pixel's beat ``p`` to the edge presenting
+        its spikes, beats back to back: ``window_lag + latency`` (``lag + 1``)."""
+        return self.window_lag + self.latency
+
+    @property
     def rmw_depth(self) -> int:
         """Beats from an accumulator read (address sampled) to its write-back."""
         return self.TAIL_STAGES + self.READ_STAGES - 1

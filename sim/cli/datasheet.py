@@ -10,6 +10,7 @@ from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.sim.cli.args import add_force_argument
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 
 #: The study's defaults (:data:`rvsm.sim.studies.point_quality.DEFAULT_FRAMES`, kept here so
@@ -65,7 +66,7 @@ def _add_study_arguments(p: argparse.ArgumentParser) -> None:
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``quality`` and ``datasheet``."""
     p = sub.add_parser(
-        "quality", help="image quality of a design point: twin, own float, dog4 float",
+        "quality", help=summary("quality"),
         description="On every built-in scene, noise off and on: PSNR/SSIM of the point's "
         "fixed twin, of its own float model and of the default point's float model (dog4) "
         "against the ground truth, and the costs own float - twin (quantisation) and dog4 "
@@ -79,7 +80,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_quality)
 
     p = sub.add_parser(
-        "datasheet", help="one Markdown page with figures: a design point for a chip",
+        "datasheet", help=summary("datasheet"),
         description="Write DIR/datasheet.md and its PNG figures: the design point and what "
         "each field costs, resources against the device (measured with --fpga, else the "
         "feasibility model's estimate), Fmax against the camera's clock, the memory map "

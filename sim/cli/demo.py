@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from rvsm.sim.cli.args import SceneRequest, add_force_argument
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.cosim.builds.cocotb_adapter import SIMULATORS
 from rvsm.sim.studies.main_job import (
@@ -21,7 +22,7 @@ from rvsm.sim.studies.main_job import (
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``demo``."""
     p = sub.add_parser(
-        "demo", help="run FSM, dog4 and gauss4 with default noise on a built-in scene",
+        "demo", help=summary("demo"),
         description="Sample a built-in scene with FSM, dog4 and gauss4 under default noise; "
         "write spike files, reconstructions beside ground truth (PNG) and a metrics table.",
     )

@@ -28,14 +28,14 @@ from rvsm.sim.cli.args import (
     add_scene_arguments,
     parse_size_arg,
 )
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.studies.event_claims import DEFAULT_KS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``events export`` and ``events import``."""
-    p = sub.add_parser("events", help="event files (--sensor dvs) to/from event lists, "
-                       "AEDAT4, EVT and CSV",
+    p = sub.add_parser("events", help=summary("events"),
                        description="Convert the events of `rvsm simulate --sensor dvs` to "
                        "an HDF5 event list (t in microseconds at 40 kHz, x, y, polarity, "
                        "scale; DSEC's names, gzip: no filter plugin), to AEDAT4, EVT 3 or "

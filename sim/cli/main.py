@@ -1,43 +1,32 @@
 """The ``rvsm`` entry point: the parser built from :data:`FAMILIES`, and exit statuses.
 
 Each module in :data:`FAMILIES` exposes ``register(subparsers)``, which adds its
-sub-command(s) and sets ``func(args) -> int`` on them; this list is the one place a
-command is registered. Errors a user can fix are raised as
-:class:`~rvsm.model.infra.errors.RvsmError` and printed here on one line, with exit status 2.
+sub-command(s) and sets ``func(args) -> int`` on them; :data:`~rvsm.sim.cli.commands.COMMANDS`
+is the one place a command is listed. The families import numpy, numba, matplotlib and
+amaranth, so they are imported lazily: ``rvsm --help`` lists the commands from that table
+alone, ``rvsm COMMAND ...`` imports only COMMAND's family. Errors a user can fix are raised
+as :class:`~rvsm.model.infra.errors.RvsmError` and printed here on one line, with exit
+status 2.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import shlex
 import signal
 import sys
+from collections.abc import Sequence
 from types import ModuleType
 
 from rvsm.model.infra.compile_notice import install_compile_notice
 from rvsm.model.infra.errors import RvsmError, ToolError, interrupt_behind
-from rvsm.sim.cli import (
-    datasheet,
-    demo,
-    events,
-    fixed,
-    formal,
-    fpga,
-    mutate,
-    regress,
-    rtl,
-    sampling,
-    scenes,
-    studies,
-    sweep,
-    verify,
-)
+from rvsm.sim.cli.commands import COMMANDS, FAMILY_NAMES
 
-#: Command families, in ``rvsm --help`` order: float twin, scenes, fixed twin, RTL and
-#: co-simulation, formal checks, FPGA timing and area, paper studies, a point's image quality
-#: and datasheet, the demo, design sweeps.
-FAMILIES: tuple[ModuleType, ...] = (sampling, events, scenes, fixed, rtl, verify, regress,
-                                    formal, mutate, fpga, studies, datasheet, demo, sweep)
+#: Command families (modules ``rvsm.sim.cli.<name>``), in ``rvsm --help`` order: float twin,
+#: scenes, fixed twin, RTL and co-simulation, formal checks, FPGA timing and area, paper
+#: studies, the demo, design sweeps.
+FAMILIES: tuple[str, ...] = FAMILY_NAMES
 
 
 #: Commands that run numba kernels: a kernel compiling in them says so (first run).
@@ -46,8 +35,15 @@ COMPILING_COMMANDS = frozenset({"simulate", "demo", "table", "robustness", "cost
                                 "sweep", "dat", "quality", "datasheet"})
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The full ``rvsm`` argument parser, with every sub-command of :data:`FAMILIES`."""
+def family_module(name: str) -> ModuleType:
+    """The family module ``rvsm.sim.cli.<name>`` (imported on first use: it is heavy)."""
+    return importlib.import_module(f"rvsm.sim.cli.{name}")
+
+
+def build_parser(families: Sequence[str] | None = None) -> argparse.ArgumentParser:
+    """The ``rvsm`` argument parser: every sub-command of :data:`FAMILIES`, or, with
+    ``families``, only those families' commands in full and the others as name and help
+    line (enough for ``rvsm --help``, and nothing imported for them)."""
     parser = argparse.ArgumentParser(
         prog="rvsm",
         description="RVSM spike-camera digital twin: float model, fixed-point twin, "
@@ -59,9 +55,22 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=version_line())
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    full = FAMILIES if families is None else tuple(families)
     for family in FAMILIES:
-        family.register(sub)
+        if family in full:
+            family_module(family).register(sub)
+        else:
+            for command in COMMANDS:
+                if command.family == family:
+                    sub.add_parser(command.name, help=command.summary)
     return parser
+
+
+def _families_for(argv: Sequence[str]) -> tuple[str, ...]:
+    """The families ``argv`` needs: its command's (the first word not an option), or none
+    (``rvsm --help``, a bare ``rvsm``, an unknown command: the overview is enough)."""
+    word = next((a for a in argv if not a.startswith("-")), None)
+    return tuple(c.family for c in COMMANDS if c.name == word)
 
 
 def _interrupt_on_signal(signum: int, frame: object) -> None:
@@ -90,10 +99,14 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(sig, _interrupt_on_signal)
     try:
         try:
-            parser = build_parser()
-            args = parser.parse_args(argv)
-            args.command_line = "rvsm " + shlex.join(sys.argv[1:] if argv is None else argv)
-        except KeyboardInterrupt as exc:
+            words = sys.argv[1:] if argv is None else list(argv)
+            parser = build_parser(_families_for(words))
+            args = parser.parse_args(words)
+            args.command_line = "rvsm " + shlex.join(words)
+        except (KeyboardInterrupt, Exception) as error:  # a signal during the family's import
+            exc = interrupt_behind(error)
+            if exc is None:
+                raise
             return _interrupted(exc)
         if not getattr(args, "func", None):
             parser.print_help()

@@ -10,6 +10,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures.registry import ARCHITECTURES
 from rvsm.rtl.capabilities import Architecture
 from rvsm.sim.cli.args import parse_size_arg
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 
 #: ``--arch`` choices: each architecture with mutation sites, or all of them.
@@ -19,7 +20,7 @@ ALL = "all"
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``mutate`` sub-command."""
     p = sub.add_parser(
-        "mutate", help="mutation testing: is every deliberate RTL bug caught?",
+        "mutate", help=summary("mutate"),
         description="Build each registered mutation of the RTL (a deliberate bug a "
         "designer could make, rtl/mutations.py; never in shipped Verilog), run the "
         "co-simulation checks (amaranth.sim, both reset modes) and the formal checks "

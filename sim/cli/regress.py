@@ -7,13 +7,14 @@ import argparse
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs, default_results
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``regress``."""
     p = sub.add_parser(
-        "regress", help="run a regression plan (seeds x points x lanes x simulators) on Dask",
+        "regress", help=summary("regress"),
         description="rvsm regress PLAN.toml [-o RESULTS.sqlite] [--workers N] [--scheduler "
         "ADDRESS] [--junit results.xml]: run every run of a plan that the database does not "
         "yet hold with a verdict, print the verdicts and the coverage closure. Exit status: "

@@ -21,6 +21,7 @@ from rvsm.rtl.capabilities import Architecture, Option
 from rvsm.rtl.flow_files import DEFAULT_CLOCK_MHZ
 from rvsm.sim.cli.args import add_force_argument, sized_contract
 from rvsm.sim.cli.build_choice import ARCH_DEFAULTS, choose_build
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 
 if TYPE_CHECKING:
@@ -29,7 +30,7 @@ if TYPE_CHECKING:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``verilog`` sub-command."""
-    p = sub.add_parser("verilog", help="generate the pixel array's Verilog and port map",
+    p = sub.add_parser("verilog", help=summary("verilog"),
                        description="Generate Verilog (readable ports, no src attributes) "
                        "and a port map (JSON, Markdown) for a design point.")
     p.add_argument("point", help="design point TOML")
@@ -184,15 +185,15 @@ def _verilog(args: argparse.Namespace) -> int:
 
 def _timing_text(ports_json: Path, gen: GeneratedVerilog) -> str:
     """What a user needs of the timing: for a streaming build the lag (input beats from a
-    pixel's beat to the beat releasing its spikes) and the pixel-to-spike delay back to
-    back, else the latency in cycles (``ports.json`` has every figure)."""
-    timing = json.loads(Path(ports_json).read_text()).get("timing", {})
+    pixel's beat to the beat releasing its spikes) and the architecture's pixel-to-spike
+    delay back to back, else the latency in cycles (``ports.json`` has every figure)."""
+    meta = json.loads(Path(ports_json).read_text())
+    timing = meta.get("timing", {})
     if "lag" not in timing:
         return f"latency {gen.latency} cycle(s)"
     lag, release = timing["lag"], timing.get("release_cycles", 2)
     return (f"lag {lag} beats (the spikes of input beat p come out {release} cycles after "
-            f"beat p + {lag} is accepted: {lag + release - (0 if 'fifo_depth' in timing else 1)}"
-            f" cycles after beat p when "
+            f"beat p + {lag} is accepted: {meta['pixel_to_spike']} cycles after beat p when "
             f"beats come back to back; the port map has every figure)")
 
 

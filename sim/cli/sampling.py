@@ -43,12 +43,13 @@ from rvsm.sim.cli.args import (
     noise_from_args,
     parse_size_arg,
 )
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import PLAIN, Output, check_outputs
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``simulate``, ``evaluate`` and ``dat``."""
-    p = sub.add_parser("simulate", help="sample a scene into a spike file (.h5 or .npz)",
+    p = sub.add_parser("simulate", help=summary("simulate"),
                        description="Sample a scene with a float model or a fixed-point "
                        "design point and write spikes (T,S,H,W) int8 plus meta to .h5 "
                        "(streamed chunk by chunk: any length in bounded memory) or .npz "
@@ -83,7 +84,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_force_argument(p)
     p.set_defaults(func=run_simulate)
 
-    p = sub.add_parser("evaluate", help="reconstruct a spike file and score it",
+    p = sub.add_parser("evaluate", help=summary("evaluate"),
                        description="Reconstruct spikes (TFI for FSM, the paper's RVSM "
                        "adjoint otherwise; --method inverse for the least-squares inverse), "
                        "match brightness and print MSE, PSNR and SSIM over the frames after "
@@ -101,7 +102,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "content digest differs from the one the file was made from")
     p.set_defaults(func=run_evaluate)
 
-    p = sub.add_parser("dat", help="convert FSM spikes to/from the camera's .dat layout")
+    p = sub.add_parser("dat", help=summary("dat"))
     dat_sub = p.add_subparsers(dest="dat_command", metavar="ACTION", required=True)
     q = dat_sub.add_parser("export", help=".h5 / .npz (FSM) -> .dat (streamed)")
     q.add_argument("spikes", help=".h5 or .npz spike file")

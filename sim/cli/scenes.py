@@ -16,6 +16,7 @@ from rvsm.model.scene.library import (
     scene_descriptions,
 )
 from rvsm.sim.cli.args import add_force_argument, parse_size_arg
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import Output, check_outputs
 
 SHEET_FRAMES = 4
@@ -25,7 +26,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``scenes`` sub-command."""
     p = subparsers.add_parser(
         "scenes",
-        help="list the built-in scenes (or render a contact sheet of one)",
+        help=summary("scenes"),
         description="List the built-in synthetic high-speed scenes. With --render NAME -o "
         "FILE.png, write a contact sheet of a few of its frames.",
     )

@@ -12,6 +12,7 @@ from rvsm.model.noise.presets import NOISE_PRESETS
 from rvsm.model.sampling.config import DEFAULT_PHI
 from rvsm.model.sampling.thresholds import DEFAULT_CALIBRATION_SCENE, THRESHOLD_RULES
 from rvsm.sim.cli.args import add_force_argument, parse_size_arg
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
 from rvsm.sim.studies import claims, robustness, table
 from rvsm.sim.studies.settings_table import run_settings_table, settings_csv
@@ -140,7 +141,7 @@ def cmd_robustness(args: argparse.Namespace) -> int:
 def register(subparsers) -> None:
     """Add the ``table`` and ``robustness`` sub-commands."""
     p = subparsers.add_parser(
-        "table", help="paper Table 1 / Fig. 6: quality of every model on the built-in scenes",
+        "table", help=summary("table"),
         description="Sample every built-in scene with FSM, One..Four DoG and One..Four Gauss, "
         "without and with noise (k=1), reconstruct, match brightness and score MSE/PSNR/SSIM.",
     )
@@ -167,7 +168,7 @@ def register(subparsers) -> None:
     p.set_defaults(func=cmd_table)
 
     p = subparsers.add_parser(
-        "robustness", help="paper Fig. 8: noise spikes of a black scene vs noise intensity k",
+        "robustness", help=summary("robustness"),
         description="Black scene, sweep the noise intensity k, count spikes of FSM, "
         "One..Four DoG and Four Gauss: ASS, ASAS and ASASS per scale.",
     )

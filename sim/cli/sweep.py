@@ -12,13 +12,14 @@ import argparse
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs, default_results
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``sweep``."""
     p = sub.add_parser(
-        "sweep", help="fixed-point design sweeps on Dask (resumable) and their reports",
+        "sweep", help=summary("sweep"),
         description="rvsm sweep [run] SWEEP.toml [-o RESULTS.sqlite] [--workers N] "
         "[--scheduler ADDRESS]: run every design point x scene of a sweep file, skipping "
         "rows already in the database. rvsm sweep report RESULTS.sqlite [-o DIR] [--fits "

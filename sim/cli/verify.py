@@ -26,6 +26,7 @@ from rvsm.rtl.architectures.registry import ARCHITECTURES, NATIVE, WRAPPERS, arc
 from rvsm.rtl.capabilities import Architecture
 from rvsm.sim.cli.args import SceneRequest, add_scene_arguments, parse_size_arg
 from rvsm.sim.cli.build_choice import ARCH_DEFAULTS, choose_build
+from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
 from rvsm.sim.cli.rtl import (
     add_arch_arguments,
@@ -43,7 +44,7 @@ if TYPE_CHECKING:
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``verify`` sub-command."""
     p = sub.add_parser(
-        "verify", help="simulate the RTL and compare every spike with the fixed twin",
+        "verify", help=summary("verify"),
         description="Build the generated Verilog on Icarus or Verilator, drive a stimulus, "
         "compare every spike. Either SCENE --fixed POINT.toml (the fixed twin makes the "
         "stimulus), --stimulus FILE (replay a file written by `rvsm stimulus`) or "

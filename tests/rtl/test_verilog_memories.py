@@ -28,11 +28,7 @@ def _amaranth(component: wiring.Component, top: str) -> str:
     return strip_zero_memory_init(text)[0]
 
 
-@pytest.mark.parametrize("arch", [
-    pytest.param(a, marks=pytest.mark.xfail(
-        reason="the staged streaming array's lowered-memory Verilog differs from Amaranth's "
-        "in internal port names; functionally equal (co-simulation)", strict=False))
-    if a == "stream" else a for a in ARCHITECTURES])
+@pytest.mark.parametrize("arch", ARCHITECTURES)
 def test_every_architecture_gets_amaranths_verilog(arch, small_contract):
     c = small_contract("dog2", 4, 8)
     a = get_architecture(arch)
@@ -41,10 +37,6 @@ def test_every_architecture_gets_amaranths_verilog(arch, small_contract):
     assert new == _amaranth(a.component(c, **a.resolve(options)), a.default_top)
 
 
-@pytest.mark.xfail(reason="since the streaming array is composed of stage components, the "
-                   "lowered-memory Verilog differs from Amaranth's in internal port names "
-                   "(port$N$0); functionally equal (co-simulation), byte identity to restore",
-                   strict=False)
 def test_several_banks_and_the_top_rail(small_contract):
     """Eight-word banks: three banks a memory; the thresholds keep their top-rail
     initialisers, the all-zero memories have none."""

@@ -46,8 +46,12 @@ from rvsm.rtl.ip.axis import spike_tdata_layout, video_lane_bits
 from rvsm.rtl.ip.drive import input_stream, threshold_chunks
 from rvsm.rtl.ip.model import run_stream_model
 from rvsm.rtl.ip.register_map import ip_register_map
-from rvsm.rtl.ports import load_ports_json
-from rvsm.sim.cosim.testbenches.tb_common import CLOCK_NS, beat_stream, testbench_arg
+from rvsm.sim.cosim.testbenches.tb_common import (
+    CLOCK_NS,
+    beat_stream,
+    build_ports,
+    testbench_arg,
+)
 
 
 def _pauses(rng: random.Random, idle: float):  # noqa: ANN202 - a generator
@@ -103,7 +107,7 @@ def _frames(words: list[int], tuser: list[int], tlast: list[int], lane_bytes: in
 async def axis_ip_matches_fixed_twin(dut: object) -> None:
     """Registers, thresholds, frames under random idles and back-pressure; every beat."""
     stim = load_stimulus(testbench_arg("stimulus"))
-    ports = load_ports_json(testbench_arg("ports"))
+    ports = build_ports()
     try:
         cfg = json.loads(testbench_arg("axis"))
     except RuntimeError:  # not given (e.g. `rvsm verify` of the IP): stall, no pauses

@@ -18,7 +18,6 @@ not only the spikes of a plain stream.
 
 from __future__ import annotations
 
-import json
 import time
 
 import cocotb
@@ -27,21 +26,22 @@ from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
 from rvsm.rtl.architectures.registry import get_architecture
-from rvsm.rtl.ports import load_ports_json
 from rvsm.sim.cosim.testbenches.tb_common import (
     CLOCK_NS,
+    OutputBeats,
     beat_stream,
+    build_ports,
     clock_and_reset,
-    logic_bits,
     stream_geometry,
     testbench_arg,
+    write_result,
 )
 
 
 @cocotb.test()
 async def stream_follows_protocol_script(dut: object) -> None:
     """Drive every cycle of the script; compare every output beat and its cycle."""
-    ports = load_ports_json(testbench_arg("ports"))
+    ports = build_ports()
     scripts = get_architecture(ports["arch"]).protocol
     if scripts is None:
         raise RuntimeError(f"the {ports['arch']} architecture has no protocol scripts")
@@ -51,9 +51,6 @@ async def stream_follows_protocol_script(dut: object) -> None:
     geo = stream_geometry(c, ports)
     if geo.lanes != script.lanes:
         raise RuntimeError(f"the build has {geo.lanes} lanes, the script {script.lanes}")
-    by_name = {p["name"]: p for p in ports["ports"]}
-    fields = {f["name"]: (f["offset"], f["width"])
-              for f in by_name["spikes_payload"]["fields"]}
     clk = dut.clk  # type: ignore[attr-defined]
     inputs = ("codes_valid", "codes_payload", "clear", "thr_we", "thr_addr", "thr_data")
     handles = [getattr(dut, name) for name in inputs]
@@ -63,9 +60,8 @@ async def stream_follows_protocol_script(dut: object) -> None:
                [int(v) for v in script.clear], [int(v) for v in script.thr_we],
                script.thr_addresses(), script.thr_words()]
     last = [0] * len(handles)
-    got: dict[str, list[int]] = {k: [] for k in fields}
+    got = OutputBeats(ports)
     cycles: list[int] = []
-    x_beats: list[int] = []
     t0 = time.perf_counter()
     start_ns = int(get_sim_time("ns"))  # the falling edge before cycle 0's rising edge
     for cyc in range(script.num_cycles):
@@ -76,22 +72,12 @@ async def stream_follows_protocol_script(dut: object) -> None:
                 last[k] = v
         await FallingEdge(clk)
         if str(out_valid.value) == "1":
-            value, xmask = logic_bits(out_payload.value)
-            if xmask:
-                x_beats.append(len(cycles))
-            for name, (off, width) in fields.items():
-                got[name].append((value >> off) & ((1 << width) - 1))
+            got.read(out_payload.value)
             cycles.append(cyc)
     seconds = time.perf_counter() - t0
-    beats = beat_stream(ports).output_beats.from_words(
-        got["row"], got["group"], got["last"], got["pos"], got["neg"], c.num_scales,
-        geo.lanes)
-    result = scripts.check(script, beats, cycles)
-    if x_beats:
-        result["mismatches"] += len(x_beats)
-        result["mismatch_list"].insert(0, {"beat": x_beats[0], "cycle": cycles[x_beats[0]],
-                                           "error": f"X/Z in {len(x_beats)} output beat(s)"})
-        result["first_mismatch"] = result["mismatch_list"][0]
+    result = scripts.check(script, got.decoded(beat_stream(ports), c.num_scales, geo.lanes),
+                           cycles)
+    got.count_x(result, cycles)
     first = result["first_mismatch"]
     at = None
     if first is not None:
@@ -107,7 +93,4 @@ async def stream_follows_protocol_script(dut: object) -> None:
         "stream_seconds": seconds,
         "sim_time_ns": int(get_sim_time("ns")),
     })
-    with open(result_path, "w", encoding="utf-8") as f:
-        json.dump(result, f)
-    assert result["mismatches"] == 0, \
-        f"{result['mismatches']} mismatches; first {result['first_mismatch']}"
+    write_result(result, result_path)

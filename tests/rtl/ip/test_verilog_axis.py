@@ -95,5 +95,5 @@ def test_printed_timing_and_ports_json_agree_with_simulation(
     lag = run.dut.geometry.lag
     measured = {run.out[p][0] - run.accepted[p] for p in range(len(run.out))}
     assert measured == {said}, (measured, said)
-    assert said == lag + meta["timing"]["release_cycles"]
+    assert said == lag + meta["timing"]["release_cycles"] == meta["pixel_to_spike"]
     assert meta["latency"] == meta["timing"]["latency"] == run.dut.latency

@@ -185,6 +185,7 @@ def test_output_released_after_lag_beats() -> None:
     # back to back, beat p + window_lag is accepted at edge p + window_lag and output p
     # is presented by edge p + lag + 1 (the second cycle after beat p + lag's edge)
     assert geo.latency == geo.lag + 1 - geo.window_lag
+    assert geo.pixel_to_spike == geo.lag + 1  # edge accepting beat p to output p
 
 
 def test_checker_catches_wrong_expectation() -> None:

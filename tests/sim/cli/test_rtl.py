@@ -133,11 +133,12 @@ def test_every_command_defaults_to_the_stream_array_and_names_it(
     assert "architecture stream (lanes 1)" in printed
     assert (f"lag {lag} beats (the spikes of input beat p come out 2 cycles after beat "
             f"p + {lag} is accepted: {lag + 1} cycles after beat p") in printed
+    assert meta["pixel_to_spike"] == lag + 1
     assert main(["verilog", str(point), "-o", str(tmp_path / "par"), "--arch",
                  "parallel"]) == 0
     assert "architecture parallel," in capsys.readouterr().out
-    assert json.loads((tmp_path / "par" / "rvsm_array.ports.json").read_text())["arch"] \
-        == "parallel"
+    par = json.loads((tmp_path / "par" / "rvsm_array.ports.json").read_text())
+    assert par["arch"] == "parallel" and par["pixel_to_spike"] == par["latency"]
     assert main(["verify", "coin", "--fixed", str(point), "--steps", "6", "--json",
                  "--work", str(tmp_path / "work"), "--lanes", "2"]) == 0
     out = json.loads(capsys.readouterr().out)

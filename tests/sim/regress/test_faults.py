@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import signal
 import subprocess
-import textwrap
 import time
 from pathlib import Path
 from xml.etree import ElementTree as ET
@@ -24,25 +23,14 @@ from tests.sim.cosim.test_faults import (
     _leftovers,
     _signal_at,
 )
+from tests.sim.regress.conftest import TINY_PLAN, write_plan
 
-PLAN = """
-[regression]
-name = "tiny"
-[base.array]
-model = "dog2"
-[run]
-size = "6x8"
-lanes = [2]
-simulators = ["icarus"]
-harness = "chunk"
-steps = 40
-seeds = [1, 2]
-"""
+#: The tiny plan's seed runs only (two runs).
+PLAN = TINY_PLAN.replace('scenes = ["coin"]\n', "")
 
 
 def _args(tmp_path: Path, workers: int = 2) -> list[str]:
-    plan = tmp_path / "plan.toml"
-    plan.write_text(textwrap.dedent(PLAN))
+    plan = write_plan(tmp_path, PLAN)
     return ["regress", str(plan), "-o", str(tmp_path / "r.sqlite"), "--work",
             str(tmp_path / "w"), "--junit", str(tmp_path / "r.xml"), "--workers",
             str(workers)]

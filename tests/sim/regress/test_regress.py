@@ -3,7 +3,6 @@ counting twice, verdicts and exit statuses, merged coverage and JUnit XML."""
 
 from __future__ import annotations
 
-import textwrap
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
@@ -15,27 +14,8 @@ from rvsm.sim.regress.plan import load_plan, parse_plan
 from rvsm.sim.regress.run import run_regression
 from rvsm.sim.regress.store import RegressionStore
 from rvsm.sim.regress.work import scene_for
-
-TINY = """
-[regression]
-name = "tiny"
-[base.array]
-model = "dog2"
-[run]
-size = "6x8"
-lanes = [2]
-simulators = ["icarus"]
-harness = "chunk"
-steps = 40
-scenes = ["coin"]
-seeds = [1, 2]
-"""
-
-
-def _plan(tmp_path: Path, text: str = TINY) -> Path:
-    path = tmp_path / "plan.toml"
-    path.write_text(textwrap.dedent(text))
-    return path
+from tests.sim.regress.conftest import TINY_PLAN as TINY
+from tests.sim.regress.conftest import write_plan
 
 
 def test_plan_expands_and_refuses_bad_fields(tmp_path: Path) -> None:
@@ -98,7 +78,7 @@ def test_protocol_seeds_run_the_protocol_testbench(tmp_path: Path) -> None:
 def test_regression_runs_resumes_and_reports(tmp_path: Path) -> None:
     """In this process (workers=0): every run passes, coverage merges over the seeds,
     JUnit has one case per run; a second call runs nothing and counts nothing twice."""
-    plan = load_plan(_plan(tmp_path))
+    plan = load_plan(write_plan(tmp_path))
     db, work, junit = tmp_path / "r.sqlite", tmp_path / "w", tmp_path / "r.xml"
     s = run_regression(plan, db, work, workers=0, junit=junit, progress=False)
     assert (s.ran, s.skipped, s.count("pass"), s.exit_status) == (3, 0, 3, 0)
@@ -129,7 +109,7 @@ def test_regress_exit_statuses(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     def failing(*args, **kwargs):
         raise ToolError("verilator build (make) exited with status 2; log: x.log")
 
-    plan = _plan(tmp_path, TINY.replace('scenes = ["coin"]', "").replace("[1, 2]", "[1]"))
+    plan = write_plan(tmp_path, TINY.replace('scenes = ["coin"]', "").replace("[1, 2]", "[1]"))
     common = ["--workers", "0", "--no-progress", "--work", str(tmp_path / "w")]
     monkeypatch.setattr(verify_module, "random_verify", failing)
     assert main(["regress", str(plan), "-o", str(tmp_path / "a.sqlite"), *common]) == 3
@@ -142,7 +122,7 @@ def test_regress_exit_statuses(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     out = capsys.readouterr().out
     assert "1 ran now" in out and "FAIL seed:1" in out and "step=3" in out
     assert ET.parse(junit).getroot().find("testsuite/testcase/failure") is not None
-    bad = _plan(tmp_path, TINY.replace("steps = 40", "steps = -1"))
+    bad = write_plan(tmp_path, TINY.replace("steps = 40", "steps = -1"))
     assert main(["regress", str(bad), "-o", str(tmp_path / "b.sqlite"), *common]) == 2
     assert "run.steps must be an integer >= 1" in capsys.readouterr().err
 
