@@ -246,18 +246,13 @@ def _clock_section(inputs: DatasheetInputs, feas: Feasibility) -> tuple[list[str
 
 
 def _interfaces_section(inputs: DatasheetInputs, feas: Feasibility) -> list[str]:
-    from rvsm.model.infra.versions import rvsm_version
     from rvsm.rtl.architectures.registry import get_architecture
-    from rvsm.rtl.flow_files import design_point_digest
-    from rvsm.rtl.ip.register_map import ip_register_map
-    from rvsm.rtl.ip.wrapper import IP_ARCH
-    from rvsm.rtl.rtl_digest import rtl_digest
 
     contract = inputs.point_file.point.contract()
     p, fifo = feas.lanes, inputs.fifo_depth
     opts = {"lanes": p, "fifo_depth": fifo}
-    regmap = ip_register_map(contract, p, fifo, rtl_digest(contract, IP_ARCH, opts),
-                             design_point_digest(contract), rvsm_version())
+    ip = get_architecture("stream", "axis")
+    regmap = ip.component(contract, **ip.resolve(opts)).regmap  # the IP's own register map
     lines = [f"## {SECTIONS[3]}", "", f"State memories at P = {p} ({feas.organisation} "
              f"organisation) on {inputs.device.name}:", ""]
     lines += [f"- {r}" for r in feas.packing.rows()]
