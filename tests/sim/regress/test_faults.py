@@ -63,6 +63,7 @@ PHASES = {
 def _check_interrupted(tmp_path: Path, status: int, err: str, seen: dict) -> None:
     assert status == 130, err
     assert "Traceback" not in err, err
+    assert "leaked semaphore" not in err, err
     lines = [ln for ln in err.splitlines() if ln.startswith("rvsm: interrupted")]
     assert len(lines) == 1, err
     _assert_no_orphans(seen)
