@@ -124,8 +124,8 @@ def interrupts_deferred(swallow: bool = False) -> Iterator[None]:
 
     Starting and closing a Dask cluster cannot be cut short: an interrupt inside
     :class:`~dask.distributed.LocalCluster`'s start leaves nannies half-started, which Dask
-    then fails to close (``AssertionError: Status.init`` tracebacks at exit) and whose
-    queues leak their semaphores. Ignored signals (``nohup``) stay ignored."""
+    then fails to close (``AssertionError: Status.init`` and "Nanny failed to start"
+    tracebacks at exit). Ignored signals (``nohup``) stay ignored."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -216,9 +216,8 @@ class DaskExecutor:
 
     def _stop(self, *exc: object) -> None:
         """Cancel what is unfinished, close the client and the cluster, then collect
-        their objects now: the nannies' multiprocessing queues unlink their semaphores
-        when collected, and an interrupted run may exit before a later collection
-        (Python's resource tracker then reports "leaked semaphore objects")."""
+        their objects now (the nannies' multiprocessing queues unlink their semaphores
+        when collected, not at some later collection)."""
         try:
             if self._client is not None and exc and exc[0] is not None:
                 self._note_pids()

@@ -118,9 +118,11 @@ def test_a_worker_killed_mid_run_finishes_elsewhere(tmp_path: Path) -> None:
         kids = _children(proc.pid)
         seen.update(kids)
         for pid, cmd in kids.items():
-            if "vvp" in cmd:
-                worker = next(p for p, c in kids.items() if "spawn_main" in c
-                              and pid in _children(p))
+            if Path(cmd.split(" ")[0]).name == "vvp":  # the simulator, not "-o sim.vvp"
+                worker = next((p for p, c in kids.items() if "spawn_main" in c
+                               and pid in _children(p)), None)
+                if worker is None:  # the simulation ended meanwhile: wait for the next
+                    continue
                 import os
 
                 os.kill(worker, signal.SIGKILL)
