@@ -153,3 +153,23 @@ def test_interrupt_while_writing_results(tmp_path: Path, reference: list, sig: i
     assert _computed(tmp_path / "r.sqlite") == 1
     monkeypatch.setattr(SweepStore, "write_result", real)
     _resumes_to(tmp_path, reference)
+
+
+def test_an_interrupt_during_a_cluster_start_lands_after_it() -> None:
+    """:func:`interrupts_deferred`: the block runs to its end, then the interrupt is
+    raised (or dropped with ``swallow``); the handlers are as they were."""
+    import time
+
+    from rvsm.sim.sweep.executors import interrupts_deferred
+
+    before = signal.getsignal(signal.SIGINT)
+    reached = []
+    with pytest.raises(KeyboardInterrupt), interrupts_deferred():
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.2)
+        reached.append("end of block")
+    assert reached == ["end of block"]
+    with interrupts_deferred(swallow=True):
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.2)
+    assert signal.getsignal(signal.SIGINT) is before
