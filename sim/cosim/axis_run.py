@@ -5,7 +5,9 @@ array, ``rtl/ip/architecture.py``) through the shared build cache
 (:func:`~.build_cache.build`), writes the stimulus into a fresh run folder and runs the
 wrapper's testbench (:mod:`.tb_axis`) through the one cocotb runner
 (:func:`~.testbench_run.run_cocotb`): the policy, the seed of the pause generators and
-the idle/back-pressure probabilities go in as ``RVSM_AXIS``.
+the idle/back-pressure probabilities go in as ``RVSM_AXIS``. :func:`register_map_check`
+runs the register-map testbench (:mod:`.tb_register_map`) on the same build: a seeded
+random sequence of AXI4-Lite writes and reads against the Python register model.
 """
 
 from __future__ import annotations
@@ -15,6 +17,9 @@ import os
 import shutil
 from pathlib import Path
 
+import numpy as np
+
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.stimulus import Stimulus, save_stimulus
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures.registry import DEFAULT_ARCHITECTURE, get_architecture
@@ -23,7 +28,7 @@ from rvsm.sim.cosim.builds.build_cache import build, new_run_dir
 from rvsm.sim.cosim.builds.testbench_run import run_cocotb
 from rvsm.sim.cosim.verify import DEFAULT_WORK
 
-__all__ = ["AXIS_POLICIES", "axis_verify"]
+__all__ = ["AXIS_POLICIES", "axis_verify", "register_map_check"]
 
 #: The output policies of the IP (CONTROL.drop = 0 / 1).
 AXIS_POLICIES = ("stall", "drop")
@@ -67,4 +72,35 @@ def axis_verify(stim: Stimulus, sim: str = "icarus", policy: str = "stall", seed
     result.update(build_seconds=sb.build_seconds, generate_seconds=sb.generate_seconds,
                   build_cached=sb.cached, verilog=str(sb.verilog), run_dir=str(run_dir),
                   arch=wrapper.name, options=options)
+    return result
+
+
+def register_map_check(contract: ArrayContract, sim: str = "icarus", seed: int = 0,
+                       count: int = 200, lanes: int = 1, fifo_depth: int | None = None,
+                       work_dir: str | os.PathLike = DEFAULT_WORK) -> dict:
+    """Drive the IP of ``contract`` with ``count`` random AXI4-Lite writes and reads
+    (seeded by ``seed``) and check each response and read-back against
+    :class:`~rvsm.rtl.ip.register_model.RegisterFileModel`; returns the testbench's result
+    (``mismatches`` 0 when all agree; ``responses``: per kind, the count of each
+    response code) with ``run_dir``."""
+    wrapper = get_architecture(DEFAULT_ARCHITECTURE, "axis")
+    options = wrapper.resolve({"lanes": lanes, "fifo_depth": fifo_depth})
+    wrapper.check(contract, **options)
+    work = Path(work_dir)
+    sb = build(contract, sim, work / "builds", arch=wrapper, **options)
+    run_dir = new_run_dir(work, f"regmap-{sim}")
+    try:
+        path = run_dir / "stimulus.npz"
+        codes = np.zeros((1, contract.height, contract.width), np.int64)
+        thresholds = np.ones((contract.num_scales, contract.height, contract.width), np.int64)
+        save_stimulus(path, Stimulus(codes, thresholds, contract.run(codes, thresholds)
+                                     .astype(np.int8), contract))
+        result = run_cocotb(sb, {"RVSM_STIMULUS": str(path.resolve()),
+                                 "RVSM_REGMAP": json.dumps({"seed": int(seed),
+                                                            "count": int(count)})},
+                            run_dir, test_module="rvsm.sim.cosim.testbenches.tb_register_map")
+    except KeyboardInterrupt:
+        shutil.rmtree(run_dir, ignore_errors=True)
+        raise
+    result.update(run_dir=str(run_dir), options=options)
     return result

@@ -15,8 +15,11 @@ must be on a trusted network or use ``tls://`` with certificates
 from __future__ import annotations
 
 import contextlib
+import gc
 import logging
 import os
+import signal
+import threading
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -99,9 +102,49 @@ def local_cluster(workers: int, processes: bool = True):
     # and ignore SIGINT (:mod:`.worker_setup`): an interrupt is the parent's to handle
     where = ({"host": LOCAL_HOST, "preload": ["rvsm.sim.sweep.worker_setup"]} if processes
              else {})
+    # Dask's own log records stay silent below CRITICAL: a task's failure reaches the
+    # caller as its exception (and is recorded), while a worker busy in a task when the
+    # cluster closes would log "Failed to communicate with scheduler during heartbeat"
+    # with a traceback on our stderr, the tracebacks an interrupt must not print
     return LocalCluster(n_workers=workers, threads_per_worker=1, processes=processes,
                         **where, dashboard_address=f"{LOCAL_HOST}:0",
-                        worker_dashboard_address=f"{LOCAL_HOST}:0", silence_logs=logging.ERROR)
+                        worker_dashboard_address=f"{LOCAL_HOST}:0",
+                        silence_logs=logging.CRITICAL)
+
+
+#: The signals the CLI turns into ``KeyboardInterrupt`` (:mod:`rvsm.sim.cli.main`).
+INTERRUPTS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+@contextlib.contextmanager
+def interrupts_deferred(swallow: bool = False) -> Iterator[None]:
+    """Hold SIGINT, SIGTERM and SIGHUP back for the block (the main thread only), then
+    deliver the first one that came to the handler that was in place (so it raises
+    ``KeyboardInterrupt`` after the block, not inside it); ``swallow`` drops it instead.
+
+    Starting and closing a Dask cluster cannot be cut short: an interrupt inside
+    :class:`~dask.distributed.LocalCluster`'s start leaves nannies half-started, which Dask
+    then fails to close (``AssertionError: Status.init`` and "Nanny failed to start"
+    tracebacks at exit). Ignored signals (``nohup``) stay ignored."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    previous = {sig: signal.getsignal(sig) for sig in INTERRUPTS}
+    for sig in INTERRUPTS:
+        if previous[sig] is not signal.SIG_IGN:
+            signal.signal(sig, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if caught and not swallow:
+            handler = previous[caught[0]]
+            if callable(handler):
+                handler(caught[0], None)  # the CLI's: raises KeyboardInterrupt
+            else:  # SIG_DFL: as if it arrived now
+                os.kill(os.getpid(), caught[0])
 
 
 class DaskExecutor:
@@ -136,6 +179,15 @@ class DaskExecutor:
             self.pids |= set(self._client.run(os.getpid).values())
 
     def __enter__(self) -> DaskExecutor:
+        try:
+            with interrupts_deferred():  # a cluster half-started cannot be closed cleanly
+                self._start()
+        except BaseException as exc:  # an interrupt held back during the start lands here
+            self.__exit__(type(exc), exc, exc.__traceback__)
+            raise
+        return self
+
+    def _start(self) -> DaskExecutor:
         from dask.distributed import Client
 
         if self.scheduler is not None:
@@ -152,11 +204,20 @@ class DaskExecutor:
             self.workers = len(self._client.scheduler_info().get("workers", {}))
             self._note_pids()
         except BaseException:
-            self.__exit__()
+            self._stop()
             raise
         return self
 
     def __exit__(self, *exc: object) -> None:
+        kind = exc[0] if exc else None
+        interrupted = isinstance(kind, type) and issubclass(kind, KeyboardInterrupt)
+        with interrupts_deferred(swallow=interrupted):  # a second Ctrl-C: the same
+            self._stop(*exc)
+
+    def _stop(self, *exc: object) -> None:
+        """Cancel what is unfinished, close the client and the cluster, then collect
+        their objects now (the nannies' multiprocessing queues unlink their semaphores
+        when collected, not at some later collection)."""
         try:
             if self._client is not None and exc and exc[0] is not None:
                 self._note_pids()
@@ -169,6 +230,8 @@ class DaskExecutor:
             if self._cluster is not None:
                 self._cluster.close()
             self._client = self._cluster = None
+            self._futures = []
+            gc.collect()
 
     def run(self, items: Sequence[WorkItem]) -> Iterator[Finished]:
         """Submit every item (keyed by ``item.key``, scheduled by ``item.priority``) and

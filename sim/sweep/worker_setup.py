@@ -7,6 +7,12 @@ moves into a process group of its own and ignores SIGINT: the interrupt reaches 
 alone, which cancels the work and closes the cluster; a worker ended by its nanny (or
 killed) takes its tools along (:mod:`rvsm.rtl.toolchain`'s guards), and what it left
 half-made is removed by the parent (:func:`rvsm.sim.regress.run.run_regression`).
+
+tqdm (the build's progress lines, :mod:`rvsm.sim.cosim.builds.build_notes`) would make a
+named multiprocessing lock on its first line, registered with the parent's resource
+tracker; a worker busy in a task when the cluster closes is killed by its nanny before it
+can unlink it, and the tracker then reports "leaked semaphore objects" as ``rvsm`` exits.
+A worker writes from one process only, so tqdm gets a thread lock instead.
 """
 
 from __future__ import annotations
@@ -14,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+import threading
 
 __all__ = ["dask_setup"]
 
@@ -24,4 +31,7 @@ def dask_setup(worker: object = None) -> None:
         os.setpgid(0, 0)
     with contextlib.suppress(ValueError):  # not the main thread: nothing to change
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+    from tqdm import tqdm
+
+    tqdm.set_lock(threading.RLock())  # never a named semaphore (module docstring)
 

@@ -51,6 +51,7 @@ from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.rtl_digest import rtl_digest
 from rvsm.rtl.toolchain import ToolFailure, run_tool
 from rvsm.sim.cosim.builds.build_lock import build_lock, remove_stale
+from rvsm.sim.cosim.builds.build_notes import note, still
 from rvsm.sim.cosim.builds.chunk_harness import (
     HARNESS_TOP,
     HARNESS_VERSION,
@@ -279,23 +280,26 @@ def _make(contract: ArrayContract, final: Path, sim: str, top: str, traced: bool
         reused = _reuse_verilog(base, digest, top, stage)
         if reused is None:
             note(f"generating the Verilog of {final.name}")
-        paths, gen = reused or design.write(contract, stage)
+            with still(f"generating the Verilog of {final.name}"):
+                reused = design.write(contract, stage)
+        paths, gen = reused
         t0 = time.perf_counter()
         note(f"building {final.name} with {sim} (once per design; its log: {log})")
-        port_map = json.loads(paths["ports_json"].read_text())
-        sources, hdl_top = [paths["verilog"]], top
-        ports = [p["name"] for p in port_map["ports"]]
-        if harness:
-            layout = HarnessLayout.from_ports(port_map)
-            if sim == "icarus":  # simulation-only, about 2x faster (:mod:`.icarus_netlist`)
-                sources[0] = stage / icarus_netlist_name(top)
-                write_icarus_netlist(paths["verilog"], top, sources[0], log)
-            state = state_memories(sources[0].read_text(), top)  # for sharded runs
-            sources.append(stage / f"{HARNESS_TOP}.v")
-            sources[-1].write_text(harness_verilog(layout, clock_inside(sim), state))
-            hdl_top, ports = HARNESS_TOP, layout.ports
-        cocotb_build(sim, sources, hdl_top, ports, stage / "sim_build", traced, log,
-                     long_run=harness, coverage=coverage)
+        with still(f"building {final.name} with {sim}"):
+            port_map = json.loads(paths["ports_json"].read_text())
+            sources, hdl_top = [paths["verilog"]], top
+            ports = [p["name"] for p in port_map["ports"]]
+            if harness:
+                layout = HarnessLayout.from_ports(port_map)
+                if sim == "icarus":  # simulation-only, about 2x faster (:mod:`.icarus_netlist`)
+                    sources[0] = stage / icarus_netlist_name(top)
+                    write_icarus_netlist(paths["verilog"], top, sources[0], log)
+                state = state_memories(sources[0].read_text(), top)  # for sharded runs
+                sources.append(stage / f"{HARNESS_TOP}.v")
+                sources[-1].write_text(harness_verilog(layout, clock_inside(sim), state))
+                hdl_top, ports = HARNESS_TOP, layout.ports
+            cocotb_build(sim, sources, hdl_top, ports, stage / "sim_build", traced, log,
+                         long_run=harness, coverage=coverage)
         build_seconds = time.perf_counter() - t0
         files = _checksums(stage, _build_files(sim, top, harness))
         if files is None:
@@ -328,14 +332,6 @@ def _make(contract: ArrayContract, final: Path, sim: str, top: str, traced: bool
     note(f"built {final.name} in {build_seconds:.0f} s")
     return dataclasses.replace(done, generate_seconds=gen.seconds,
                                build_seconds=build_seconds, cached=False)
-
-
-def note(text: str) -> None:
-    """One progress line on stderr (above any progress bar): a build's phases say what is
-    happening, so a minutes-long compile is never a silent wait."""
-    from tqdm import tqdm
-
-    tqdm.write(f"rvsm: {text}", file=sys.stderr)
 
 
 def _build_files(sim: str, top: str, harness: bool = False) -> list[str]:

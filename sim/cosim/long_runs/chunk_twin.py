@@ -9,7 +9,8 @@ core, at the same time as the simulator.
 
 :func:`start_twin` launches ``python -m rvsm.sim.cosim.long_runs.chunk_twin`` (a fresh interpreter:
 no fork of a simulator or of a Dask worker) before the simulator starts, so its first
-chunk is ready when the testbench has reset the array and written the thresholds. It
+chunk is ready when the testbench has reset the array and written the thresholds; it
+ends by itself when the process that started it ends (:func:`_end_with`). It
 listens on a Unix socket (:mod:`multiprocessing.connection`, an authentication key from
 the environment); the testbench connects (:func:`connect`) and the two exchange small
 messages, in order:
@@ -120,7 +121,8 @@ def start_twin(source: str, ports: str | os.PathLike, run_dir: str | os.PathLike
     config = {"source": source, "ports": str(ports), "dir": str(run_dir),
               "chunk_steps": int(chunk_steps), "depth": int(depth),
               "stop_on_mismatch": bool(stop_on_mismatch), "address": address,
-              "segment": None if segment is None else [int(t) for t in segment]}
+              "segment": None if segment is None else [int(t) for t in segment],
+              "parent": os.getpid()}
     env = {**os.environ, CONFIG_ENV: json.dumps(config), KEY_ENV: key}
     log = run_dir / "twin.log"
     with open(log, "ab") as f:
@@ -385,6 +387,19 @@ def _accept_and_send(listener: Listener, out: list, msg: tuple) -> None:
     out.append(c)
 
 
+def _end_with(parent: int, address: str) -> None:
+    """Exit once ``parent`` (the process that started this one) has ended, its socket
+    removed: a Dask worker killed by its nanny, or ``rvsm`` SIGKILLed, cannot close this
+    process, which would otherwise wait for a testbench that never connects."""
+    while os.getppid() == parent:
+        time.sleep(0.5)
+    with contextlib.suppress(OSError):
+        os.unlink(address)
+    with contextlib.suppress(OSError):
+        os.rmdir(Path(address).parent)
+    os._exit(3)
+
+
 def main() -> int:
     """``python -m rvsm.sim.cosim.long_runs.chunk_twin``: the configuration in the environment."""
     try:
@@ -392,6 +407,9 @@ def main() -> int:
         key = bytes.fromhex(os.environ[KEY_ENV])
     except (KeyError, ValueError) as exc:
         raise ToolError(f"the twin's process needs {CONFIG_ENV} and {KEY_ENV}") from exc
+    if "parent" in cfg:
+        threading.Thread(target=_end_with, args=(int(cfg["parent"]), cfg["address"]),
+                         name="rvsm-twin-parent", daemon=True).start()
     serve(cfg, key)
     return 0
 

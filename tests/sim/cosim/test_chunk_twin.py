@@ -28,3 +28,28 @@ def test_the_twin_hands_its_error_to_the_testbench(tmp_path: Path) -> None:
         twin.close()
     with pytest.raises(RuntimeError, match="did not listen"):
         connect(str(tmp_path / "none"), "00", timeout=0.05)
+
+
+def test_the_twin_ends_with_the_process_that_started_it(tmp_path: Path) -> None:
+    """Its starter killed (a Dask worker SIGKILLed by its nanny) before the testbench
+    connects: the twin, waiting for that testbench, ends by itself, its socket removed."""
+    import subprocess
+    import sys
+    import time
+
+    from tests.sim.cosim.test_faults import _alive
+
+    ports = tmp_path / "arr.ports.json"
+    ports.write_text("{}")
+    starter = (f"import os, json; from rvsm.sim.cosim.long_runs.chunk_twin import start_twin; "
+               f"t = start_twin(json.dumps({{'kind': 'nothing'}}), {str(ports)!r}, "
+               f"{str(tmp_path)!r}, 8, 64); print(t.proc.pid, t.address, flush=True); "
+               f"os._exit(0)")
+    out = subprocess.run([sys.executable, "-c", starter], capture_output=True, text=True,
+                         timeout=120)
+    pid, address = out.stdout.split()
+    end = time.monotonic() + 30
+    while _alive(int(pid)) and time.monotonic() < end:
+        time.sleep(0.1)
+    assert not _alive(int(pid))
+    assert not Path(address).parent.exists()
