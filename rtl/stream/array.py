@@ -108,7 +108,6 @@ from rvsm.rtl.stream.signatures import (
     code_beat_signature,
     spike_beat_signature,
     threshold_word_bits,
-    threshold_write_signature,
 )
 from rvsm.rtl.stream.state_stage import StateStage
 from rvsm.rtl.stream.sum_stage import SumStage
@@ -145,6 +144,15 @@ class StreamProbes:
     window_valid: Value
     sums: list[list[Value]]
     sum_valid: Value
+
+
+def _shared_threshold_docs(contract: ArrayContract) -> dict[str, str]:
+    """The threshold ports of an array with one threshold register per scale."""
+    c = contract
+    return {"thr_we": "threshold write enable (one scale's register per rising edge)",
+            "thr_addr": f"scale s, 0..{c.num_scales - 1} (threshold.storage = shared)",
+            "thr_data": f"the scale's threshold, 1..{(1 << c.threshold_bits) - 1} "
+                        f"(configured to {', '.join(map(str, c.shared_thresholds))})"}
 
 
 class RvsmStreamArray(wiring.Component):
@@ -184,8 +192,7 @@ class RvsmStreamArray(wiring.Component):
             "codes": In(code_beat_signature(c.adc_bits, geo.lanes)),
             "spikes": Out(spike_beat_signature(c.num_scales, geo.lanes, c.height,
                                                geo.groups)),
-            "thr": In(threshold_write_signature(c.num_scales, geo.beats_per_frame,
-                                                geo.lanes, c.threshold_bits)),
+            "thr": In(geo.threshold_bus),
             "clear": In(1),
         })
 
@@ -206,10 +213,11 @@ class RvsmStreamArray(wiring.Component):
             "codes_ready": "the array accepts a beat (low only while clear is high)",
             "spikes_payload": "one output beat (fields below): position and S*P spikes",
             "spikes_valid": "high for one cycle when a position is released",
-            "thr_we": "threshold write enable (one memory word per rising edge)",
-            "thr_addr": f"(scale s << {wb}) | (y*{g} + g)",
-            "thr_data": f"{p} thresholds, lane i at bits [i*{c.threshold_bits} +: "
-                        f"{c.threshold_bits}], each 1..{(1 << c.threshold_bits) - 1}",
+            **(_shared_threshold_docs(c) if geo.shared_thresholds else {
+                "thr_we": "threshold write enable (one memory word per rising edge)",
+                "thr_addr": f"(scale s << {wb}) | (y*{g} + g)",
+                "thr_data": f"{p} thresholds, lane i at bits [i*{c.threshold_bits} +: "
+                            f"{c.threshold_bits}], each 1..{(1 << c.threshold_bits) - 1}"}),
             "clear": "synchronous restart of the stream: positions in flight dropped, "
                      "accumulators zero in the next frame, thresholds kept",
         }
