@@ -26,6 +26,7 @@ from rvsm.rtl.stream.signatures import (
     spike_beat_layout,
     threshold_word_bits,
     threshold_write_signature,
+    top_threshold_word,
 )
 from rvsm.rtl.threshold_storage import shared_threshold_values
 
@@ -93,6 +94,25 @@ class StreamGeometry:
         c = self.contract
         return threshold_write_signature(c.num_scales, self.beats_per_frame, self.lanes,
                                          c.threshold_bits, self.shared_thresholds)
+
+    @property
+    def threshold_words(self) -> int:
+        """Threshold-bus words per scale: ``H*G`` memory words, or 1 (the register)."""
+        return 1 if self.shared_thresholds else self.beats_per_frame
+
+    @property
+    def threshold_data_bits(self) -> int:
+        """Bits of one threshold write: ``P*(W-1)``, or ``W-1`` with shared thresholds."""
+        return self.contract.threshold_bits * (1 if self.shared_thresholds else self.lanes)
+
+    def threshold_reset_data(self, scale: int) -> int:
+        """What a reset restores in scale ``scale``'s words: every threshold at the top
+        rail ``2**(W-1)-1`` (no spike until loaded), or with shared thresholds the
+        register's configuration value, the contract's nominal threshold."""
+        c = self.contract
+        if self.shared_thresholds:
+            return c.shared_thresholds[scale]
+        return top_threshold_word(c.threshold_bits, self.lanes)
 
     def threshold_address(self, scale: int, word: int) -> int:
         """The bus address of memory word ``word`` (``y*G + g``) of scale ``scale``:
