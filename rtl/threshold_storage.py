@@ -19,7 +19,7 @@ import numpy as np
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
 
-__all__ = ["shared_threshold_values"]
+__all__ = ["indexed_threshold_writes", "shared_threshold_values"]
 
 
 def shared_threshold_values(contract: ArrayContract, thresholds: np.ndarray
@@ -37,3 +37,13 @@ def shared_threshold_values(contract: ArrayContract, thresholds: np.ndarray
                 "threshold.storage = \"per-pixel\" for a per-accumulator pattern")
     del contract  # the one rule for every architecture; the contract names the point
     return [int(row[0]) for row in thr]
+
+
+def indexed_threshold_writes(contract: ArrayContract, thresholds: np.ndarray
+                             ) -> list[tuple[int, int]]:
+    """``(address, threshold)`` writes loading ``thresholds (S, H, W)`` into an array
+    addressed by flat index (the parallel array's ``cfg``): one per accumulator, index
+    ``(s*H + y)*W + x``, or with shared thresholds one per scale, address ``s``."""
+    if contract.shared_thresholds is not None:
+        return list(enumerate(shared_threshold_values(contract, thresholds)))
+    return [(a, int(v)) for a, v in enumerate(np.asarray(thresholds).ravel())]

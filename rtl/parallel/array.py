@@ -42,7 +42,7 @@ from rvsm.rtl.interfaces import ThresholdWriteSignature
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.pixel_cell import PixelCell
 from rvsm.rtl.receptive_sum import sum_width, weighted_sum
-from rvsm.rtl.threshold_storage import shared_threshold_values
+from rvsm.rtl.threshold_storage import indexed_threshold_writes
 
 __all__ = ["RvsmArray", "accumulator_index", "receptive_taps"]
 
@@ -93,10 +93,8 @@ class RvsmArray(wiring.Component):
                          ) -> list[tuple[int, int]]:
         """``(cfg_addr, cfg_data)`` of every write loading thresholds ``(S, H, W)``: one
         per accumulator (index ``a``), or with shared thresholds one per scale
-        (:func:`~rvsm.rtl.threshold_storage.shared_threshold_values`)."""
-        if contract.shared_thresholds is not None:
-            return list(enumerate(shared_threshold_values(contract, thresholds)))
-        return [(a, int(v)) for a, v in enumerate(np.asarray(thresholds).ravel())]
+        (:func:`~rvsm.rtl.threshold_storage.indexed_threshold_writes`)."""
+        return indexed_threshold_writes(contract, thresholds)
 
     @staticmethod
     def interface(contract: ArrayContract) -> wiring.Signature:

@@ -7,7 +7,7 @@ Inputs (environment, or ``+rvsm_stimulus=`` / ``+rvsm_result=`` plusargs):
 the contract (``adc_bits``); ``RVSM_RESULT`` -- where the JSON result goes.
 
 Sequence: reset; load every threshold through ``cfg_we/cfg_addr/cfg_data`` (one per scale
-with shared thresholds, ``RvsmArray.threshold_writes``); then one
+with shared thresholds, ``indexed_threshold_writes``); then one
 clock per step with ``strobe`` high (inputs driven on the falling edge), a ``clear``
 cycle before each listed step, and a drain of the pipeline. Every cycle where ``valid``
 is high is matched to the next expected step and every accumulator compared.
@@ -24,7 +24,7 @@ from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
 from rvsm.model.fixed.stimulus import load_stimulus
-from rvsm.rtl.parallel.array import RvsmArray
+from rvsm.rtl.threshold_storage import indexed_threshold_writes
 from rvsm.sim.cosim.testbenches.tb_common import clock_and_reset, logic_bits, testbench_arg
 
 MAX_LISTED = 50
@@ -59,7 +59,7 @@ async def array_matches_fixed_twin(dut: object) -> None:
     await clock_and_reset(dut, ("strobe", "clear", "cfg_we", "cfg_addr", "cfg_data",
                                 "codes"))
 
-    for a, thr in RvsmArray.threshold_writes(stim.contract, thresholds):
+    for a, thr in indexed_threshold_writes(stim.contract, thresholds):
         dut.cfg_we.value = 1
         dut.cfg_addr.value = a
         dut.cfg_data.value = thr
