@@ -81,6 +81,10 @@ schedule.
   the top rail ``2**(W-1)-1``, like the parallel array after its reset, so an array
   whose thresholds were never loaded fires only at saturation instead of reading
   undefined data; neither ``rst`` nor ``clear`` reloads them (a block RAM has no reset).
+  With shared thresholds (``threshold.storage = "shared"``) there is no threshold
+  memory: ``addr`` is the scale, ``data`` one threshold, written to that scale's
+  register with the same timing; the registers start at the contract's nominal
+  thresholds (:class:`~rvsm.rtl.stream.state_stage.StateStage`).
 
 The bit-accurate model is :meth:`ArrayContract.run`, rearranged into beats by
 :class:`~rvsm.rtl.stream.schedule.StreamSchedule`; the component is driven in
