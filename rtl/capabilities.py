@@ -156,6 +156,8 @@ class Architecture:
     * ``formal``: formal harness factories by check name (``"properties"``,
       ``"equivalence"``): ``factory(contract, mutation=None, **options)`` returns a
       :class:`~rvsm.rtl.formal_harness.FormalHarness` (``rvsm formal``);
+    * ``formal_storage``: check name -> the ``threshold.storage`` it is about (the
+      others skip it, :meth:`formal_skip_reason`);
     * ``extra_outputs(component, provenance)``: more files for ``rvsm verilog`` beside
       the Verilog, ``{suffix: text}`` with the suffixes of ``extra_suffixes`` (the IP's
       register map, :mod:`rvsm.rtl.ip.architecture`).
@@ -184,6 +186,17 @@ class Architecture:
     simulate_keywords: frozenset[str] = frozenset()
     running_threshold_writes: Callable[..., tuple[np.ndarray, Any]] | None = None
     mutation_sites: MutationSites | None = None
+    formal_storage: Mapping[str, str] = field(default_factory=dict)
+
+    def formal_skip_reason(self, check: str, contract: ArrayContract) -> str | None:
+        """Why formal check ``check`` does not apply to ``contract`` (``None``: it does):
+        a check about one ``threshold.storage`` (:attr:`formal_storage`, e.g. the
+        streaming array's threshold memories) on a point with the other."""
+        storage = self.formal_storage.get(check)
+        if storage is None or storage == contract.threshold_storage:
+            return None
+        return (f"it checks the {storage} threshold storage; this point has "
+                f"threshold.storage = {contract.threshold_storage!r}")
 
     def takes(self, option: str) -> bool:
         """Whether this architecture has the option called ``option``."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
 
 __all__ = ["MUTATIONS", "Mutation", "check_mutation", "mutations_for"]
@@ -19,12 +20,23 @@ __all__ = ["MUTATIONS", "Mutation", "check_mutation", "mutations_for"]
 @dataclass(frozen=True)
 class Mutation:
     """One deliberate bug: ``name``, the ``architecture`` it applies to (``"stream"`` /
-    ``"parallel"``), the ``block`` (module) it changes and a one-line ``description``."""
+    ``"parallel"``), the ``block`` (module) it changes and a one-line ``description``;
+    ``storage``: the ``threshold.storage`` whose logic it breaks (``None``: any), e.g.
+    the threshold memories' forwarding, which an array with shared threshold registers
+    does not have."""
 
     name: str
     architecture: str
     block: str
     description: str
+    storage: str | None = None
+
+    def skip_reason(self, contract: ArrayContract) -> str | None:
+        """Why this mutation does not apply to ``contract``'s array (``None``: it does)."""
+        if self.storage is None or self.storage == contract.threshold_storage:
+            return None
+        return (f"it breaks the {self.storage} threshold storage; this point has "
+                f"threshold.storage = {contract.threshold_storage!r}")
 
 
 #: Every mutation, by name.
@@ -45,9 +57,11 @@ MUTATIONS: dict[str, Mutation] = {m.name: m for m in (
     Mutation("stream.no_negative_spikes", "stream", _OUTPUT,
              "never fire -1 (the negative compare left out)"),
     Mutation("stream.stale_threshold", "stream", _OUTPUT,
-             "compare with the previous position's threshold (a stale threshold read)"),
+             "compare with the previous position's threshold (a stale threshold read)",
+             storage="per-pixel"),  # shared: every position's threshold is the same
     Mutation("stream.no_threshold_forwarding", "stream", _STATE,
-             "a threshold write meeting a read of its word is not forwarded"),
+             "a threshold write meeting a read of its word is not forwarded",
+             storage="per-pixel"),  # shared: registers, no memory to forward around
     Mutation("stream.shift_off_by_one", "stream", _OUTPUT,
              "shift the receptive sum one bit too far"),
     Mutation("stream.swapped_lanes", "stream", _OUTPUT,

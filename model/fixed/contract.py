@@ -365,10 +365,13 @@ class ArrayContract:
     ``weights`` holds, per scale, the integer kernel as a tuple of row tuples (hashable, so
     a contract can key a cache of generated RTL). Thresholds are *not* part of it: they are
     loaded at run time through the configuration interface (fixed-pattern noise lives
-    there), each in ``1 .. 2**(accumulator_bits-1) - 1``. ``sensor`` is the name of its
-    :attr:`kind`: ``"spike"`` (the spike camera) or ``"dvs"`` (the event sensor: log ADC
-    codes, references instead of accumulators; module docstring). It stays a name so a
-    contract is written to JSON and digested as text.
+    there), each in ``1 .. 2**(accumulator_bits-1) - 1``. ``shared_thresholds`` (``None``:
+    a threshold per accumulator, in memories) is, for an array with one threshold
+    register per scale (``threshold.storage = "shared"``), each register's reset and
+    configuration value: the nominal thresholds, still writable at run time. ``sensor``
+    is the name of its :attr:`kind`: ``"spike"`` (the spike camera) or ``"dvs"`` (the
+    event sensor: log ADC codes, references instead of accumulators; module docstring).
+    It stays a name so a contract is written to JSON and digested as text.
     """
 
     height: int
@@ -380,6 +383,24 @@ class ArrayContract:
     signed: bool
     reset: str = "zero"
     sensor: str = SPIKE.name
+    shared_thresholds: tuple[int, ...] | None = None
+
+    def __post_init__(self) -> None:
+        shared = self.shared_thresholds
+        if shared is None:
+            return
+        shared = tuple(int(t) for t in shared)  # a JSON list reads back as a tuple
+        object.__setattr__(self, "shared_thresholds", shared)
+        top = unsigned_max(self.threshold_bits)
+        if len(shared) != self.num_scales or not all(1 <= t <= top for t in shared):
+            raise RvsmError(f"shared_thresholds must be {self.num_scales} threshold(s) in "
+                            f"1..{top}, one per scale, got {shared!r}")
+
+    @property
+    def threshold_storage(self) -> str:
+        """``"shared"`` (one threshold register per scale, reset to
+        :attr:`shared_thresholds`) or ``"per-pixel"`` (a threshold per accumulator)."""
+        return "per-pixel" if self.shared_thresholds is None else "shared"
 
     @property
     def kind(self) -> SensorKind:

@@ -22,7 +22,8 @@ accumulator LSBs, ``threshold_scale = (2**N - 1) / full_scale * 2**frac_bits / 2
 for the spike camera, ``q_thr`` the threshold rounding (default ``"ceil"``: with integer
 accumulators ``acc >= x`` is exactly ``acc >= ceil(x)``). With noise, each accumulator's
 ``theta * phi_s + V_OS`` (clipped at 0, as the float model does) is mapped the same way and
-clamped to ``1 .. 2**(W-1) - 1``.
+clamped to ``1 .. 2**(W-1) - 1``. With ``threshold.storage = "shared"`` the thresholds are
+the nominal ones whatever the noise (one register per scale; the dark current stays).
 """
 
 from __future__ import annotations
@@ -174,6 +175,8 @@ class DesignPoint(PointFields):
             signed=self.signed,
             reset=self.reset,
             sensor=self.sensor,
+            shared_thresholds=(tuple(int(t) for t in self.nominal_thresholds())
+                               if self.shared_thresholds else None),
         )
 
     def to_threshold_lsbs(self, values: np.ndarray) -> np.ndarray:
@@ -193,15 +196,17 @@ class DesignPoint(PointFields):
     def integer_thresholds(self, noise: NoiseSource | None = None) -> np.ndarray:
         """Per-accumulator integer thresholds ``(S, H, W) int64`` in ``1 .. 2**(W-1)-1``.
 
-        Without noise every accumulator of scale ``s`` gets the nominal threshold. With
-        noise, the fixed pattern ``theta``, ``V_OS`` of ``noise.fixed_pattern()`` (a fresh
+        Without noise, or with ``threshold.storage = "shared"`` (one threshold register
+        per scale: no threshold fixed-pattern noise, whatever ``noise``), every
+        accumulator of scale ``s`` gets the nominal threshold. With noise, the fixed
+        pattern ``theta``, ``V_OS`` of ``noise.fixed_pattern()`` (a fresh
         source of this point's seed when ``noise`` is None) makes each accumulator's
         float threshold by its sensor's rule (``theta * phi_s + V_OS``; the event
         sensor: ``theta * C_s``), clipped at 0, mapped to LSBs and clamped to
         ``1 .. 2**(W-1)-1``.
         """
         s, (h, w) = self.num_scales, self.shape
-        if not self.noise:
+        if not self.noise or self.shared_thresholds:
             return np.broadcast_to(
                 self.nominal_thresholds()[:, None, None], (s, h, w)
             ).copy()

@@ -47,10 +47,14 @@ from rvsm.model.scene.library import SCENE_NAMES
 __all__ = [
     "FIELDS", "FIELD_BY_NAME", "FIELD_BY_PATH", "FIELD_PATH", "MAX_ACC_BITS", "MAX_ADC_BITS",
     "MAX_FRAC_BITS", "MAX_LOG_FRAC_BITS", "MAX_SHIFT", "MAX_SIDE", "MAX_WEIGHT_BITS",
-    "THRESHOLD_ROUNDINGS", "PointFields",
+    "THRESHOLD_ROUNDINGS", "THRESHOLD_STORAGES", "PointFields",
 ]
 
 THRESHOLD_ROUNDINGS = ("ceil", "round-half-up", "truncate")
+#: ``threshold.storage``: a threshold per accumulator (memories, the SPEC's threshold
+#: fixed-pattern noise folded in), or one per scale (registers; the comparison is digital,
+#: behind the ADC, so the thresholds carry no fixed-pattern noise; the dark current stays).
+THRESHOLD_STORAGES = ("per-pixel", "shared")
 MAX_ADC_BITS = 16
 MAX_WEIGHT_BITS = 32
 MAX_FRAC_BITS = 40
@@ -119,6 +123,10 @@ class PointFields:
     calibration_scene: str | None = declare(
         "threshold", "calibration_scene", OptionalChoice(SCENE_NAMES), None,
         f"scene of the response rule (default {DEFAULT_CALIBRATION_SCENE})", sweep=False)
+    threshold_storage: str = declare(
+        "threshold", "storage", Choice(THRESHOLD_STORAGES), "per-pixel",
+        "per-pixel: a threshold memory folding the fixed-pattern noise in; shared: one "
+        "register per scale, no threshold fixed-pattern noise (a comparison behind an ADC)")
     noise: bool = declare("noise", "enabled", Flag(), False,
                           "SPEC section 3 noise on or off", sweep=False)
     noise_k: float = declare("noise", "k", Number(allow_zero=True, hi=MAX_K), 1.0,
@@ -187,14 +195,24 @@ class PointFields:
         """ADC codes per brightness unit, ``(2**adc_bits - 1) / adc_full_scale``."""
         return adc_gain(self.adc_bits, self.adc_full_scale)
 
+    @property
+    def shared_thresholds(self) -> bool:
+        """``threshold.storage = "shared"``: one threshold per scale, no threshold
+        fixed-pattern noise."""
+        return self.threshold_storage == "shared"
+
     def noise_params(self) -> NoiseParams | None:
         """The float model's noise parameters (SPEC defaults, this point's k and seed; a
-        ``noise.preset`` replaces k, :mod:`rvsm.model.noise.presets`)."""
+        ``noise.preset`` replaces k, :mod:`rvsm.model.noise.presets`). With shared
+        thresholds the fixed pattern is off (``theta = 1``, ``V_OS = 0`` exactly) and the
+        dark current is the same as with per-pixel ones."""
         if not self.noise:
             return None
         if self.noise_preset is not None:
-            return preset_noise(self.noise_preset, int(self.seed))
-        return NoiseParams(k=float(self.noise_k), seed=int(self.seed))
+            params = preset_noise(self.noise_preset, int(self.seed))
+        else:
+            params = NoiseParams(k=float(self.noise_k), seed=int(self.seed))
+        return params.without_fixed_pattern() if self.shared_thresholds else params
 
     def noise_source(self) -> NoiseSource | None:
         """A fresh seeded noise source for this array (None when noise is off)."""

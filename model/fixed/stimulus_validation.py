@@ -98,7 +98,7 @@ def member_contract(value: np.ndarray, source: str) -> ArrayContract:
         raise RvsmError(f"{source}: 'contract' is not valid JSON ({exc})") from None
     fields = {f.name for f in dataclasses.fields(ArrayContract)}
     if not isinstance(raw, dict) or set(raw) - fields or \
-            fields - {"reset", "sensor"} - set(raw):
+            fields - {"reset", "sensor", "shared_thresholds"} - set(raw):
         raise RvsmError(f"{source}: 'contract' must be an object with the fields "
                         f"{', '.join(sorted(fields))}")
     for name, (lo, hi) in CONTRACT_LIMITS.items():
@@ -112,6 +112,11 @@ def member_contract(value: np.ndarray, source: str) -> ArrayContract:
     if raw.get("sensor", "spike") not in SENSORS:
         raise RvsmError(f"{source}: contract sensor must be one of {SENSORS}, got "
                         f"{raw.get('sensor')!r}")
+    shared = raw.get("shared_thresholds")
+    if shared is not None and (not isinstance(shared, list) or not all(
+            isinstance(v, int) and not isinstance(v, bool) for v in shared)):
+        raise RvsmError(f"{source}: contract shared_thresholds must be null or a list of "
+                        f"integers, got {shared!r}")
     raw["weights"] = _kernels(raw["weights"], source)
     return ArrayContract(**raw)
 

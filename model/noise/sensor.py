@@ -16,7 +16,7 @@ from the same streams.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -63,6 +63,12 @@ class NoiseParams:
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
                 or self.seed < 0:
             raise RvsmError(f"noise seed must be an integer >= 0, got {self.seed!r}")
+
+    def without_fixed_pattern(self) -> NoiseParams:
+        """The same dark current (``e1``, ``b1``, ``k``, ``seed``) with no threshold
+        fixed-pattern noise: ``V_OS = 0`` and ``theta = 1`` exactly (``b2 = b3 = 0``,
+        ``e2 = 0``, ``e3 = 1``), the noise of a sensor whose thresholds are digital."""
+        return replace(self, e2=0.0, b2=0.0, e3=1.0, b3=0.0)
 
     def to_dict(self) -> dict:
         """Plain-JSON form, for spike-file metadata."""

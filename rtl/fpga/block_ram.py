@@ -168,11 +168,14 @@ class StateLayout:
     radius: int
 
     @classmethod
-    def from_contract(cls, contract: ArrayContract, shared_thresholds: bool = False,
+    def from_contract(cls, contract: ArrayContract, shared_thresholds: bool | None = None,
                       pitches: tuple[int, ...] | None = None) -> StateLayout:
         """The layout of ``contract``'s array (:func:`~rvsm.rtl.fpga.camera.state_memory`):
-        per-pixel thresholds unless ``shared_thresholds``, every scale at pitch 1 unless
-        ``pitches`` says otherwise."""
+        shared threshold registers when ``shared_thresholds`` (``None``: when the contract
+        has them, ``threshold.storage = "shared"``), else per-pixel threshold memories;
+        every scale at pitch 1 unless ``pitches`` says otherwise."""
+        if shared_thresholds is None:
+            shared_thresholds = contract.shared_thresholds is not None
         st = state_memory(contract)
         pitches = pitches or (1,) * st.num_scales
         if len(pitches) != st.num_scales or any(p < 1 for p in pitches):

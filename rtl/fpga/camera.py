@@ -11,7 +11,9 @@ State memory (exact, at one design point). Per scale and pixel the array keeps a
 window needs ``2L`` line buffers of ``W`` ADC codes (``N`` bits), ``L`` the largest
 radius of a non-zero quantised weight. Without fixed-pattern noise every accumulator of
 a scale has the same threshold, so a design could keep ``S`` threshold registers instead
-of a threshold memory; :attr:`StateMemory.thresholds_uniform` says when.
+of a threshold memory; :attr:`StateMemory.thresholds_uniform` says when, and a point with
+``threshold.storage = "shared"`` does (:attr:`StateMemory.shared_thresholds`: no threshold
+memory bits).
 
 Block RAM. An ECP5 DP16KD holds 18 Kbit as 16Kx1, 8Kx2, 4Kx4, 2Kx9, 1Kx18 or 512x36;
 :func:`bram_blocks` counts the blocks one ``depth x width`` memory takes in the best of
@@ -94,6 +96,9 @@ class StateMemory:
     adc_bits: int
     radius: int
     thresholds_uniform: bool
+    #: ``threshold.storage = "shared"``: one threshold register per scale, no threshold
+    #: memory (:attr:`thresholds` is 0 bits; the ``S * (A-1)`` register bits are logic).
+    shared_thresholds: bool = False
 
     @property
     def accumulators(self) -> int:
@@ -102,7 +107,9 @@ class StateMemory:
 
     @property
     def thresholds(self) -> int:
-        """``S * H * W * (A - 1)`` bits of per-accumulator thresholds."""
+        """``S * H * W * (A - 1)`` bits of per-accumulator thresholds (0 when shared)."""
+        if self.shared_thresholds:
+            return 0
         return self.num_scales * self.height * self.width * self.threshold_bits
 
     @property
@@ -124,7 +131,8 @@ class StateMemory:
         """
         depth = cycles_per_step(self.height, self.width, lanes)
         per_acc = bram_blocks(depth, lanes * self.accumulator_bits)
-        per_thr = bram_blocks(depth, lanes * self.threshold_bits)
+        per_thr = 0 if self.shared_thresholds else bram_blocks(depth,
+                                                               lanes * self.threshold_bits)
         lines = 2 * self.radius * bram_blocks(-(-self.width // lanes), lanes * self.adc_bits)
         return {"accumulators": self.num_scales * per_acc,
                 "thresholds": self.num_scales * per_thr, "line_buffers": lines}
@@ -132,7 +140,8 @@ class StateMemory:
     def fits(self) -> dict[str, dict]:
         """Per device: whether accumulators alone / all state fit its block RAM bits."""
         out = {}
-        per_pixel = self.num_scales * (self.accumulator_bits + self.threshold_bits)
+        per_pixel = self.num_scales * (self.accumulator_bits
+                                       + (0 if self.shared_thresholds else self.threshold_bits))
         for name, dev in DEVICES.items():
             out[name] = {
                 "bram_bits": dev.bram_bits,
@@ -156,10 +165,13 @@ class StateMemory:
 
 
 def state_memory(contract: ArrayContract, thresholds_uniform: bool = False) -> StateMemory:
-    """The :class:`StateMemory` of ``contract``'s array (its own height and width)."""
+    """The :class:`StateMemory` of ``contract``'s array (its own height and width; shared
+    threshold registers when the contract has them)."""
+    shared = contract.shared_thresholds is not None
     return StateMemory(
         num_scales=contract.num_scales, height=contract.height, width=contract.width,
         accumulator_bits=contract.accumulator_bits,
         threshold_bits=contract.threshold_bits, adc_bits=contract.adc_bits,
-        radius=window_radius(contract), thresholds_uniform=thresholds_uniform,
+        radius=window_radius(contract), thresholds_uniform=thresholds_uniform or shared,
+        shared_thresholds=shared,
     )

@@ -371,7 +371,10 @@ class FpgaReport:
                     f"{n} {f['bram_bits'] / 1e6:.2f} Mbit ({f['pixels_that_fit']:,} pixels)"
                     for n, f in st.fits().items())),
         ]
-        if st.thresholds_uniform:
+        if st.shared_thresholds:
+            rows.append("              (threshold.storage = \"shared\": one threshold "
+                        "register per scale, no threshold memory)")
+        elif st.thresholds_uniform:
             rows.append("              (this point has no fixed-pattern noise: one threshold "
                         "register per scale would replace the threshold memory)")
         return "\n".join(rows)

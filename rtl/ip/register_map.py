@@ -176,9 +176,10 @@ def ip_register_map(contract: ArrayContract, lanes: int, fifo_depth: int, rtl_di
     strings (their first 8 digits go into DIGEST_RTL / DIGEST_POINT), ``version`` the
     rvsm version (:func:`pack_version`)."""
     c, geo = contract, StreamGeometry(contract, lanes)
-    tw, p, words = c.threshold_bits, geo.lanes, geo.beats_per_frame
+    tw, p, words = c.threshold_bits, geo.lanes, geo.threshold_words
+    per_word = geo.threshold_data_bits // tw  # thresholds per word: P, or 1 when shared
     wb, sb = threshold_word_bits(words), field_bits(c.num_scales - 1)
-    chunks = -(-p * tw // 32)
+    chunks = -(-per_word * tw // 32)
     if THR_DATA_BASE + 4 * chunks > 1 << ADDR_BITS:
         raise RvsmError(f"a threshold word of {p * tw} bits needs {chunks} data registers; "
                         f"the IP's 4 KiB register window holds at most "
@@ -228,8 +229,9 @@ def ip_register_map(contract: ArrayContract, lanes: int, fifo_depth: int, rtl_di
                   live=True),
             Field("framing", 1, 1, "W1C", 0, "an input beat's tuser/tlast disagreed with "
                   "its position (start of frame / end of line)", live=True),
-            Field("init", 2, 1, "RO", 1, "thresholds are being set to the top rail after "
-                  "rst", live=True),
+            Field("init", 2, 1, "RO", 1, "thresholds are being set to "
+                  + ("their nominal values" if geo.shared_thresholds else "the top rail")
+                  + " after rst", live=True),
             Field("flushing", 3, 1, "RO", 0, "flush beats are being inserted", live=True),
             Field("busy", 4, 1, "RO", 1, "init, flush or clear in progress: input tready "
                   "is low", live=True),
@@ -244,26 +246,41 @@ def ip_register_map(contract: ArrayContract, lanes: int, fifo_depth: int, rtl_di
         Register("DROPPED", 0x38, (Field("count", 0, 32, "RO", 0, "output beats dropped "
                                          "(FIFO full), wrapping", live=True),),
                  "output beats dropped, modulo 2**32"),
-        Register("THR_ADDR", 0x40, (
-            Field("word", 0, wb, "RW", 0, f"threshold word y*G + g (0..{words - 1}); "
-                  "increments after each commit", external=True, max=words - 1),
-            Field("scale", 16, sb, "RW", 0, f"scale s (0..{c.num_scales - 1})",
-                  external=True, max=c.num_scales - 1)),
-            "address of the next threshold word to commit; after a commit it moves to the "
-            "next word (word, then scale, wrapping to 0)"),
+        _threshold_address(geo, wb, sb),
     ]
     for k in range(chunks):
-        lo, hi = 32 * k, min(32 * (k + 1), p * tw)
+        lo, hi = 32 * k, min(32 * (k + 1), per_word * tw)
         last = k == chunks - 1
+        packing = (f"the scale's one threshold (threshold.storage = shared; configured to "
+                   f"{', '.join(map(str, c.shared_thresholds))})" if geo.shared_thresholds
+                   else f"lane i at [i*{tw} +: {tw}]")
         regs.append(Register(
             f"THR_DATA{k}", THR_DATA_BASE + 4 * k,
             (Field("data", 0, hi - lo, "RW", 0, f"bits [{hi - 1}:{lo}] of the threshold "
                    "word"),),
-            f"threshold word bits [{hi - 1}:{lo}] (lane i at [i*{tw} +: {tw}])"
+            f"threshold word bits [{hi - 1}:{lo}] ({packing})"
             + ("; writing this register commits the word to THR_ADDR (SLVERR while "
                "STATUS.init)" if last else ""),
             commit=last))
-    return RegisterMap(tuple(regs), ADDR_BITS, chunks, tw, p)
+    return RegisterMap(tuple(regs), ADDR_BITS, chunks, tw, per_word)
+
+
+def _threshold_address(geo: StreamGeometry, word_bits: int, scale_bits: int) -> Register:
+    """THR_ADDR: the word (``y*G + g``) and scale of the next commit; with shared
+    thresholds (one register per scale) the scale alone."""
+    scales, words = geo.contract.num_scales, geo.threshold_words
+    scale = Field("scale", 16, scale_bits, "RW", 0, f"scale s (0..{scales - 1})",
+                  external=True, max=scales - 1)
+    if geo.shared_thresholds:
+        return Register("THR_ADDR", 0x40, (scale,),
+                        "scale of the next threshold to commit (one register per scale, "
+                        "threshold.storage = shared); after a commit it moves to the next "
+                        "scale, wrapping to 0")
+    return Register("THR_ADDR", 0x40, (
+        Field("word", 0, word_bits, "RW", 0, f"threshold word y*G + g (0..{words - 1}); "
+              "increments after each commit", external=True, max=words - 1), scale),
+        "address of the next threshold word to commit; after a commit it moves to the "
+        "next word (word, then scale, wrapping to 0)")
 
 
 def regs_json(regmap: RegisterMap, meta: Mapping[str, object]) -> str:

@@ -36,7 +36,10 @@ word, one word per cycle (``S*H*G`` cycles, ``STATUS.init`` and ``busy`` high, i
 ``tready`` low, threshold commits refused): the thresholds then have the same defined
 value after every reset as after configuration, on any memory technology (a block
 RAM's initial contents are an FPGA feature; an ASIC SRAM has none). Load the thresholds
-after ``STATUS.init`` falls.
+after ``STATUS.init`` falls. With shared thresholds (``threshold.storage = "shared"``:
+one register per scale, ``THR_ADDR`` a scale only, ``THR_DATA`` one threshold) the walk
+takes ``S`` cycles and restores each scale's nominal threshold: the IP spikes correctly
+with no threshold load.
 
 **Flush and clear.** ``CONTROL.flush`` inserts ``lag`` zero beats (input ``tready``
 low meanwhile), so every accepted beat's output comes out; ``CONTROL.clear`` restarts
@@ -48,7 +51,7 @@ sending a new frame.
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, Module, Mux, Signal
+from amaranth.hdl import Cat, Const, Module, Mux, Signal
 from amaranth.lib import wiring
 from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.wiring import In, Out
@@ -63,7 +66,6 @@ from rvsm.rtl.ip.register_map import ADDR_BITS, RegisterMap, ip_register_map
 from rvsm.rtl.rtl_digest import rtl_digest
 from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.dimensions import StreamGeometry
-from rvsm.rtl.stream.signatures import top_threshold_word
 
 __all__ = ["IP_ARCH", "RvsmAxisIp"]
 
@@ -162,8 +164,9 @@ class RvsmAxisIp(wiring.Component):
 
     @property
     def init_cycles(self) -> int:
-        """Cycles after ``rst`` during which the thresholds are set (``S*H*G``)."""
-        return self.contract.num_scales * self.geometry.beats_per_frame
+        """Cycles after ``rst`` during which the thresholds are set (``S*H*G``; ``S`` with
+        shared thresholds)."""
+        return self.contract.num_scales * self.geometry.threshold_words
 
     def elaborate(self, platform: object) -> Module:
         m = Module()
@@ -274,24 +277,30 @@ class RvsmAxisIp(wiring.Component):
         """THR_ADDR (auto-incrementing), the commit of THR_DATA chunks, and the walk
         that sets every threshold word to the top rail after reset."""
         c, geo, arr, rm = self.contract, self.geometry, self.array, self.regmap
-        word = regs.value["THR_ADDR.word"]
+        shared = geo.shared_thresholds  # THR_ADDR without a word: one register per scale
+        word = None if shared else regs.value["THR_ADDR.word"]
         scale = regs.value["THR_ADDR.scale"]
-        last_word = word == geo.beats_per_frame - 1
+        last_word = Const(1) if shared else word == geo.threshold_words - 1
         last_scale = scale == c.num_scales - 1
+        reset_data = Const(geo.threshold_reset_data(0), len(arr.thr.data))
+        for s in range(1, c.num_scales if shared else 1):  # what rst restores, per scale
+            reset_data = Mux(scale == s, geo.threshold_reset_data(s), reset_data)
         chunks = [regs.value[f"{r.name}.data"] for r in rm.thr_data_registers()]
         commit = regs.written[rm.thr_data_registers()[-1].name]
         for name in ("THR_ADDR", rm.thr_data_registers()[-1].name):
             m.d.comb += regs.refuse[name].eq(init)
         step = init | commit
-        m.d.comb += [arr.thr.we.eq(step), arr.thr.addr.eq(Cat(word, scale)),
-                     arr.thr.data.eq(Mux(init, top_threshold_word(c.threshold_bits,
-                                                                   geo.lanes),
+        m.d.comb += [arr.thr.we.eq(step),
+                     arr.thr.addr.eq(scale if shared else Cat(word, scale)),
+                     arr.thr.data.eq(Mux(init, reset_data,
                                          Cat(*chunks)[:len(arr.thr.data)]))]
         with m.If(step):
-            m.d.sync += [word.eq(Mux(last_word, 0, word + 1)),
-                         scale.eq(Mux(last_word, Mux(last_scale, 0, scale + 1), scale))]
+            m.d.sync += scale.eq(Mux(last_word, Mux(last_scale, 0, scale + 1), scale))
+            if not shared:
+                m.d.sync += word.eq(Mux(last_word, 0, word + 1))
             with m.If(last_word & last_scale):
                 m.d.sync += init.eq(0)
         with m.Elif(regs.written["THR_ADDR"]):
-            m.d.sync += [word.eq(regs.wdata[:len(word)]),
-                         scale.eq(regs.wdata[16:16 + len(scale)])]
+            m.d.sync += scale.eq(regs.wdata[16:16 + len(scale)])
+            if not shared:
+                m.d.sync += word.eq(regs.wdata[:len(word)])

@@ -12,7 +12,10 @@ Bit ordering of the flat ports (all little-endian, index 0 = LSB):
 * ``codes``: pixel ``(y, x)`` at bits ``[(y*W + x)*N +: N]`` (unsigned ADC code);
 * ``spike_pos`` / ``spike_neg``: accumulator ``a = (s*H + y)*W + x`` at bit ``a``;
 * ``cfg.addr``: the same accumulator index ``a``; ``cfg.data`` the threshold
-  (``1 .. 2**(W-1)-1``), written when ``cfg.we`` is high at a clock edge. ``cfg`` is the
+  (``1 .. 2**(W-1)-1``), written when ``cfg.we`` is high at a clock edge. With shared
+  thresholds (``threshold.storage = "shared"``) the cells have none of their own: one
+  register per scale (reset to the contract's nominal threshold), ``cfg.addr`` the
+  scale ``s``. ``cfg`` is the
   threshold-write bus (:class:`~rvsm.rtl.interfaces.ThresholdWriteSignature`); in the
   Verilog its ports are ``cfg_we``, ``cfg_addr``, ``cfg_data`` (:mod:`rvsm.rtl.ports`).
 
@@ -28,6 +31,7 @@ The bit-accurate model of this component is :meth:`ArrayContract.run`; it is dri
 
 from __future__ import annotations
 
+import numpy as np
 from amaranth.hdl import Module, Signal, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
@@ -38,6 +42,7 @@ from rvsm.rtl.interfaces import ThresholdWriteSignature
 from rvsm.rtl.mutations import check_mutation
 from rvsm.rtl.parallel.pixel_cell import PixelCell
 from rvsm.rtl.receptive_sum import sum_width, weighted_sum
+from rvsm.rtl.threshold_storage import indexed_threshold_writes
 
 __all__ = ["RvsmArray", "accumulator_index", "receptive_taps"]
 
@@ -84,15 +89,24 @@ class RvsmArray(wiring.Component):
         super().__init__(self.interface(contract))
 
     @staticmethod
+    def threshold_writes(contract: ArrayContract, thresholds: np.ndarray
+                         ) -> list[tuple[int, int]]:
+        """``(cfg_addr, cfg_data)`` of every write loading thresholds ``(S, H, W)``: one
+        per accumulator (index ``a``), or with shared thresholds one per scale
+        (:func:`~rvsm.rtl.threshold_storage.indexed_threshold_writes`)."""
+        return indexed_threshold_writes(contract, thresholds)
+
+    @staticmethod
     def interface(contract: ArrayContract) -> wiring.Signature:
         """The array's signature for ``contract`` (no component needed)."""
         c = contract
         n_acc = c.num_scales * c.height * c.width
+        targets = c.num_scales if c.shared_thresholds is not None else n_acc
         return wiring.Signature({
             "codes": In(unsigned(c.height * c.width * c.adc_bits)),
             "strobe": In(1),
             "clear": In(1),
-            "cfg": In(ThresholdWriteSignature(c.threshold_bits, index_bits(n_acc))),
+            "cfg": In(ThresholdWriteSignature(c.threshold_bits, index_bits(targets))),
             "spike_pos": Out(unsigned(n_acc)),
             "spike_neg": Out(unsigned(n_acc)),
             "valid": Out(1),
@@ -115,18 +129,23 @@ class RvsmArray(wiring.Component):
         c = contract
         n_acc = c.num_scales * c.height * c.width
         top = unsigned_max(c.threshold_bits)
+        shared = c.shared_thresholds
+        cfg = {"cfg_we": "threshold write enable",
+               "cfg_addr": f"accumulator index (s*{c.height}+y)*{c.width}+x, 0..{n_acc - 1}",
+               "cfg_data": f"threshold, 1..{top}"} if shared is None else {
+            "cfg_we": "threshold write enable (one scale's register)",
+            "cfg_addr": f"scale s, 0..{c.num_scales - 1} (threshold.storage = shared)",
+            "cfg_data": f"the scale's threshold, 1..{top}"}
         return {
             "clk": "clock (rising edge)",
             "rst": "synchronous reset: accumulators and spikes to 0, thresholds to "
-                   f"{top}",
+                   + (f"{top}" if shared is None else ", ".join(map(str, shared))),
             "codes": f"ADC codes, pixel (y, x) at bits [(y*{c.width}+x)*{c.adc_bits} +: "
                      f"{c.adc_bits}]",
             "strobe": "sample strobe: one contract step per rising edge with strobe=1",
             "clear": "synchronous clear of accumulators and spikes (thresholds kept); "
                      "priority over strobe",
-            "cfg_we": "threshold write enable",
-            "cfg_addr": f"accumulator index (s*{c.height}+y)*{c.width}+x, 0..{n_acc - 1}",
-            "cfg_data": f"threshold, 1..{top}",
+            **cfg,
             "spike_pos": "+1 spikes, accumulator (s*H+y)*W+x at that bit",
             "spike_neg": "-1 spikes, same ordering (always 0 for unsigned models)",
             "valid": f"spikes of a strobed step are valid (latency {cls.LATENCY} cycle(s))",
@@ -146,6 +165,12 @@ class RvsmArray(wiring.Component):
             m.d.sync += stage.eq(go if i == 0 else valid_pipe[i - 1])
         m.d.comb += self.valid.eq(valid_pipe[-1])
 
+        shared = c.shared_thresholds is not None
+        registers = [Signal(unsigned(c.threshold_bits), name=f"thr_s{s}", init=t)
+                     for s, t in enumerate(c.shared_thresholds or ())]
+        for s, register in enumerate(registers):  # threshold.storage = "shared"
+            with m.If(self.cfg.we & (self.cfg.addr == s)):
+                m.d.sync += register.eq(self.cfg.data)
         for s in range(c.num_scales):
             lo, hi = c.sum_range(s)
             for y in range(h):
@@ -156,15 +181,16 @@ class RvsmArray(wiring.Component):
                     a = accumulator_index(c, s, y, x)
                     cell = PixelCell(sum_width(lo, hi), c.shift, c.accumulator_bits,
                                      c.signed, c.reset, self.mutation,
-                                     c.kind.output)
+                                     c.kind.output, shared_threshold=shared)
                     self.cells[a] = cell
                     m.submodules[f"cell_s{s}_y{y}_x{x}"] = cell
                     m.d.comb += [
                         cell.sum_in.eq(weighted_sum(taps, wts, lo, hi)),
                         cell.strobe.eq(self.strobe),
                         cell.clear.eq(self.clear),
-                        cell.thr.we.eq(self.cfg.we & (self.cfg.addr == a)),
-                        cell.thr.data.eq(self.cfg.data),
+                        *([cell.threshold_in.eq(registers[s])] if shared else
+                          [cell.thr.we.eq(self.cfg.we & (self.cfg.addr == a)),
+                           cell.thr.data.eq(self.cfg.data)]),
                         self.spike_pos[a].eq(cell.spike_pos),
                         self.spike_neg[a].eq(cell.spike_neg),
                     ]

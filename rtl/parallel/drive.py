@@ -45,10 +45,10 @@ def simulate(
     shifts = np.arange(c.height * c.width, dtype=object) * c.adc_bits
 
     async def bench(ctx) -> None:  # noqa: ANN001 - amaranth's SimulatorContext
-        for a, value in enumerate(thr.ravel()):
+        for a, value in RvsmArray.threshold_writes(c, thr):
             ctx.set(dut.cfg.we, 1)
             ctx.set(dut.cfg.addr, a)
-            ctx.set(dut.cfg.data, int(value))
+            ctx.set(dut.cfg.data, value)
             await ctx.tick()
         ctx.set(dut.cfg.we, 0)
         for t in range(steps):

@@ -17,7 +17,8 @@ and checks every accumulator cell against the contract's integer rules
   reset mode leaves;
 * ``hold.no_strobe``: without strobe, clear or reset nothing changes;
 * ``clear.zeroes_state``: ``clear`` zeroes accumulators and spikes, keeps thresholds;
-* ``reset.domain``: ``rst`` zeroes accumulators and spikes, thresholds to ``2**(W-1)-1``;
+* ``reset.domain``: ``rst`` zeroes accumulators and spikes, thresholds to ``2**(W-1)-1``
+  (shared thresholds: to the contract's nominal ones);
 * ``threshold.write`` / ``threshold.kept``: a write to a cell's address loads it from the
   next cycle, any other cycle keeps it;
 * ``valid.latency``: ``valid`` is high exactly one cycle after a strobe without clear;
@@ -165,7 +166,7 @@ class ParallelProperties(FormalHarness):
                     self.check(m, "receptive.sum", cell.sum_in == ref_sum,
                                "the cell's input is the exact weighted sum of the codes "
                                "(codes outside the array are 0)")
-                    high, low, cleared = self._cell(m, a, cell, prev, lo, hi)
+                    high, low, cleared = self._cell(m, a, s, cell, prev, lo, hi)
                     rails[0].append(high)
                     rails[1].append(cleared)
                     if c.signed and lowest_shifted_sum(kernel, y, x) < 0:
@@ -179,10 +180,15 @@ class ParallelProperties(FormalHarness):
                        "a total below the low rail (any cell with a negative sum)", "cover")
         return m
 
-    def _cell(self, m: Module, a: int, cell: PixelCell, prev: _Past, lo: int,
+    def _cell(self, m: Module, a: int, scale: int, cell: PixelCell, prev: _Past, lo: int,
               hi: int) -> tuple[Value, Value, Value]:
-        """Cell ``a``'s properties; returns its rail and clear cover conditions."""
+        """Cell ``a``'s (of scale ``scale``) properties; returns its rail and clear cover
+        conditions. With shared thresholds the cell's threshold is its scale's register:
+        written at address ``scale``, reset to the contract's nominal threshold."""
         c = self.contract
+        shared = c.shared_thresholds is not None
+        target = scale if shared else a  # the threshold's write address
+        top = c.shared_thresholds[scale] if shared else hi  # its value after rst
         step = prev.step
         w = c.accumulator_bits
         p_acc = Signal(signed(w), name=f"p_acc_{a}")
@@ -240,9 +246,9 @@ class ParallelProperties(FormalHarness):
         self.check(m, "reset.domain",
                    ~prev.started | ~prev.rst
                    | ((cell.acc == 0) & ~cell.spike_pos & ~cell.spike_neg
-                      & (cell.threshold == hi)),
-                   f"the domain reset zeroes accumulator and spikes, threshold to {hi}")
-        written = prev.we & (prev.addr == a)
+                      & (cell.threshold == top)),
+                   f"the domain reset zeroes accumulator and spikes, threshold to {top}")
+        written = prev.we & (prev.addr == target)
         self.check(m, "threshold.write", ~prev.observed | ~written
                    | (cell.threshold == prev.data),
                    "a threshold write to the cell's address loads it from the next cycle")

@@ -15,7 +15,9 @@ Control, all synchronous: ``clear`` (priority) zeroes the accumulator and the sp
 outputs and keeps the threshold; ``thr.we`` loads ``thr.data`` into the threshold
 register (any time; it takes effect from the next strobe). ``thr`` is the threshold-write
 bus (:class:`~rvsm.rtl.interfaces.ThresholdWriteSignature`, without address). The domain
-reset returns the threshold to its ``init`` value ``2**(W-1) - 1``.
+reset returns the threshold to its ``init`` value ``2**(W-1) - 1``. A cell of an array with
+shared thresholds has no threshold register: it compares with its scale's
+(``threshold_in``).
 """
 
 from __future__ import annotations
@@ -49,7 +51,9 @@ class PixelCell(wiring.Component):
     ``spike_neg`` Out(1), registered, valid :attr:`LATENCY` cycles after the strobe;
     ``acc`` Out(signed(W)) and ``threshold`` Out(unsigned(W-1)) for observation (the
     formal harness :mod:`rvsm.rtl.parallel.harnesses`). ``mutation``: a deliberate bug of
-    :mod:`rvsm.rtl.mutations` (``parallel.*``) or None.
+    :mod:`rvsm.rtl.mutations` (``parallel.*``) or None. ``shared_threshold``
+    (``threshold.storage = "shared"``): no threshold register of its own; ``thr`` is
+    replaced by ``threshold_in`` In(unsigned(W-1)), its scale's register.
     """
 
     #: Clock cycles from the strobe edge that samples ``sum_in`` to valid spike outputs.
@@ -64,6 +68,7 @@ class PixelCell(wiring.Component):
         reset: str = "zero",
         mutation: str | None = None,
         output: Output = Output.SPIKES,
+        shared_threshold: bool = False,
     ):
         if not isinstance(output, Output):
             raise ValueError(f"output must be one of {[o.name for o in Output]}, got "
@@ -78,11 +83,15 @@ class PixelCell(wiring.Component):
         self.reset = reset
         #: A deliberate bug (:mod:`rvsm.rtl.mutations`) or None (the shipped logic).
         self.mutation = mutation
+        self.shared_threshold = shared_threshold
+        threshold_port = ({"threshold_in": In(unsigned(accumulator_bits - 1))}
+                          if shared_threshold else
+                          {"thr": In(ThresholdWriteSignature(accumulator_bits - 1))})
         super().__init__({
             "sum_in": In(signed(sum_bits)),
             "strobe": In(1),
             "clear": In(1),
-            "thr": In(ThresholdWriteSignature(accumulator_bits - 1)),
+            **threshold_port,
             "spike_pos": Out(1),
             "spike_neg": Out(1),
             "acc": Out(signed(accumulator_bits)),
@@ -99,7 +108,12 @@ class PixelCell(wiring.Component):
         m = Module()
         lo, hi = self.acc_range
         w = self.accumulator_bits
-        thr = Signal(unsigned(w - 1), init=hi)
+        if self.shared_threshold:  # the scale's register, outside the cell
+            thr = self.threshold_in
+        else:
+            thr = Signal(unsigned(w - 1), init=hi)
+            with m.If(self.thr.we):
+                m.d.sync += thr.eq(self.thr.data)
         acc = Signal(signed(w))
         m.d.comb += [self.acc.eq(acc), self.threshold.eq(thr)]
 
@@ -130,11 +144,9 @@ class PixelCell(wiring.Component):
                  Output.EVENTS: lambda: self._event_cell(m, thr, acc, shifted)}
         return cells[self.output]()
 
-    def _spike_cell(self, m: Module, thr: Signal, acc: Signal, pos: Signal, neg: Signal,
+    def _spike_cell(self, m: Module, thr: Value, acc: Signal, pos: Signal, neg: Signal,
                     after: Value) -> Module:
-        """The spike camera's registers: threshold write, clear, accumulate and fire."""
-        with m.If(self.thr.we):
-            m.d.sync += thr.eq(self.thr.data)
+        """The spike camera's registers: clear, accumulate and fire."""
         clear = self.clear if self.mutation != "parallel.clear_ignored" else 0
         with m.If(clear):
             m.d.sync += [acc.eq(0), self.spike_pos.eq(0), self.spike_neg.eq(0)]
@@ -142,7 +154,7 @@ class PixelCell(wiring.Component):
             m.d.sync += [acc.eq(after), self.spike_pos.eq(pos), self.spike_neg.eq(neg)]
         return m
 
-    def _event_cell(self, m: Module, thr: Signal, ref: Signal, shifted: Value) -> Module:
+    def _event_cell(self, m: Module, thr: Value, ref: Signal, shifted: Value) -> Module:
         """The event sensor's next-state logic (class docstring): ``ref`` in ``acc``."""
         lo, hi = self.acc_range
         captured = Signal()
@@ -151,8 +163,6 @@ class PixelCell(wiring.Component):
         up, down = d >= thr, d <= -thr
         moved = Mux(up, ref + thr, Mux(down, ref - thr, ref))
         new = Mux(captured, moved, shifted)
-        with m.If(self.thr.we):
-            m.d.sync += thr.eq(self.thr.data)
         with m.If(self.clear):
             m.d.sync += [ref.eq(0), captured.eq(0), self.spike_pos.eq(0),
                          self.spike_neg.eq(0)]

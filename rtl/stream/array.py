@@ -81,6 +81,10 @@ schedule.
   the top rail ``2**(W-1)-1``, like the parallel array after its reset, so an array
   whose thresholds were never loaded fires only at saturation instead of reading
   undefined data; neither ``rst`` nor ``clear`` reloads them (a block RAM has no reset).
+  With shared thresholds (``threshold.storage = "shared"``) there is no threshold
+  memory: ``addr`` is the scale, ``data`` one threshold, written to that scale's
+  register with the same timing; the registers start at the contract's nominal
+  thresholds (:class:`~rvsm.rtl.stream.state_stage.StateStage`).
 
 The bit-accurate model is :meth:`ArrayContract.run`, rearranged into beats by
 :class:`~rvsm.rtl.stream.schedule.StreamSchedule`; the component is driven in
@@ -108,7 +112,6 @@ from rvsm.rtl.stream.signatures import (
     code_beat_signature,
     spike_beat_signature,
     threshold_word_bits,
-    threshold_write_signature,
 )
 from rvsm.rtl.stream.state_stage import StateStage
 from rvsm.rtl.stream.sum_stage import SumStage
@@ -145,6 +148,15 @@ class StreamProbes:
     window_valid: Value
     sums: list[list[Value]]
     sum_valid: Value
+
+
+def _shared_threshold_docs(contract: ArrayContract) -> dict[str, str]:
+    """The threshold ports of an array with one threshold register per scale."""
+    c = contract
+    return {"thr_we": "threshold write enable (one scale's register per rising edge)",
+            "thr_addr": f"scale s, 0..{c.num_scales - 1} (threshold.storage = shared)",
+            "thr_data": f"the scale's threshold, 1..{(1 << c.threshold_bits) - 1} "
+                        f"(configured to {', '.join(map(str, c.shared_thresholds))})"}
 
 
 class RvsmStreamArray(wiring.Component):
@@ -184,8 +196,7 @@ class RvsmStreamArray(wiring.Component):
             "codes": In(code_beat_signature(c.adc_bits, geo.lanes)),
             "spikes": Out(spike_beat_signature(c.num_scales, geo.lanes, c.height,
                                                geo.groups)),
-            "thr": In(threshold_write_signature(c.num_scales, geo.beats_per_frame,
-                                                geo.lanes, c.threshold_bits)),
+            "thr": In(geo.threshold_bus),
             "clear": In(1),
         })
 
@@ -206,10 +217,11 @@ class RvsmStreamArray(wiring.Component):
             "codes_ready": "the array accepts a beat (low only while clear is high)",
             "spikes_payload": "one output beat (fields below): position and S*P spikes",
             "spikes_valid": "high for one cycle when a position is released",
-            "thr_we": "threshold write enable (one memory word per rising edge)",
-            "thr_addr": f"(scale s << {wb}) | (y*{g} + g)",
-            "thr_data": f"{p} thresholds, lane i at bits [i*{c.threshold_bits} +: "
-                        f"{c.threshold_bits}], each 1..{(1 << c.threshold_bits) - 1}",
+            **(_shared_threshold_docs(c) if geo.shared_thresholds else {
+                "thr_we": "threshold write enable (one memory word per rising edge)",
+                "thr_addr": f"(scale s << {wb}) | (y*{g} + g)",
+                "thr_data": f"{p} thresholds, lane i at bits [i*{c.threshold_bits} +: "
+                            f"{c.threshold_bits}], each 1..{(1 << c.threshold_bits) - 1}"}),
             "clear": "synchronous restart of the stream: positions in flight dropped, "
                      "accumulators zero in the next frame, thresholds kept",
         }

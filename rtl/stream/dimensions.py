@@ -18,10 +18,17 @@ from amaranth.lib import data
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.geometry import kernel_radius
+from rvsm.rtl.interfaces import ThresholdWriteSignature
 from rvsm.rtl.receptive_sum import sum_width
 from rvsm.rtl.stream.pipelined_sum import Pipeline, Timed, orbit_terms, weighted_orbits
-from rvsm.rtl.stream.schedule import StreamSchedule
-from rvsm.rtl.stream.signatures import spike_beat_layout
+from rvsm.rtl.stream.schedule import StreamSchedule, pack_lanes
+from rvsm.rtl.stream.signatures import (
+    spike_beat_layout,
+    threshold_word_bits,
+    threshold_write_signature,
+    top_threshold_word,
+)
+from rvsm.rtl.threshold_storage import shared_threshold_values
 
 __all__ = ["StreamGeometry"]
 
@@ -73,6 +80,74 @@ class StreamGeometry:
                 f"the stream array needs more than {self.rmw_depth} beats per frame (its "
                 f"read-modify-write depth); {c.height}x{c.width} at {lanes} lane(s) has "
                 f"{self.beats_per_frame}: use fewer lanes")
+
+    @property
+    def shared_thresholds(self) -> bool:
+        """One threshold register per scale (``threshold.storage = "shared"``) instead of
+        the threshold memories."""
+        return self.contract.shared_thresholds is not None
+
+    @property
+    def threshold_bus(self) -> ThresholdWriteSignature:
+        """The threshold-write bus (:func:`threshold_write_signature`): one memory word
+        of ``P`` thresholds per write, or with shared thresholds one scale's threshold."""
+        c = self.contract
+        return threshold_write_signature(c.num_scales, self.beats_per_frame, self.lanes,
+                                         c.threshold_bits, self.shared_thresholds)
+
+    @property
+    def threshold_words(self) -> int:
+        """Threshold-bus words per scale: ``H*G`` memory words, or 1 (the register)."""
+        return 1 if self.shared_thresholds else self.beats_per_frame
+
+    @property
+    def threshold_data_bits(self) -> int:
+        """Bits of one threshold write: ``P*(W-1)``, or ``W-1`` with shared thresholds."""
+        return self.contract.threshold_bits * (1 if self.shared_thresholds else self.lanes)
+
+    def threshold_reset_data(self, scale: int) -> int:
+        """What a reset restores in scale ``scale``'s words: every threshold at the top
+        rail ``2**(W-1)-1`` (no spike until loaded), or with shared thresholds the
+        register's configuration value, the contract's nominal threshold."""
+        c = self.contract
+        if self.shared_thresholds:
+            return c.shared_thresholds[scale]
+        return top_threshold_word(c.threshold_bits, self.lanes)
+
+    def threshold_address(self, scale: int, word: int) -> int:
+        """The bus address of memory word ``word`` (``y*G + g``) of scale ``scale``:
+        ``(s << word_bits) | word``; with shared thresholds ``s`` (``word`` unused)."""
+        if self.shared_thresholds:
+            return int(scale)
+        return int(scale) << threshold_word_bits(self.beats_per_frame) | int(word)
+
+    def threshold_data(self, values: np.ndarray) -> int:
+        """The bus ``data`` writing thresholds ``values (P,)`` to one word: ``P``
+        thresholds packed, lane 0 lowest; with shared thresholds the one threshold (the
+        values must be equal)."""
+        values = np.asarray(values, dtype=np.int64).reshape(-1)
+        if self.shared_thresholds:
+            return shared_threshold_values(self.contract, values[None])[0]
+        return pack_lanes(values[None], self.contract.threshold_bits)[0]
+
+    def words_written(self, word: int) -> int | slice:
+        """The words (index into ``(H*G,)``) a write addressed to ``word`` changes: that
+        word, or with shared thresholds every word of the scale (one register)."""
+        return slice(None) if self.shared_thresholds else int(word)
+
+    def threshold_writes(self, thresholds: np.ndarray) -> list[tuple[int, int]]:
+        """``(addr, data)`` of every write loading thresholds ``(S, H, W)``: scale by
+        scale, word ``y*G + g`` in order, ``P`` thresholds per word; with shared
+        thresholds one write per scale (:func:`~rvsm.rtl.threshold_storage.
+        shared_threshold_values`: one value per scale, or refused)."""
+        c = self.contract
+        if self.shared_thresholds:
+            return list(enumerate(shared_threshold_values(c, thresholds)))
+        words = self.schedule.threshold_words(np.asarray(thresholds, dtype=np.int64))
+        packed = pack_lanes(words.reshape(-1, self.lanes), c.threshold_bits)
+        n = self.beats_per_frame
+        return [(self.threshold_address(k // n, k % n), word)
+                for k, word in enumerate(packed)]
 
     @property
     def window_lag(self) -> int:
@@ -141,13 +216,15 @@ class StreamGeometry:
 
     @property
     def state_bits(self) -> dict[str, int]:
-        """Memory bits: ``accumulators`` (``S*H*W*A``), ``thresholds`` (``S*H*W*(A-1)``),
-        ``line_buffer`` (``2L*W*N``); the sensor-level account of the same bits, with
-        the devices that hold them, is ``rtl/fpga/camera.py``'s ``StateMemory``."""
+        """Memory bits: ``accumulators`` (``S*H*W*A``), ``thresholds`` (``S*H*W*(A-1)``;
+        0 with shared thresholds, whose ``S*(A-1)`` bits are registers), ``line_buffer``
+        (``2L*W*N``); the sensor-level account of the same bits, with the devices that
+        hold them, is ``rtl/fpga/camera.py``'s ``StateMemory``."""
         c = self.contract
         accumulators = c.num_scales * c.height * c.width
         return {"accumulators": accumulators * c.accumulator_bits,
-                "thresholds": accumulators * c.threshold_bits,
+                "thresholds": 0 if c.shared_thresholds is not None
+                else accumulators * c.threshold_bits,
                 "line_buffer": 2 * self.radius * c.width * c.adc_bits}
 
     @property

@@ -20,7 +20,6 @@ from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.protocol_script import ProtocolScript
 from rvsm.rtl.stream.schedule import OutputBeats, pack_lanes
-from rvsm.rtl.stream.signatures import threshold_word_bits
 
 __all__ = ["BeatCollector", "colliding_threshold_writes", "simulate", "simulate_script",
            "simulate_with_threshold_writes", "threshold_writes", "write_thresholds"]
@@ -31,14 +30,10 @@ FIELDS = ("row", "group", "last", "pos", "neg")
 
 def threshold_writes(geometry: StreamGeometry, thresholds: np.ndarray
                      ) -> list[tuple[int, int]]:
-    """``(addr, data)`` of every threshold word for thresholds ``(S, H, W)``: scale by
-    scale, word ``y*G + g`` in order (``addr = (s << word_bits) | word``)."""
-    c, sched = geometry.contract, geometry.schedule
-    words = sched.threshold_words(np.asarray(thresholds, dtype=np.int64))
-    packed = pack_lanes(words.reshape(-1, geometry.lanes), c.threshold_bits)
-    word_bits = threshold_word_bits(sched.beats_per_frame)
-    n = sched.beats_per_frame
-    return [((k // n) << word_bits | k % n, word) for k, word in enumerate(packed)]
+    """``(addr, data)`` of every threshold write for thresholds ``(S, H, W)``
+    (:meth:`StreamGeometry.threshold_writes`: scale by scale, word ``y*G + g`` in order,
+    ``addr = (s << word_bits) | word``; shared thresholds: ``(s, threshold)``)."""
+    return geometry.threshold_writes(thresholds)
 
 
 async def write_thresholds(ctx, dut: RvsmStreamArray,  # noqa: ANN001 - SimulatorContext
@@ -156,7 +151,6 @@ def simulate_with_threshold_writes(
     c = contract
     dut = RvsmStreamArray(c, lanes, bank_words, mutation=mutation)
     sched = dut.schedule
-    word_bits = threshold_word_bits(sched.beats_per_frame)
     beats = pack_lanes(sched.input_beats(np.asarray(codes, dtype=np.int64)), c.adc_bits)
     out = BeatCollector(dut)
 
@@ -171,7 +165,7 @@ def simulate_with_threshold_writes(
             ctx.set(dut.codes.payload.as_value(), beat or 0)
             s, a, w = writes.get(k, (0, 0, 0))
             ctx.set(dut.thr.we, k in writes)
-            ctx.set(dut.thr.addr, (s << word_bits) | a)
+            ctx.set(dut.thr.addr, dut.geometry.threshold_address(s, a))
             ctx.set(dut.thr.data, w)
             await ctx.tick()
             out.after_edge(ctx, k if beat is not None else -1)
@@ -233,18 +227,20 @@ def colliding_threshold_writes(
     for p in range(steps * hg):
         k = p + lag + 1
         s, lanes_thr = int(rng.integers(c.num_scales)), rng.integers(1, thr_hi, lanes)
+        if geometry.shared_thresholds:  # one register per scale: one value
+            lanes_thr[:] = lanes_thr[0]
         kind = rng.integers(4)  # 0: p's own word, 1: p+1's word, 2: any word, 3: none
         a = [p % hg, (p + 1) % hg, int(rng.integers(hg)), None][kind]
         if a is not None:
-            writes[k] = (s, a, pack_lanes(lanes_thr[None], c.threshold_bits)[0])
+            writes[k] = (s, a, geometry.threshold_data(lanes_thr))
             collisions += kind == 0
         if p % hg == 0:
             frames.append(np.empty_like(state))
             frames_late.append(np.empty_like(state))
         frames[-1][:, p % hg] = state[:, p % hg]
         if a is not None:
-            seen_late[s, a] = lanes_thr
+            seen_late[s, geometry.words_written(a)] = lanes_thr
         frames_late[-1][:, p % hg] = seen_late[:, p % hg]
         if a is not None:
-            state[s, a] = lanes_thr
+            state[s, geometry.words_written(a)] = lanes_thr
     return writes, frames, frames_late, collisions

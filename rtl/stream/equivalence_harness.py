@@ -47,7 +47,7 @@ class StreamEquivalence(StreamHarness):
         m = Module()
         dut = self._array(m)
         c, geo = self.contract, self.geometry
-        p, n, tw = geo.lanes, c.adc_bits, c.threshold_bits
+        p, tw = geo.lanes, c.threshold_bits
         words, hw = geo.beats_per_frame, c.height * c.width
         wb = threshold_word_bits(words)
         ref = RvsmArray(c)
@@ -59,6 +59,15 @@ class StreamEquivalence(StreamHarness):
         # Threshold writes: one threshold (scale, word, lane, value) while loading.
         loading = ~self._beats(m, dut, 1)
         we = AnySeq(1)
+        if geo.shared_thresholds:  # one register per scale on both arrays
+            scale, value = AnySeq(max(1, (c.num_scales - 1).bit_length())), AnySeq(tw)
+            self.check(m, "assume.threshold_write",
+                       ~we | (loading & ~taken & (value != 0) & (scale < c.num_scales)),
+                       "thresholds (1 .. 2**(W-1)-1) are written only while no beat was "
+                       "accepted since the last clear", "assume")
+            m.d.comb += [dut.thr.we.eq(we), dut.thr.addr.eq(scale), dut.thr.data.eq(value),
+                         ref.cfg.we.eq(we), ref.cfg.addr.eq(scale), ref.cfg.data.eq(value)]
+            return self._reference_frames(m, dut, ref, taken, clear)
         scale, word = AnySeq(max(1, (c.num_scales - 1).bit_length())), AnySeq(wb)
         lane, value = AnySeq(max(1, (p - 1).bit_length())), AnySeq(tw)
         self.check(m, "assume.threshold_write",
@@ -81,7 +90,13 @@ class StreamEquivalence(StreamHarness):
         for s in range(c.num_scales):
             with m.If(we & (scale == s)):
                 m.d.sync += shadow[s][word].eq(data)
+        return self._reference_frames(m, dut, ref, taken, clear)
 
+    def _reference_frames(self, m: Module, dut: RvsmStreamArray, ref: RvsmArray,
+                          taken: Value, clear: Value) -> Module:
+        """The reference strobed with each whole frame, then the comparison."""
+        c, geo = self.contract, self.geometry
+        p, n, words = geo.lanes, c.adc_bits, geo.beats_per_frame
         # The reference gets a frame when its last beat is accepted.
         in_pos = self._counter(m, "in_pos", clear, taken, words)
         frame = [Signal(p * n, name=f"frame_w{w}") for w in range(words)]

@@ -150,14 +150,17 @@ class StreamProperties(StreamHarness):
         m = Module()
         dut = self._array(m)
         geo, c = self.geometry, self.contract
-        tw, p = c.threshold_bits, geo.lanes
+        tw = c.threshold_bits
         words = geo.beats_per_frame
         wb = threshold_word_bits(words)
         m.d.comb += [dut.thr.we.eq(AnySeq(1)), dut.thr.addr.eq(AnySeq(len(dut.thr.addr))),
                      dut.thr.data.eq(AnySeq(len(dut.thr.data)))]
-        in_range = Cat(*[dut.thr.data[i * tw:(i + 1) * tw] != 0 for i in range(p)]).all()
-        self.check(m, "assume.threshold_write", ~dut.thr.we | (
-            in_range & (dut.thr.addr[:wb] < words) & (dut.thr.addr[wb:] < c.num_scales)),
+        per_word = len(dut.thr.data) // tw  # P thresholds, or one (shared thresholds)
+        in_range = Cat(*[dut.thr.data[i * tw:(i + 1) * tw] != 0
+                         for i in range(per_word)]).all()
+        where = (dut.thr.addr < c.num_scales) if geo.shared_thresholds else (
+            (dut.thr.addr[:wb] < words) & (dut.thr.addr[wb:] < c.num_scales))
+        self.check(m, "assume.threshold_write", ~dut.thr.we | (in_range & where),
             "a threshold write holds thresholds in 1 .. 2**(W-1)-1 at an existing word "
             "and scale", "assume")
         m.submodules.properties = ElaborateAfter(lambda platform: self._properties(dut))

@@ -93,7 +93,9 @@ def build_script(contract: ArrayContract, lanes: int, codes: np.ndarray,
         clear.append(cl)
 
     words = geo.schedule.threshold_words(thresholds)  # (S, H*G, P)
-    load = [(s, a) for s in range(c.num_scales) for a in range(hg)]
+    if geo.shared_thresholds:  # one write per scale (refused if a scale's values differ)
+        geo.threshold_writes(thresholds)
+    load = [(s, a) for s in range(c.num_scales) for a in range(geo.threshold_words)]
     for _ in load:
         cycle(False)
     seg_info = []  # (first step, first cycle, accepted edges)
@@ -135,6 +137,8 @@ def build_script(contract: ArrayContract, lanes: int, codes: np.ndarray,
         if 0 <= cyc < n_cycles and not we[cyc]:
             we[cyc], w_scale[cyc], w_word[cyc] = True, s, a
             w_data[cyc] = rng.integers(1, max(2, top // 8) + 1, p_lanes)
+            if geo.shared_thresholds:  # a scale's register: one threshold
+                w_data[cyc] = w_data[cyc, 0]
     for _, edges, _ in seg_info:
         released = max(0, len(edges) - lag)
         for p in range(released):
@@ -159,10 +163,12 @@ def _expected(c: ArrayContract, geo: StreamGeometry, seg_info: list, we: np.ndar
     hg, lag, tl, p_lanes, g = (geo.beats_per_frame, geo.lag, geo.threshold_lag, geo.lanes,
                                geo.groups)
     top = (1 << c.threshold_bits) - 1
+    shared = geo.shared_thresholds  # a write sets its scale's register: every word
     w_cycles = np.flatnonzero(we)
     groups_sa: dict[tuple[int, int], np.ndarray] = {}
     for cyc in w_cycles:
-        groups_sa.setdefault((int(w_scale[cyc]), int(w_word[cyc])), []).append(cyc)
+        word_key = -1 if shared else int(w_word[cyc])
+        groups_sa.setdefault((int(w_scale[cyc]), word_key), []).append(cyc)
     parts = {k: [] for k in ("rows", "groups", "last", "spikes", "cycles", "steps")}
     for start, edges, frames in seg_info:
         released = max(0, len(edges) - lag)
@@ -173,8 +179,10 @@ def _expected(c: ArrayContract, geo: StreamGeometry, seg_info: list, we: np.ndar
         word = p % hg
         n_frames = -(-released // hg)
         thr = np.full((n_frames * hg, c.num_scales, p_lanes), top, dtype=np.int64)
+        if shared:  # the registers' configuration value
+            thr[:] = np.asarray(c.shared_thresholds)[None, :, None]
         for (s, a), cycs in groups_sa.items():
-            sel = np.flatnonzero(word == a)
+            sel = np.arange(len(word)) if shared else np.flatnonzero(word == a)
             if not len(sel):
                 continue
             cycs = np.asarray(cycs)
@@ -241,7 +249,10 @@ def random_script(contract: ArrayContract, lanes: int, steps: int, seed: int
         used += cost
     if not segments or segments[-1].cut is not None:  # end drained: every beat comes out
         segments.append(Segment(max(0, min(1, steps - used)), None))
-    return build_script(contract, lanes, base.codes, base.thresholds, segments,
+    thresholds = base.thresholds
+    if geo.shared_thresholds:  # one threshold per scale: each scale's first
+        thresholds = np.broadcast_to(thresholds[:, :1, :1], thresholds.shape).copy()
+    return build_script(contract, lanes, base.codes, thresholds, segments,
                         writes_per_cycle=0.1, collisions=0.25, seed=seed)
 
 

@@ -14,7 +14,6 @@ import numpy as np
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, pack_lanes
-from rvsm.rtl.stream.signatures import threshold_word_bits
 
 __all__ = ["SCRIPT_ARRAYS", "ProtocolScript", "Segment", "load_script", "save_script"]
 
@@ -80,14 +79,19 @@ class ProtocolScript:
         return pack_lanes(self.codes, self.contract.adc_bits)
 
     def thr_addresses(self) -> list[int]:
-        """``thr_addr`` of every cycle: ``(scale << word_bits) | word``."""
-        bits = threshold_word_bits(self.geometry.beats_per_frame)
-        return [int(s) << bits | int(w) for s, w in zip(self.thr_scale, self.thr_word,
-                                                        strict=True)]
+        """``thr_addr`` of every cycle: ``(scale << word_bits) | word`` (shared
+        thresholds: ``scale``; :meth:`StreamGeometry.threshold_address`)."""
+        geo = self.geometry
+        return [geo.threshold_address(s, w) for s, w in zip(self.thr_scale, self.thr_word,
+                                                            strict=True)]
 
     def thr_words(self) -> list[int]:
-        """``thr_data`` of every cycle, lanes packed (lane ``i`` at ``i*(W-1)``)."""
-        return pack_lanes(self.thr_data, self.contract.threshold_bits)
+        """``thr_data`` of every cycle, lanes packed (lane ``i`` at ``i*(W-1)``; shared
+        thresholds: the one threshold, :meth:`StreamGeometry.threshold_data`)."""
+        geo = self.geometry
+        if not geo.shared_thresholds:
+            return pack_lanes(self.thr_data, self.contract.threshold_bits)
+        return [geo.threshold_data(row) for row in self.thr_data]
 
 
 SCRIPT_ARRAYS = ("valid", "codes", "clear", "thr_we", "thr_scale", "thr_word", "thr_data",

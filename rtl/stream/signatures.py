@@ -69,10 +69,14 @@ def top_threshold_word(threshold_bits: int, lanes: int) -> int:
 
 
 def threshold_write_signature(num_scales: int, words: int, lanes: int,
-                              threshold_bits: int) -> ThresholdWriteSignature:
+                              threshold_bits: int, shared: bool = False
+                              ) -> ThresholdWriteSignature:
     """The shared threshold-write bus with one memory word (P thresholds) per write:
     ``data`` lane ``i`` at ``[i*(W-1) +: W-1]``, ``addr = (s << word_bits) | (y*G + g)``
-    (:func:`threshold_word_bits`)."""
+    (:func:`threshold_word_bits`). ``shared`` (one threshold register per scale,
+    ``threshold.storage = "shared"``): ``addr = s`` and ``data`` one threshold."""
+    if shared:
+        return ThresholdWriteSignature(threshold_bits, field_bits(num_scales - 1))
     return ThresholdWriteSignature(lanes * threshold_bits,
                                    field_bits(num_scales - 1) + threshold_word_bits(words))
 

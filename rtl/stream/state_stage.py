@@ -9,6 +9,13 @@ The accumulator read-modify-write needs no forwarding: each address is read and 
 once per frame, ``rmw_depth`` beats apart, and the read is gated by a cheaper superset
 of the collisions (``valid`` of the write-back and ``rmw_guard_bits`` low address bits).
 
+Shared thresholds (``threshold.storage = "shared"``, :attr:`StreamGeometry.shared_thresholds`):
+no threshold memory; per scale one register of W-1 bits, configured to the contract's
+nominal threshold (so the array spikes right with no threshold load; ``rst`` leaves it,
+as it leaves the memories) and written through the same bus (``addr = s``, ``data`` one
+threshold) with the same timing as a memory word: a write accepted at edge ``e`` lands
+at ``e + 1``, and a read (an ``advance`` edge) from ``e + 1`` on sees it.
+
 Threshold writes (the bus ``thr``) pass a register (``thr_*_r``) and land one edge after
 the bus accepts them, so a read at the bus' edge does not see them; a read meeting the
 registered write at the next edge gets its data forwarded after the bank registers (a
@@ -25,7 +32,7 @@ no path from the beat advance into the comparator.
 from __future__ import annotations
 
 import numpy as np
-from amaranth.hdl import Module, Mux, Signal, unsigned
+from amaranth.hdl import Cat, Module, Mux, Signal, Value, unsigned
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -34,11 +41,7 @@ from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.input_stage import control_signature
 from rvsm.rtl.stream.memory_target import GENERIC_MEMORY, MemoryTarget
 from rvsm.rtl.stream.position_stage import read_tap_signature, write_tap_signature
-from rvsm.rtl.stream.signatures import (
-    threshold_word_bits,
-    threshold_write_signature,
-    top_threshold_word,
-)
+from rvsm.rtl.stream.signatures import threshold_word_bits, top_threshold_word
 
 __all__ = ["StateModel", "StateStage", "state_words_layout", "write_back_layout"]
 
@@ -85,22 +88,75 @@ class StateStage(wiring.Component):
             "read": In(read_tap_signature(geo.beats_per_frame)),
             "write": In(write_tap_signature(c.height, geo.groups)),
             "write_data": In(write_back_layout(s, p, wa)),
-            "thr": In(threshold_write_signature(s, geo.beats_per_frame, p, c.threshold_bits)),
+            "thr": In(geo.threshold_bus),
             "words": Out(state_words_layout(s, p, wa)),
         })
 
     def elaborate(self, platform: object) -> Module:
         m = Module()
         c, geo = self.geometry.contract, self.geometry
-        p, words, wa, tw = geo.lanes, geo.beats_per_frame, c.accumulator_bits, \
-            c.threshold_bits
+        p, words, wa = geo.lanes, geo.beats_per_frame, c.accumulator_bits
         advance, read, write = self.ctl.advance, self.read, self.write
         bus = self.thr
-        word_bits = threshold_word_bits(words)
         bus_we = Signal(name="thr_we_r", reset_less=True)
         bus_addr = Signal.like(bus.addr, name="thr_addr_r", reset_less=True)
         bus_data = Signal.like(bus.data, name="thr_data_r", reset_less=True)
         m.d.sync += [bus_we.eq(bus.we), bus_addr.eq(bus.addr), bus_data.eq(bus.data)]
+        self.threshold_memories, self.accumulator_memories = [], []
+        self.threshold_registers = []
+        if geo.shared_thresholds:
+            self._shared_thresholds(m, bus_we, bus_addr, bus_data)
+        else:
+            self._threshold_memories(m, bus_we, bus_addr, bus_data)
+        memory = {"bank_words": geo.bank_words, "read_stages": geo.READ_STAGES,
+                  "target": self.target}
+        for s in range(c.num_scales):
+            held = self.target.held_write
+            acc_mem = BankedMemory(p * wa, words, guard_bits=geo.rmw_guard_bits,
+                                   held_write=held, **memory)
+            m.submodules[f"acc_s{s}"] = acc_mem
+            self.accumulator_memories.append(acc_mem)
+            m.d.comb += [acc_mem.advance.eq(advance), acc_mem.read_addr.eq(read.addr),
+                         acc_mem.read_bank.eq(read.bank), acc_mem.write_en.eq(write.en),
+                         acc_mem.write_addr.eq(write.addr),
+                         acc_mem.write_data.eq(self.write_data[s]),
+                         acc_mem.may_write.eq(write.valid),
+                         acc_mem.advance_next.eq(self.ctl.advance_next),
+                         self.words.acc[s].eq(acc_mem.data)]
+            if held:
+                m.d.comb += acc_mem.write_en_next.eq(write.valid_next)
+        return m
+
+    def _shared_thresholds(self, m: Module, bus_we: Value, bus_addr: Value,
+                           bus_data: Value) -> None:
+        """Per scale one ``W-1``-bit register (configuration value: the contract's
+        nominal threshold, no reset), written where the registered write lands; the
+        value a read at an ``advance`` edge takes (the landing write included) goes
+        through ``READ_STAGES`` advance-loaded registers, so it reaches ``words`` with
+        the accumulators read at that edge: the threshold memories' timing."""
+        c, geo, advance = self.geometry.contract, self.geometry, self.ctl.advance
+        tw = c.threshold_bits
+        for s, nominal in enumerate(c.shared_thresholds):
+            reg = Signal(unsigned(tw), name=f"thr_s{s}", init=nominal, reset_less=True)
+            landing = bus_we & (bus_addr == s)
+            with m.If(landing):
+                m.d.sync += reg.eq(bus_data)
+            read = [Signal(unsigned(tw), name=f"thr_s{s}_q{k}", init=nominal,
+                           reset_less=True) for k in range(geo.READ_STAGES)]
+            with m.If(advance):
+                m.d.sync += [read[0].eq(Mux(landing, bus_data, reg)),
+                             *(b.eq(a) for a, b in zip(read, read[1:], strict=False))]
+            m.d.comb += self.words.thr[s].eq(Cat(*([read[-1]] * geo.lanes)))
+            self.threshold_registers.append(reg)
+
+    def _threshold_memories(self, m: Module, bus_we: Value, bus_addr: Value,
+                            bus_data: Value) -> None:
+        """Per scale a threshold memory, writes forwarded to a read of their word
+        (module docstring)."""
+        c, geo = self.geometry.contract, self.geometry
+        p, words, tw = geo.lanes, geo.beats_per_frame, c.threshold_bits
+        advance, read, bus = self.ctl.advance, self.read, self.thr
+        word_bits = threshold_word_bits(words)
         bus_word = bus_addr[:word_bits]
         bus_scale = bus_addr[word_bits:]
         # bus_addr == read.addr, registered (module docstring)
@@ -117,7 +173,6 @@ class StateStage(wiring.Component):
             m.d.sync += [fwd_data[0].eq(bus_data), fwd_data[1].eq(fwd_data[0])]
         memory = {"bank_words": geo.bank_words, "read_stages": geo.READ_STAGES,
                   "target": self.target}
-        self.threshold_memories, self.accumulator_memories = [], []
         for s in range(c.num_scales):
             thr_mem = BankedMemory(p * tw, words, forward=True,
                                    init_word=top_threshold_word(tw, p), **memory)
@@ -133,21 +188,6 @@ class StateStage(wiring.Component):
                              hit if self.mutation != "stream.no_threshold_forwarding" else 0),
                          thr_mem.forward_data.eq(fwd_data[1]),
                          self.words.thr[s].eq(thr_mem.data)]
-            held = self.target.held_write
-            acc_mem = BankedMemory(p * wa, words, guard_bits=geo.rmw_guard_bits,
-                                   held_write=held, **memory)
-            m.submodules[f"acc_s{s}"] = acc_mem
-            self.accumulator_memories.append(acc_mem)
-            m.d.comb += [acc_mem.advance.eq(advance), acc_mem.read_addr.eq(read.addr),
-                         acc_mem.read_bank.eq(read.bank), acc_mem.write_en.eq(write.en),
-                         acc_mem.write_addr.eq(write.addr),
-                         acc_mem.write_data.eq(self.write_data[s]),
-                         acc_mem.may_write.eq(write.valid),
-                         acc_mem.advance_next.eq(self.ctl.advance_next),
-                         self.words.acc[s].eq(acc_mem.data)]
-            if held:
-                m.d.comb += acc_mem.write_en_next.eq(write.valid_next)
-        return m
 
 
 class StateModel:
@@ -167,6 +207,8 @@ class StateModel:
         self.geometry = geo
         shape = (c.num_scales, geo.beats_per_frame, geo.lanes)
         self.thr = np.full(shape, (1 << c.threshold_bits) - 1, dtype=np.int64)
+        if geo.shared_thresholds:  # every word of a scale holds its one register
+            self.thr[:] = np.array(c.shared_thresholds, dtype=np.int64)[:, None, None]
         self.acc = np.full(shape, -1, dtype=np.int64)
         self._bus: tuple[int, int, np.ndarray] | None = None  # the registered write
         self._reads: list[tuple[np.ndarray, np.ndarray]] = []  # in flight, oldest first
@@ -177,12 +219,14 @@ class StateModel:
              bus: tuple[int, int, np.ndarray] | None) -> None:
         """One rising edge: ``read_addr`` (sampled where ``advance``), the write-back
         (``write_en``, ``write_valid``, ``write_addr``, ``write_data (S, P)``) and the
-        threshold bus this edge accepts (``(scale, word, thresholds (P,))`` or ``None``)."""
+        threshold bus this edge accepts (``(scale, word, thresholds (P,))`` or ``None``;
+        with shared thresholds ``(scale, word, threshold)``, ``word`` unused: the write
+        sets the scale's register, which every word of the model mirrors)."""
         geo = self.geometry
         if self._bus is not None:  # the registered write lands now
             s, word, values = self._bus
             if s < len(self.thr):
-                self.thr[s, word] = values
+                self.thr[s, slice(None) if geo.shared_thresholds else word] = values
         self._bus = bus
         if advance:
             acc = self.acc[:, read_addr].copy()

@@ -169,6 +169,15 @@ def run_checks(contract: ArrayContract, arch: str | Architecture, options: dict[
         raise RvsmError(f"unknown formal check {unknown[0]!r} for --arch {arch} (known: "
                         f"{', '.join(known)})")
     chosen = [c for c in known if c in checks] if checks else known  # registry order
+    skipped = {c: architecture.formal_skip_reason(c, contract) for c in chosen}
+    skipped = {c: why for c, why in skipped.items() if why is not None}
+    if skipped and len(skipped) == len(chosen):
+        name, why = next(iter(skipped.items()))
+        raise RvsmError(f"formal check {name!r} of --arch {arch} does not apply: {why}")
+    for name, why in skipped.items():
+        if progress:
+            progress(f"formal {arch} {name}: skipped ({why})")
+    chosen = [c for c in chosen if c not in skipped]
     if mode is not None and mode not in MODES:
         raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
     if depth is not None and depth < 1:

@@ -120,7 +120,9 @@ class _FormalSetup:
             arch.check(contracts[RESETS[0]], **options)
         except RvsmError:  # e.g. lanes that do not divide the tiny width
             options = arch.resolve()
-        return cls(contracts, options, _sites(arch).formal_checks)
+        checks = tuple(c for c in _sites(arch).formal_checks
+                       if arch.formal_skip_reason(c, contracts[RESETS[0]]) is None)
+        return cls(contracts, options, checks)
 
 
 def _formal(setup: _FormalSetup, arch: Architecture, mutation: str | None, workdir: Path,
@@ -187,6 +189,10 @@ def run_mutants(
             if killed:
                 raise RvsmError(f"the shipped {a.name} RTL fails {killed[0]}; run rvsm formal")
         mutants = [m for m in _sites(a).mutations if names is None or m.name in names]
+        for m in mutants:
+            if m.skip_reason(run.contract) is not None:
+                say(f"{m.name}: skipped ({m.skip_reason(run.contract)})")
+        mutants = [m for m in mutants if m.skip_reason(run.contract) is None]
         for i, m in enumerate(mutants, 1):
             t0 = time.perf_counter()
             killed, passed = [], []

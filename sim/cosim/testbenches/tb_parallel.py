@@ -6,7 +6,8 @@ Inputs (environment, or ``+rvsm_stimulus=`` / ``+rvsm_result=`` plusargs):
 ``spikes (T,S,H,W) int8``, ``clear_before`` (steps before which ``clear`` is pulsed) and
 the contract (``adc_bits``); ``RVSM_RESULT`` -- where the JSON result goes.
 
-Sequence: reset; load every threshold through ``cfg_we/cfg_addr/cfg_data``; then one
+Sequence: reset; load every threshold through ``cfg_we/cfg_addr/cfg_data`` (one per scale
+with shared thresholds, ``indexed_threshold_writes``); then one
 clock per step with ``strobe`` high (inputs driven on the falling edge), a ``clear``
 cycle before each listed step, and a drain of the pipeline. Every cycle where ``valid``
 is high is matched to the next expected step and every accumulator compared.
@@ -23,6 +24,7 @@ from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge
 
 from rvsm.model.fixed.stimulus import load_stimulus
+from rvsm.rtl.threshold_storage import indexed_threshold_writes
 from rvsm.sim.cosim.testbenches.tb_common import clock_and_reset, logic_bits, testbench_arg
 
 MAX_LISTED = 50
@@ -57,10 +59,10 @@ async def array_matches_fixed_twin(dut: object) -> None:
     await clock_and_reset(dut, ("strobe", "clear", "cfg_we", "cfg_addr", "cfg_data",
                                 "codes"))
 
-    for a, thr in enumerate(thresholds.ravel()):
+    for a, thr in indexed_threshold_writes(stim.contract, thresholds):
         dut.cfg_we.value = 1
         dut.cfg_addr.value = a
-        dut.cfg_data.value = int(thr)
+        dut.cfg_data.value = thr
         await FallingEdge(dut.clk)
     dut.cfg_we.value = 0
 

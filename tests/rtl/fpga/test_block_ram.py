@@ -6,7 +6,7 @@ import dataclasses
 
 import pytest
 
-from rvsm.model.fixed.design_point import default_design_point
+from rvsm.model.fixed.design_point import DesignPoint, default_design_point
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.block_ram import (
     MemoryShape,
@@ -179,3 +179,22 @@ def test_devices_without_distributed_ram_keep_the_line_buffer_in_block_ram() -> 
     up5k = pack_state(StateLayout(128, 128, (ScaleState(16, 0),), 7, 0), 1,
                       get_budget("ice40-up5k"))
     assert up5k.extra == 2 and up5k.bram == 0
+
+
+@pytest.mark.parametrize(("kw", "mbit", "blocks"), [
+    ({"model": "dog4"}, (14.0168, 7.2168), (779, 400)),
+    ({"model": "dog2", "shift": 1, "accumulator_bits": 17}, (6.6056, 3.4056), (369, 190)),
+])
+def test_threshold_storage_of_the_point_reaches_the_layout(kw, mbit, blocks) -> None:
+    """threshold.storage = "shared" -> the contract's shared_thresholds -> no threshold
+    memory in the layout, the state memory and the geometry (chip-notes.md figures)."""
+    got_bits, got_blocks = [], []
+    for storage in ("per-pixel", "shared"):
+        c = DesignPoint(threshold_storage=storage, **kw).contract()
+        layout = StateLayout.from_contract(c)
+        assert layout.total_bits == state_memory(c).total
+        assert (layout.threshold_bits == 0) == (storage == "shared")
+        assert (StreamGeometry(c, 40).state_bits["thresholds"] == 0) == (storage == "shared")
+        got_bits.append(round(layout.total_bits / 1e6, 4))
+        got_blocks.append(pack_state(layout, 40, ECP5, "packed").bram)
+    assert tuple(got_bits) == mbit and tuple(got_blocks) == blocks

@@ -214,3 +214,44 @@ def test_fifo_depth_is_checked() -> None:
     with pytest.raises(RvsmError, match="fifo-depth"):
         STREAM_AXIS.check(c, lanes=LANES, fifo_depth=RvsmAxisIp.MIN_FIFO_DEPTH - 1)
     STREAM_AXIS.check(c, lanes=LANES, fifo_depth=RvsmAxisIp.MIN_FIFO_DEPTH)
+
+
+def _shared(c: ArrayContract, thresholds: tuple[int, ...]) -> ArrayContract:
+    import dataclasses
+
+    return dataclasses.replace(c, shared_thresholds=thresholds)
+
+
+def test_shared_thresholds_load_by_scale_and_reset_to_the_nominal_ones() -> None:
+    """threshold.storage = "shared": THR_ADDR a scale only, THR_DATA one threshold; the
+    reset walk restores the nominal thresholds (S cycles), and a load of other values
+    by scale spikes as the twin with them."""
+    c, codes, _ = _run(model="dog2", steps=2)
+    c = _shared(c, (9, 40))
+    dut = RvsmAxisIp(c, LANES)
+    assert [f.name for f in dut.regmap["THR_ADDR"].fields] == ["scale"]
+    assert dut.regmap.thr_chunks == 1 and dut.init_cycles == c.num_scales
+    nominal = np.broadcast_to(np.array(c.shared_thresholds)[:, None, None],
+                              (c.num_scales, c.height, c.width))
+    words, tuser, tlast = input_stream(dut.geometry.schedule, codes, c.adc_bits, True)
+
+    async def bench(cy: Cycler) -> None:
+        await wait_idle(cy)
+        await stream_beats(cy, words, tuser, tlast, ())
+        for _ in range(16):
+            await cy.tick()
+
+    cy = run_bench(dut, bench)
+    beats, *_ = decode_output(dut, cy.out)
+    assert check_beats(dut.geometry.schedule, c.run(codes, nominal), beats)["mismatches"] == 0
+    loaded = np.broadcast_to(np.array([5, 70])[:, None, None], nominal.shape)
+    run = simulate_ip(c, LANES, codes, loaded, fifo_depth=8)
+    got, *_ = decode_output(run.dut, run.out)
+    result = check_beats(run.dut.geometry.schedule, c.run(codes, loaded), got)
+    assert result["mismatches"] == 0 and not any(run.load_responses)
+    assert not np.array_equal(c.run(codes, loaded), c.run(codes, nominal))
+    # a scale out of range is refused; the pattern of a per-pixel point cannot be loaded
+    assert dut.regmap.field("THR_ADDR", "scale").max == 1
+    with pytest.raises(RvsmError, match="shared"):
+        dut.geometry.threshold_writes(np.arange(2 * c.height * c.width).reshape(
+            2, c.height, c.width) + 1)

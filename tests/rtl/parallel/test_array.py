@@ -52,3 +52,38 @@ def test_extremes_saturation_and_clear(reset: str, small_contract, amaranth_sim)
     got = simulate(c, codes, thr, clear_before=clears, vcd_path=amaranth_sim.vcd_path())
     assert np.array_equal(got, want)
     assert (want == -1).any() and (want == 1).any()
+
+
+def _shared(c, thresholds):  # noqa: ANN001, ANN202 - a contract
+    import dataclasses
+
+    return dataclasses.replace(c, shared_thresholds=thresholds)
+
+
+def test_shared_thresholds_by_scale(small_contract, amaranth_sim) -> None:
+    """threshold.storage = "shared": one register per scale (cfg_addr = s), reset to the
+    nominal thresholds: spikes right with no load, and with a load by scale."""
+    c = _shared(small_contract("dog2", 3, 4, acc_bits=12), (30, 80))
+    assert RvsmArray.interface(c).members["cfg"].signature.addr_bits == 1
+    rng = np.random.default_rng(9)
+    codes = rng.integers(0, 16, (12, 3, 4))
+    loaded = np.broadcast_to(np.array([50, 9])[:, None, None], (2, 3, 4))
+    assert RvsmArray.threshold_writes(c, loaded) == [(0, 50), (1, 9)]
+    assert np.array_equal(simulate(c, codes, loaded), c.run(codes, loaded))
+    dut = RvsmArray(c)
+    got = []
+
+    async def bench(ctx) -> None:  # noqa: ANN001
+        for t in range(len(codes)):
+            flat = sum(int(v) << (4 * k) for k, v in enumerate(codes[t].ravel()))
+            ctx.set(dut.codes, flat)
+            ctx.set(dut.strobe, 1)
+            await ctx.tick()
+            ctx.set(dut.strobe, 0)
+            pos, neg = ctx.get(dut.spike_pos), ctx.get(dut.spike_neg)
+            got.append([((pos >> a) & 1) - ((neg >> a) & 1) for a in range(24)])
+
+    amaranth_sim.run(dut, bench)
+    nominal = np.broadcast_to(np.array([30, 80])[:, None, None], (2, 3, 4))
+    want = c.run(codes, nominal)
+    assert np.array_equal(np.array(got).reshape(want.shape), want) and np.abs(want).sum()

@@ -258,3 +258,76 @@ def test_full_sensor_dog4_p40() -> None:
     result = assert_exact(c, 40, codes, thr)
     print(f"full sensor P=40: {result['compared']} spikes compared, "
           f"{time.perf_counter() - t0:.1f} s")
+
+
+def _shared(c: ArrayContract, thresholds: tuple[int, ...]) -> ArrayContract:
+    import dataclasses
+
+    return dataclasses.replace(c, shared_thresholds=thresholds)
+
+
+def _per_scale(c: ArrayContract, values: list[int]) -> np.ndarray:
+    return np.broadcast_to(np.array(values)[:, None, None],
+                           (c.num_scales, c.height, c.width)).copy()
+
+
+@pytest.mark.parametrize("lanes", [1, 3])
+def test_shared_thresholds_load_update_and_collide(lanes: int) -> None:
+    """threshold.storage = "shared": one register per scale, loaded by scale, updated at
+    a frame boundary and written while the stream runs (the memory word's timing: a
+    write meeting a read is not seen by it, the next read sees it)."""
+    c = _shared(model_contract("dog2", 5, 6, reset="subtract"), (40, 90))
+    assert StreamGeometry(c, lanes).threshold_bus.addr_bits == 1
+    codes, _ = random_run(c, 4, seed=61)
+    thr, thr2 = _per_scale(c, [30, 70]), _per_scale(c, [55, 20])
+    assert_exact(c, lanes, codes, thr)
+    integ = FixedIntegrator(thr, c.accumulator_bits, c.signed, c.reset)
+    sums = arithmetic_shift(integer_receptive_sums(codes, c.weight_arrays), c.shift)
+    want = []
+    for t in range(len(codes)):
+        if t == 2:
+            integ.thr = thr2
+        want.append(integ.step(sums[t]))
+    assert_exact(c, lanes, codes, thr, np.stack(want), threshold_updates={2: thr2})
+    geo = StreamGeometry(c, lanes)
+    writes, frames, frames_late, collisions = colliding_threshold_writes(
+        geo, thr, 4, seed=67, thr_hi=200)
+    assert collisions >= 5
+
+    def run(per_frame: list[np.ndarray]) -> np.ndarray:
+        integ = FixedIntegrator(thr, c.accumulator_bits, c.signed, c.reset)
+        return np.stack([integ.__setattr__("thr", per_frame[t].reshape(thr.shape))
+                         or integ.step(sums[t]) for t in range(4)])
+
+    want = run(frames)
+    assert not np.array_equal(want, run(frames_late))
+    got = simulate_with_threshold_writes(c, lanes, codes, thr, writes)
+    result = check_beats(geo.schedule, want, got)
+    assert result["mismatches"] == 0, result["first_mismatch"]
+
+
+def test_shared_thresholds_need_no_load() -> None:
+    """With no threshold write the registers hold the contract's nominal thresholds."""
+    from rvsm.rtl.amaranth_sim import run_simulation
+    from rvsm.rtl.stream.array import RvsmStreamArray
+    from rvsm.rtl.stream.drive import BeatCollector
+    from rvsm.rtl.stream.schedule import pack_lanes
+
+    c = _shared(model_contract("dog2", 5, 6, reset="subtract"), (25, 60))
+    codes, _ = random_run(c, 3, seed=71)
+    dut = RvsmStreamArray(c, 2)
+    beats = pack_lanes(dut.schedule.input_beats(codes), c.adc_bits)
+    out = BeatCollector(dut)
+
+    async def bench(ctx) -> None:  # noqa: ANN001 - SimulatorContext
+        for k, beat in enumerate([*beats, None, None]):
+            ctx.set(dut.codes.valid, beat is not None)
+            ctx.set(dut.codes.payload.as_value(), beat or 0)
+            await ctx.tick()
+            out.after_edge(ctx, k if beat is not None else -1)
+
+    run_simulation(dut, bench)
+    want = c.run(codes, _per_scale(c, [25, 60]))
+    result = check_beats(dut.schedule, want, out.beats())
+    assert result["mismatches"] == 0 and result["compared"] == want.size
+    assert np.abs(want).sum() > 0

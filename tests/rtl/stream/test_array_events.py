@@ -73,3 +73,16 @@ def test_spike_expectation_does_not_pass(small_contract) -> None:
     spike_rules = dataclasses.replace(c, sensor="spike").run(codes, thr)
     result = check_beats(StreamGeometry(c, 3).schedule, spike_rules, got)
     assert result["mismatches"] > 0
+
+
+def test_shared_thresholds_event_sensor(small_contract) -> None:
+    """threshold.storage = "shared" in event-sensor mode: one contrast threshold register
+    per scale, loaded by scale; the array follows the twin."""
+    c = dataclasses.replace(_dvs(small_contract, "dog2", 6, 6, 12), shared_thresholds=(9, 20))
+    rng = np.random.default_rng(3)
+    codes = rng.integers(0, 1 << c.adc_bits, (5, 6, 6))
+    thr = np.broadcast_to(np.array([14, 6])[:, None, None], (2, 6, 6))
+    want = c.run(codes, thr, clear_before=(3,))
+    got = simulate(c, codes, thr, 2, clear_before=(3,))
+    result = check_beats(StreamGeometry(c, 2).schedule, want, got)
+    assert result["mismatches"] == 0 and np.count_nonzero(want)

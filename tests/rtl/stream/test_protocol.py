@@ -191,3 +191,22 @@ def test_bad_segments_are_refused(small_contract) -> None:
         build_script(c, 3, codes, thr, [Segment(2), Segment(1)])
     with pytest.raises(RvsmError, match="cut"):
         build_script(c, 3, codes, thr, [Segment(0, 99)])
+
+
+@pytest.mark.parametrize("lanes", [1, 3])
+def test_random_scripts_with_shared_thresholds(tmp_path: Path, small_contract,
+                                               lanes: int) -> None:
+    """threshold.storage = "shared": scripts load one threshold per scale and write
+    scales while the stream runs (each write reaching every position read after it
+    lands); the array follows every beat and cycle; the file keeps the storage."""
+    import dataclasses
+
+    c = dataclasses.replace(small_contract("dog2", 6, 6, acc_bits=10), reset="subtract",
+                            shared_thresholds=(30, 70))
+    for seed in range(2):
+        script = random_script(c, lanes, 12, seed)
+        assert script.thr_data[script.thr_we].min(axis=1).tolist() == \
+            script.thr_data[script.thr_we].max(axis=1).tolist()  # one value per write
+        _assert_rtl_follows(script)
+    save_script(tmp_path / "s.npz", script)
+    assert load_script(tmp_path / "s.npz").contract == c

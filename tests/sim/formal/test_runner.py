@@ -94,3 +94,21 @@ def test_bad_requests_are_input_errors(formal_point, tmp_path):
         run_checks(contract, "parallel", {}, depth=0, workdir=tmp_path)
     with pytest.raises(RvsmError, match="mutation"):
         run_checks(contract, "parallel", {}, mutation="stream.nothing", workdir=tmp_path)
+
+
+def test_shared_thresholds_formal(formal_point, tmp_path):
+    """threshold.storage = "shared": the parallel array's properties hold (the threshold
+    a scale's register, reset to the nominal one); the stream's check about its
+    threshold memories does not apply and says so."""
+    import dataclasses
+
+    from rvsm.rtl.stream.architecture import STREAM
+
+    shared = dataclasses.replace(formal_point, threshold_storage="shared").contract()
+    report = run_checks(shared, "parallel", {}, workdir=tmp_path / "parallel")
+    assert report.ok, [r.message for r in report.results]
+    assert STREAM.formal_skip_reason("thresholds", shared)
+    assert STREAM.formal_skip_reason("thresholds", formal_point.contract()) is None
+    assert STREAM.formal_skip_reason("tail", shared) is None
+    with pytest.raises(RvsmError, match="does not apply"):
+        run_checks(shared, "stream", {"lanes": 1}, checks=["thresholds"], workdir=tmp_path)

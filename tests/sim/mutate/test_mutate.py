@@ -102,3 +102,24 @@ def test_every_mutation_is_killed(tmp_path, capsys) -> None:
     assert main(["mutate", str(_point(tmp_path)), "--json", "-o", str(tmp_path / "m")]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["killed"] == data["mutations"] == len(MUTATIONS)
+
+
+def test_a_shared_point_skips_the_threshold_memory_mutations() -> None:
+    """threshold.storage = "shared": the shipped array passes every check with one
+    threshold per scale, the memory's mutations are skipped with a word, the others
+    still die."""
+    point = dataclasses.replace(default_design_point().with_size(4, 6),
+                                threshold_storage="shared")
+    c = point.contract()
+    for check in COSIM_CHECKS:
+        assert check.mismatches(c, "stream", 2, None) == 0, check.name
+    assert MUTATIONS["stream.no_threshold_forwarding"].skip_reason(c)
+    assert MUTATIONS["stream.no_threshold_forwarding"].skip_reason(
+        default_design_point().contract()) is None
+    said: list[str] = []
+    names = ("stream.no_threshold_forwarding", "stream.threshold_off_by_one")
+    results = run_mutants(point, ("stream",), 2, ("cosim",), first_kill=True, names=names,
+                          progress=said.append)
+    assert [r.mutation.name for r in results] == ["stream.threshold_off_by_one"]
+    assert results[0].killed
+    assert any("no_threshold_forwarding: skipped" in line for line in said)
