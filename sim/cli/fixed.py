@@ -127,6 +127,9 @@ def run_config_check(args: argparse.Namespace) -> int:
     print(f"  {p.rules.describe_adc(p)}")
     print(f"  weights {p.weight_bits} bits / {p.weight_frac_bits} fraction "
           f"({p.weight_rounding}); shift {p.shift}; accumulator {p.accumulator_bits} bits")
+    storage = ("one register per scale (shared)" if p.shared_thresholds
+               else "a memory word per accumulator (per-pixel)")
+    print(f"  thresholds: {storage}")
     for s, t in enumerate(p.nominal_thresholds()):
         lo, hi = c.sum_range(s)
         what = p.rules.threshold_noun

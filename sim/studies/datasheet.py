@@ -115,7 +115,7 @@ def _assess(inputs: DatasheetInputs, logic: LogicCost | None) -> Feasibility:
     if fp is not None and fp.get("fmax_mhz") and inputs.device.family == "ecp5":
         measured = MeasuredFmax(float(fp["fmax_mhz"]), int(fp["lanes"]),
                                 f"rvsm fpga at {fp['height']}x{fp['width']}")
-    shared = getattr(point, "threshold_storage", "per-pixel") == "shared"
+    shared = point.shared_thresholds
     layout = StateLayout.from_contract(point.contract(), shared_thresholds=shared)
     return assess(layout, inputs.device, Camera(h, w, inputs.rate_hz, clock), logic,
                   measured=measured, organisation=inputs.organisation)
@@ -131,7 +131,7 @@ def _point_section(inputs: DatasheetInputs, logic: LogicCost | None,
     pf, point = inputs.point_file, inputs.point_file.point
     st = state_memory(point.contract())
     s, (h, w) = st.num_scales, point.shape
-    shared = getattr(point, "threshold_storage", "per-pixel") == "shared"
+    shared = point.shared_thresholds
     lines = [f"## {SECTIONS[0]}", "", f"`{pf.path}`: {point.model} "
              f"({point.sensor}), {h}x{w} pixels, {s} scale(s)"
              + (f"; `[rtl]` {', '.join(f'{k} = {v}' for k, v in pf.rtl.items())}"
