@@ -149,7 +149,9 @@ class Architecture:
       ``compared``, ``mismatches``, ``first_mismatch``, ``mismatch_list``;
     * ``testbench``: its per-cycle cocotb testbench module (a name: rtl imports no sim);
       ``long_run_testbench``: its testbench in the long-run harness (``None``: no long
-      runs; the harness needs a ``beats`` stream);
+      runs; the harness needs a ``beats`` stream); ``register_testbench``: the testbench
+      that drives its register file against the register model (``None``: no register
+      file);
     * ``beats``: its :class:`BeatStream` (``None``: it does not stream);
     * ``protocol``: its :class:`ProtocolScripts` (``None``: none);
     * ``mutation_sites``: its :class:`MutationSites` (``None``: no mutations);
@@ -181,6 +183,7 @@ class Architecture:
     extra_outputs: Callable[[Any, Mapping], dict[str, str]] | None = None
     extra_suffixes: tuple[str, ...] = ()
     long_run_testbench: str | None = None
+    register_testbench: str | None = None
     beats: BeatStream | None = None
     protocol: ProtocolScripts | None = None
     simulate_keywords: frozenset[str] = frozenset()

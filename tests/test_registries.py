@@ -102,7 +102,8 @@ def _names_tested(node: ast.AST) -> list[str]:
 def _sources() -> dict[str, tuple[Path, tuple[str, ...]]]:
     """Module -> (file, packages it may import): every sim module, and every rtl module
     outside the architecture packages and the registry."""
-    testbenches = {w.testbench: w for w in WRAPPERS.values()}
+    testbenches = {tb: w for w in WRAPPERS.values()
+                   for tb in (w.testbench, w.register_testbench) if tb is not None}
     out = {}
     for path in sorted((ROOT / "sim").rglob("*.py")):
         module = _module(path, "rvsm.sim", ROOT / "sim")
@@ -125,6 +126,7 @@ def test_the_walk_covers_sim_and_rtl():
     assert NAMES >= {"stream", "parallel", "stream_axis"}
     axis_tb = sources["rvsm.sim.cosim.testbenches.tb_axis"][1]
     assert axis_tb == ("rvsm.rtl.ip",)  # the wrapper's testbench, and only its package
+    assert sources["rvsm.sim.cosim.testbenches.tb_register_map"][1] == ("rvsm.rtl.ip",)
 
 
 def test_nothing_outside_the_registry_knows_an_architecture_by_name():

@@ -185,6 +185,7 @@ STREAM_AXIS = Architecture(
     simulate=simulate_axis,
     compare=_compare,
     testbench="rvsm.sim.cosim.testbenches.tb_axis",
+    register_testbench="rvsm.sim.cosim.testbenches.tb_register_map",
     extra_outputs=_extra_outputs,
     extra_suffixes=(".regs.md", ".regs.json", ".regs.h"),
     beats=STREAM_BEATS,

@@ -98,7 +98,7 @@ def register_map_check(contract: ArrayContract, sim: str = "icarus", seed: int =
         result = run_cocotb(sb, {"RVSM_STIMULUS": str(path.resolve()),
                                  "RVSM_REGMAP": json.dumps({"seed": int(seed),
                                                             "count": int(count)})},
-                            run_dir, test_module="rvsm.sim.cosim.testbenches.tb_register_map")
+                            run_dir, test_module=wrapper.register_testbench)
     except KeyboardInterrupt:
         shutil.rmtree(run_dir, ignore_errors=True)
         raise
