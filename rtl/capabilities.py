@@ -162,7 +162,9 @@ class Architecture:
       others skip it, :meth:`formal_skip_reason`);
     * ``extra_outputs(component, provenance)``: more files for ``rvsm verilog`` beside
       the Verilog, ``{suffix: text}`` with the suffixes of ``extra_suffixes`` (the IP's
-      register map, :mod:`rvsm.rtl.ip.architecture`).
+      register map, :mod:`rvsm.rtl.ip.architecture`);
+    * ``register_map(contract, **options)``: its register map without building it
+      (``None``: no register file).
     """
 
     name: str
@@ -184,6 +186,7 @@ class Architecture:
     extra_suffixes: tuple[str, ...] = ()
     long_run_testbench: str | None = None
     register_testbench: str | None = None
+    register_map: Callable[..., Any] | None = None
     beats: BeatStream | None = None
     protocol: ProtocolScripts | None = None
     simulate_keywords: frozenset[str] = frozenset()

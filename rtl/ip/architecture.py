@@ -25,7 +25,7 @@ from rvsm.rtl.ip.axi_lite import AxiLiteSignature
 from rvsm.rtl.ip.axis import spike_tdata_layout, video_lane_bits
 from rvsm.rtl.ip.drive import decode_output, simulate_ip
 from rvsm.rtl.ip.register_map import regs_c_header, regs_json, regs_markdown
-from rvsm.rtl.ip.wrapper import IP_ARCH, RvsmAxisIp
+from rvsm.rtl.ip.wrapper import IP_ARCH, RvsmAxisIp, ip_regmap
 from rvsm.rtl.ports import port_map
 from rvsm.rtl.stream.architecture import STREAM_BEATS
 from rvsm.rtl.stream.dimensions import StreamGeometry
@@ -186,6 +186,7 @@ STREAM_AXIS = Architecture(
     compare=_compare,
     testbench="rvsm.sim.cosim.testbenches.tb_axis",
     register_testbench="rvsm.sim.cosim.testbenches.tb_register_map",
+    register_map=ip_regmap,
     extra_outputs=_extra_outputs,
     extra_suffixes=(".regs.md", ".regs.json", ".regs.h"),
     beats=STREAM_BEATS,

@@ -67,7 +67,7 @@ from rvsm.rtl.rtl_digest import rtl_digest
 from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.dimensions import StreamGeometry
 
-__all__ = ["IP_ARCH", "RvsmAxisIp"]
+__all__ = ["IP_ARCH", "RvsmAxisIp", "ip_regmap"]
 
 #: The architecture name of the IP in provenance, digests and ``ports.json``.
 IP_ARCH = "stream_axis"
@@ -115,9 +115,7 @@ class RvsmAxisIp(wiring.Component):
         #: The options that build this IP (provenance, digest).
         self.options = {"lanes": self.lanes, "fifo_depth": fifo_depth}
         self.rtl_digest = rtl_digest(contract, IP_ARCH, self.options)
-        self.regmap: RegisterMap = ip_register_map(
-            contract, self.lanes, fifo_depth, self.rtl_digest,
-            design_point_digest(contract), rvsm_version())
+        self.regmap: RegisterMap = ip_regmap(contract, self.lanes, fifo_depth)
         #: The register file (:class:`AxiLiteRegisters`) and the output FIFO: submodules,
         #: attributes so that a bench can observe them.
         self.regs = AxiLiteRegisters(self.regmap)
@@ -304,3 +302,12 @@ class RvsmAxisIp(wiring.Component):
             m.d.sync += scale.eq(regs.wdata[16:16 + len(scale)])
             if not shared:
                 m.d.sync += word.eq(regs.wdata[:len(word)])
+
+
+def ip_regmap(contract: ArrayContract, lanes: int, fifo_depth: int) -> RegisterMap:
+    """The register map of the IP built with ``lanes`` and ``fifo_depth`` (its identity
+    registers hold this build's digests), without building the IP."""
+    options = {"lanes": lanes, "fifo_depth": fifo_depth}
+    return ip_register_map(contract, lanes, fifo_depth,
+                           rtl_digest(contract, IP_ARCH, options),
+                           design_point_digest(contract), rvsm_version())

@@ -252,7 +252,7 @@ def _interfaces_section(inputs: DatasheetInputs, feas: Feasibility) -> list[str]
     p, fifo = feas.lanes, inputs.fifo_depth
     opts = {"lanes": p, "fifo_depth": fifo}
     ip = get_architecture("stream", "axis")
-    regmap = ip.component(contract, **ip.resolve(opts)).regmap  # the IP's own register map
+    regmap = ip.register_map(contract, **ip.resolve(opts))
     lines = [f"## {SECTIONS[3]}", "", f"State memories at P = {p} ({feas.organisation} "
              f"organisation) on {inputs.device.name}:", ""]
     lines += [f"- {r}" for r in feas.packing.rows()]
