@@ -62,8 +62,9 @@ def _port_docs(contract: ArrayContract, lanes: int) -> dict[str, str]:
     p, b, g = geo.lanes, video_lane_bits(c.adc_bits), geo.groups
     docs = {
         "clk": "clock (rising edge); every port is synchronous to it",
-        "rst": "synchronous reset, active high: then the thresholds are set to the top "
-               "rail (STATUS.init) before the input opens",
+        "rst": "synchronous reset, active high: then the thresholds are set to "
+               + ("their nominal values" if geo.shared_thresholds else "the top rail")
+               + " (STATUS.init) before the input opens",
         "s_axis_tdata": f"{p} ADC codes: lane i = pixel (y, g*{p} + i) at bits "
                         f"[i*{b} +: {c.adc_bits}] (each padded to {b} bits); beats in "
                         f"raster order (frame, row y, group g = 0..{g - 1})",
