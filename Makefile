@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep bench-fpga lint diagrams clean
+.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep bench-fpga datasheet lint diagrams clean
 
 setup: $(STAMP)
 
@@ -101,6 +101,17 @@ POINT ?= points/ecp5-85-40khz.toml
 bench-fpga: setup
 	$(BIN)/python scripts/bench_fpga.py $(POINT) -o build/bench-fpga \
 	  $(if $(SIZE),--size $(SIZE)) $(ARGS)
+
+# the shipped point's datasheet, remade from its saved results (docs/datasheet-ecp5-85-40khz/
+# results: rvsm fpga from make bench-fpga, rvsm quality, the 40,000-step rvsm verify, rvsm
+# formal and rvsm mutate, each file naming its command); tests/sim/studies/
+# test_shipped_datasheet.py checks the page against them
+SHEET = docs/datasheet-ecp5-85-40khz
+datasheet: setup
+	$(BIN)/rvsm datasheet points/ecp5-85-40khz.toml -o $(SHEET) --force \
+	  --fpga $(SHEET)/results/fpga.json --quality $(SHEET)/results/quality.json \
+	  --verify $(SHEET)/results/verify.json --formal $(SHEET)/results/formal.json \
+	  --mutate $(SHEET)/results/mutate.json
 
 # the guides' timing diagrams, recorded from amaranth.sim (docs/integration.md, docs/ip.md)
 diagrams: setup

@@ -85,8 +85,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "each field costs, resources against the device (measured with --fpga, else the "
         "feasibility model's estimate), Fmax against the camera's clock, the memory map "
         "and interfaces, image quality (rvsm quality) and what was verified (--verify, "
-        "--regress). Without --fpga it synthesises the lane cost with yosys (about a "
-        "minute; --no-synthesis skips it).")
+        "--regress, --formal, --mutate). Without --fpga it synthesises the lane cost with "
+        "yosys (about a minute; --no-synthesis skips it).")
     p.add_argument("point", help="design point TOML (its [rtl] lanes, if any, are the lanes)")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     p.add_argument("--device", default="ecp5-85", help="device budget (default %(default)s; "
@@ -101,6 +101,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quality", metavar="FILE.json", help="saved rvsm quality POINT --json "
                    "(default: run the study)")
     p.add_argument("--verify", metavar="FILE.json", help="saved rvsm verify ... --json")
+    p.add_argument("--formal", metavar="FILE.json", help="saved rvsm formal POINT --size "
+                   "HxW --json")
+    p.add_argument("--mutate", metavar="FILE.json", help="saved rvsm mutate POINT --json")
     p.add_argument("--regress", metavar="FILE", help="rvsm regress results: its database "
                    "(-o RESULTS.sqlite) or its JUnit XML (--junit FILE.xml)")
     p.add_argument("--picture-scene", metavar="SCENE",
@@ -173,7 +176,8 @@ def _datasheet(args: argparse.Namespace) -> int:
     if not args.rate_hz > 0:
         raise RvsmError(f"--rate-hz must be > 0, got {args.rate_hz:g}")
     device = get_budget(args.device)
-    inputs = [args.point, args.fpga, args.quality, args.verify, args.regress]
+    inputs = [args.point, args.fpga, args.quality, args.verify, args.regress, args.formal,
+              args.mutate]
     check_outputs([Output(args.output, "-o", FOLDER, DATASHEET_FILES)], inputs, args.force)
     pf = di.load_point_file(args.point)
     lanes = args.lanes or pf.lanes
@@ -190,13 +194,15 @@ def _datasheet(args: argparse.Namespace) -> int:
         _same_point(quality, pf.point, args.quality)
     verify = di.load_verify_result(args.verify) if args.verify else None
     regress = di.load_regress(args.regress) if args.regress else None
+    checks = {"formal": di.load_formal_report(args.formal) if args.formal else None,
+              "mutate": di.load_mutate_report(args.mutate) if args.mutate else None}
     picture_scene = _scenes([args.picture_scene]) if args.picture_scene else None
     return _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,
-                           picture_scene, settings)
+                           picture_scene, settings, checks)
 
 
 def _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,  # noqa: ANN001
-                    picture_scene, settings) -> int:
+                    picture_scene, settings, checks) -> int:
     """Compute what was not given, then write every file (all inputs already checked)."""
     from rvsm.model.fixed.design_point import default_design_point
     from rvsm.model.infra.atomic import atomic_path, write_text_atomic
@@ -234,7 +240,8 @@ def _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,  # 
         quality_source=source, lanes=args.lanes, organisation=args.organisation, picture=picture,
         fpga=fpga, fpga_path=args.fpga, lane_cost=lane_cost, verify=verify,
         verify_path=args.verify, regress=regress, regress_path=args.regress,
-        command=command))
+        formal=checks["formal"], formal_path=args.formal, mutate=checks["mutate"],
+        mutate_path=args.mutate, command=command))
     out = Path(args.output)
     for name, fig in sheet.figures.items():
         with atomic_path(out / name) as tmp:

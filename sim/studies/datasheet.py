@@ -74,6 +74,10 @@ class DatasheetInputs:
     verify_path: str | None = None
     regress: RegressSummary | None = None
     regress_path: str | None = None
+    formal: dict[str, Any] | None = None
+    formal_path: str | None = None
+    mutate: dict[str, Any] | None = None
+    mutate_path: str | None = None
     command: str = "rvsm datasheet"
 
 
@@ -330,8 +334,29 @@ def _verification_section(inputs: DatasheetInputs) -> list[str]:
                      f"{r.count('fail')} fail, {r.count('error')} error |")
         bad = [c for c in r.cases if c[2] in ("fail", "error")]
         lines += [f"| - {c[1]} | | {c[2]} |" for c in bad[:20]]
-    lines += ["", "Sources: the saved results named above (--verify, --regress); a check "
-              "without one says \"not run\".", ""]
+    f = inputs.formal
+    if f is None:
+        lines.append("| formal checks (tiny size) | `rvsm formal POINT --size HxW --json` | "
+                     "not run |")
+    else:
+        h, w = f["size"]
+        lanes = (f.get("options") or {}).get("lanes")
+        done = "; ".join(f"{c['check']} {c['status']} ({c.get('mode', '?')}, depth "
+                         f"{c.get('depth', '?')})" for c in f["checks"])
+        lines.append(f"| formal checks, {f.get('model', '?')} {h}x{w}"
+                     f"{f', P = {lanes}' if lanes else ''} | `rvsm formal ... --json` saved "
+                     f"as `{inputs.formal_path}` | {'PASS' if f.get('ok') else 'FAIL'}: "
+                     f"{done} |")
+    m = inputs.mutate
+    if m is None:
+        lines.append("| mutation testing (tiny size) | `rvsm mutate POINT --json` | not run |")
+    else:
+        survivors = ", ".join(m["survivors"]) or "none"
+        lines.append(f"| mutation testing ({', '.join(m.get('checks', []))}) | `rvsm mutate "
+                     f"... --json` saved as `{inputs.mutate_path}` | {m['killed']} of "
+                     f"{m['mutations']} mutations killed; survivors: {survivors} |")
+    lines += ["", "Sources: the saved results named above (--verify, --regress, --formal, "
+              "--mutate); a check without one says \"not run\".", ""]
     return lines
 
 

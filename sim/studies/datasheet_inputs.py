@@ -7,6 +7,8 @@ results of other commands, each checked before anything is computed or written.
 - ``--fpga FILE.json``: ``rvsm fpga POINT --json`` (nextpnr's LUT4, FF, DP16KD, Fmax);
 - ``--quality FILE.json``: ``rvsm quality POINT --json``;
 - ``--verify FILE.json``: ``rvsm verify ... --json`` (spikes compared, mismatches);
+- ``--formal FILE.json``: ``rvsm formal POINT --size HxW --json`` (each check's status);
+- ``--mutate FILE.json``: ``rvsm mutate POINT --json`` (mutations killed, survivors);
 - ``--regress FILE``: the results database of ``rvsm regress PLAN -o FILE.sqlite`` or its
   JUnit XML (``--junit FILE.xml``).
 
@@ -34,6 +36,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.text_files import read_utf8_text
 
 __all__ = ["PointFile", "RegressSummary", "load_fpga_report", "load_point_file",
+           "load_formal_report", "load_mutate_report",
            "load_regress", "load_regress_database", "load_regress_junit",
            "load_verify_result", "read_json_object", "read_result_text"]
 
@@ -143,6 +146,31 @@ class RegressSummary:
     def count(self, status: str) -> int:
         """Cases with ``status``."""
         return sum(1 for c in self.cases if c[2] == status)
+
+
+def load_formal_report(path: str | os.PathLike) -> dict[str, Any]:
+    """An ``rvsm formal --json`` report: ``checks`` (each ``check``, ``mode``, ``depth``,
+    ``status``), ``size`` and ``model``."""
+    hint = "make it with rvsm formal POINT --size HxW --json > FILE.json"
+    d = read_json_object(path, "rvsm formal report", hint)
+    checks = d.get("checks")
+    if not isinstance(checks, list) or not all(
+            isinstance(c, dict) and {"check", "status"} <= set(c) for c in checks) \
+            or not isinstance(d.get("size"), list):
+        raise RvsmError(f"{path}: not an rvsm formal report (no checks and size); {hint}")
+    return d
+
+
+def load_mutate_report(path: str | os.PathLike) -> dict[str, Any]:
+    """An ``rvsm mutate --json`` report: ``mutations``, ``killed``, ``survivors``,
+    ``checks``."""
+    hint = "make it with rvsm mutate POINT --json > FILE.json"
+    d = read_json_object(path, "rvsm mutate report", hint)
+    if not all(_number(d.get(k)) for k in ("mutations", "killed")) \
+            or not isinstance(d.get("survivors"), list):
+        raise RvsmError(f"{path}: not an rvsm mutate report (no mutations, killed and "
+                        f"survivors); {hint}")
+    return d
 
 
 def load_regress(path: str | os.PathLike) -> RegressSummary:

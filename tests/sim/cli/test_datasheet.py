@@ -48,8 +48,15 @@ def files(tmp_path_factory) -> dict[str, Path]:
         '<?xml version="1.0"?><testsuites><testsuite name="smoke" tests="2">'
         '<testcase name="run-a"/><testcase name="run-b"><failure message="x"/></testcase>'
         "</testsuite></testsuites>\n")
+    (d / "formal.json").write_text(json.dumps({
+        "arch": "stream", "options": {"lanes": 2}, "ok": True, "size": [3, 4], "model": "dog2",
+        "checks": [{"check": "protocol", "mode": "bmc", "depth": 30, "status": "pass"},
+                   {"check": "tail", "mode": "prove", "depth": 12, "status": "pass"}]}))
+    (d / "mutate.json").write_text(json.dumps({"checks": ["cosim", "formal"], "mutations": 15,
+                                               "killed": 14, "survivors": ["stream.odd"]}))
     return {"point": point, "quality": quality, "csv": d / "q.csv", "fpga": d / "fpga.json",
-            "verify": d / "verify.json", "junit": d / "junit.xml"}
+            "verify": d / "verify.json", "junit": d / "junit.xml",
+            "formal": d / "formal.json", "mutate": d / "mutate.json"}
 
 
 def test_defaults_match_the_study():
@@ -88,7 +95,8 @@ def test_datasheet_with_every_saved_result(files, tmp_path):
     out = tmp_path / "sheet"
     rc = main(["datasheet", str(files["point"]), "-o", str(out), "--quality",
                str(files["quality"]), "--fpga", str(files["fpga"]), "--verify",
-               str(files["verify"]), "--regress", str(files["junit"]), "--quiet"])
+               str(files["verify"]), "--regress", str(files["junit"]), "--formal",
+               str(files["formal"]), "--mutate", str(files["mutate"]), "--quiet"])
     assert rc == 0
     md = (out / "datasheet.md").read_text()
     assert _sections(md) == list(SECTIONS)
@@ -106,6 +114,9 @@ def test_datasheet_with_every_saved_result(files, tmp_path):
     assert "`THR_DATA0`" in md and "`s_axis_tdata`" in md and "`codes_payload`" in md
     assert "PASS: 4,321 spikes compared" in md
     assert "1 of 2 pass, 1 fail" in md and "| - run-b | | fail |" in md
+    assert ("PASS: protocol pass (bmc, depth 30); tail pass (prove, depth 12)" in md
+            and "dog2 3x4, P = 2" in md)
+    assert "14 of 15 mutations killed; survivors: stream.odd" in md
     assert "| not run |" not in md.split("## Verification")[1]
     q = json.loads(files["quality"].read_text())
     assert f"| coin | {q['rows'][0]['psnr_twin']:.2f} |" in md
@@ -133,7 +144,7 @@ def test_datasheet_runs_the_study_and_says_what_is_missing(files, tmp_path, monk
     assert "P = 8 lanes (--lanes)" in md and "16 x 24/8 x 10,000" in md
     assert "measured: not given" in md and "timing model" in md
     verification = md.split("## Verification")[1]
-    assert verification.count("| not run |") == 2
+    assert verification.count("| not run |") == 4  # verify, regress, formal, mutate
     assert "rvsm quality" in md.split("## Image quality")[1]
 
 
@@ -159,7 +170,7 @@ def test_regress_database_is_read(tmp_path):
 
 
 @pytest.mark.parametrize("case", ["missing", "bad_json", "other_point", "bad_lanes",
-                                  "bad_fpga", "device", "bad_rtl"])
+                                  "bad_fpga", "device", "bad_rtl", "bad_formal"])
 def test_datasheet_refusals_leave_nothing(files, tmp_path, capsys, case):
     out = tmp_path / "sheet"
     other = tmp_path / "other.json"
@@ -181,6 +192,9 @@ def test_datasheet_refusals_leave_nothing(files, tmp_path, capsys, case):
         args += ["--fpga", str(other)]
     elif case == "device":
         args += ["--device", "no-such-chip"]
+    elif case == "bad_formal":
+        other.write_text(json.dumps({"checks": "all fine"}))
+        args += ["--formal", str(other)]
     else:
         point = tmp_path / "p.toml"
         point.write_text(files["point"].read_text().replace("lanes = 4", "lanes = 0"))
