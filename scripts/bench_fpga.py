@@ -18,7 +18,8 @@ small wrapper and prints:
   (``sensor_clock_needed_mhz``: the point's sensor at 40 kHz steps).
 
 The figures go to ``OUT/bench.json`` as well (``--bench-json`` elsewhere), with the
-command, the machine's CPU count and load average at the start. A benchmark reports, it
+command, the machine's CPU count and load average at the start, and ``rvsm fpga``'s own
+report to ``OUT/fpga.json`` (what ``rvsm datasheet --fpga`` reads). A benchmark reports, it
 does not judge: exit 0 when the run finished (a missed clock is printed), 3 when it
 failed, 2 for a bad point or option (``rvsm fpga``'s own exit status).
 """
@@ -137,6 +138,10 @@ def measure(point: str, out: Path, extra: list[str]) -> dict:
             raise SystemExit(proc.returncode if proc.returncode in (2, 130) else 3)
         max_kb, cpu = rusage.read_text().split()
     result = json.loads(stdout)
+    from rvsm.model.infra.atomic import write_text_atomic
+
+    # the report itself, as rvsm fpga --json printed it: rvsm datasheet --fpga reads it
+    write_text_atomic(out / "fpga.json", json.dumps(result, indent=1) + "\n")
     r = _report_of(result)
     need = r["sensor_clock_needed_mhz"]
     fmax = r["fmax_mhz"]
