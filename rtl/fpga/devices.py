@@ -182,9 +182,10 @@ class TimingModel:
 
 
 #: The ECP5 measurements of docs/fpga.md, "Best of 3 placer seeds": the default point at
-#: 64x64, speed grade 6, ``--freq 150 --seeds 3``.
+#: 64x64, speed grade 6, ``--freq 150 --seeds 3``; and the full 250x400 sensor at P = 40
+#: (the shipped point, "The full sensor on the ECP5-85").
 ECP5_SPEED6 = TimingModel(
-    family="ecp5", speed="6", what="default point, 64x64, best of 3 seeds, docs/fpga.md",
+    family="ecp5", speed="6", what="64x64 best of 3 seeds, and 250x400 at P = 40; docs/fpga.md",
     points=(
         TimingPoint(1, 160.9, "rvsm fpga point.toml --size 64x64 --lanes 1 --freq 150 "
                               "--seeds 3, 3232ffd"),
@@ -192,6 +193,8 @@ ECP5_SPEED6 = TimingModel(
                               "--seeds 3, 59d4cff"),
         TimingPoint(8, 154.1, "rvsm fpga point.toml --size 64x64 --lanes 8 --freq 150 "
                               "--seeds 3, 59d4cff"),
+        TimingPoint(40, 115.7, "rvsm fpga points/ecp5-85-40khz.toml (250x400, dog2, "
+                               "--lanes 40 --freq 100; make bench-fpga), b28cb49"),
     ),
 )
 

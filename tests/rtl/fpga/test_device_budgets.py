@@ -58,8 +58,11 @@ def test_timing_model_measured_between_and_beyond() -> None:
     assert ECP5_SPEED6.fmax_mhz(4)[0] == 180.3
     f, how = ECP5_SPEED6.fmax_mhz(2)
     assert f == 160.9 and "lower of P = 1 and P = 4" in how
-    f, how = ECP5_SPEED6.fmax_mhz(40)
-    assert f == 154.1 and how.startswith("extrapolated from P = 8")
+    f, how = ECP5_SPEED6.fmax_mhz(25)
+    assert f == 115.7 and "lower of P = 8 and P = 40" in how
+    assert ECP5_SPEED6.fmax_mhz(40)[0] == 115.7  # the full sensor, placed and routed
+    f, how = ECP5_SPEED6.fmax_mhz(50)
+    assert f == 115.7 and how.startswith("extrapolated from P = 40")
     m = TimingModel("x", "1", (TimingPoint(4, 100.0, "s"),), "w")
     assert m.fmax_mhz(1)[0] == 100.0 and "fewest lanes measured" in m.fmax_mhz(1)[1]
 
