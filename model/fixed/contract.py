@@ -402,6 +402,17 @@ class ArrayContract:
         :attr:`shared_thresholds`) or ``"per-pixel"`` (a threshold per accumulator)."""
         return "per-pixel" if self.shared_thresholds is None else "shared"
 
+    def storable_thresholds(self, thresholds: np.ndarray, rng: np.random.Generator
+                            ) -> np.ndarray:
+        """``thresholds (S, H, W)`` as this array can hold them: unchanged per pixel; with
+        shared thresholds, for each scale one of its values (drawn with ``rng``) for every
+        accumulator of the scale. For stimulus generators that draw per accumulator."""
+        if self.shared_thresholds is None:
+            return thresholds
+        flat = np.asarray(thresholds).reshape(len(thresholds), -1)
+        picked = flat[np.arange(len(flat)), rng.integers(0, flat.shape[1], len(flat))]
+        return np.broadcast_to(picked[:, None, None], np.shape(thresholds)).copy()
+
     @property
     def kind(self) -> SensorKind:
         """The sensor kind named by :attr:`sensor`; its ``output`` is the RTL's output

@@ -115,7 +115,7 @@ def corner_stimulus(contract: ArrayContract, seed: int, steps: int) -> Stimulus:
     kind = rng.integers(0, 3, (s, h, w))
     random_thr = rng.integers(1, max(2, top // 4) + 1, (s, h, w))
     thresholds = np.where(kind == 0, top, np.where(kind == 1, exact, random_thr))
-    thresholds = thresholds.astype(np.int64)
+    thresholds = c.storable_thresholds(thresholds.astype(np.int64), rng)
     spikes = c.run(codes, thresholds, clears)
     meta = {"kind": "stimulus", "generator": "corner", "seed": int(seed), "steps": int(steps)}
     return Stimulus(codes.astype(np.uint16), thresholds, spikes, c, None, meta, clears)

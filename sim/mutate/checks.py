@@ -39,25 +39,14 @@ class Stimulus:
     threshold_updates: dict | None = None
 
 
-def _storable(contract: ArrayContract, thresholds: np.ndarray, rng: np.random.Generator
-              ) -> np.ndarray:
-    """``thresholds (S, H, W)`` as the array holds them: per pixel, or with shared
-    thresholds (``threshold.storage = "shared"``) one of each scale's values for every
-    accumulator of the scale (a threshold register per scale)."""
-    if contract.shared_thresholds is None:
-        return thresholds
-    flat = thresholds.reshape(len(thresholds), -1)
-    picked = flat[np.arange(len(flat)), rng.integers(0, flat.shape[1], len(flat))]
-    return np.broadcast_to(picked[:, None, None], thresholds.shape).copy()
-
-
 def stimulus(contract: ArrayContract, kind: str, seed: int = 0) -> Stimulus:
     """The stimulus of check ``kind`` for ``contract`` (seeded). Thresholds are drawn
     around the typical shifted sum of each scale, so an accumulator integrates a few
     steps before it fires and its residual matters; ``exact`` sets each threshold to the
     accumulator's value after the first step (every pixel hits its threshold exactly);
     ``rails`` uses the top threshold, which saturation reaches before firing. With
-    shared thresholds each scale takes one of its drawn values (:func:`_storable`)."""
+    shared thresholds each scale takes one of its drawn values
+    (:meth:`~rvsm.model.fixed.contract.ArrayContract.storable_thresholds`)."""
     from rvsm.model.fixed.contract import arithmetic_shift, integer_receptive_sums
 
     c = contract
@@ -78,14 +67,14 @@ def stimulus(contract: ArrayContract, kind: str, seed: int = 0) -> Stimulus:
         thresholds = np.abs(sums[0])
     if kind == "rails":
         thresholds = np.full(shape, top_thr)
-    thresholds = _storable(c, np.clip(thresholds, 1, top_thr).astype(np.int64), rng)
+    thresholds = c.storable_thresholds(np.clip(thresholds, 1, top_thr).astype(np.int64), rng)
     if kind == "stall":
         return Stimulus(codes, thresholds, idle_every=2)
     if kind == "clear":
         return Stimulus(codes, thresholds, clear_before=(steps // 2,))
     if kind == "threshold_update":
         new = np.clip(rng.permutation(thresholds.ravel()).reshape(shape), 1, top_thr)
-        new = _storable(c, new, rng)
+        new = c.storable_thresholds(new, rng)
         return Stimulus(codes, thresholds, threshold_updates={2: new})
     return Stimulus(codes, thresholds)
 

@@ -65,3 +65,25 @@ def test_unsigned_model_marks_the_negative_bins_unreachable(small_contract) -> N
 def test_too_few_steps_is_one_clear_error(small_contract) -> None:
     with pytest.raises(RvsmError, match="--steps >="):
         corner_stimulus(small_contract("dog4", 3, 3), 1, 5)
+
+
+def test_a_shared_threshold_point_gets_one_threshold_per_scale() -> None:
+    """Regression plans draw random and corner stimuli for every point: an array with one
+    threshold register per scale must get thresholds it can hold (the regression of the
+    shipped ECP5-85 point refused 32 of 42 runs before)."""
+    import dataclasses
+
+    from rvsm.model.fixed.design_point import DesignPoint
+
+    point = dataclasses.replace(DesignPoint(height=6, width=8, model="dog2"),
+                                threshold_storage="shared")
+    c = point.contract()
+    for seed in range(4):
+        stim = corner_stimulus(c, seed, 40)
+        flat = stim.thresholds.reshape(c.num_scales, -1)
+        assert (flat == flat[:, :1]).all()  # one value per scale
+        assert np.array_equal(stim.spikes, c.run(stim.codes.astype(np.int64),
+                                                 stim.thresholds, stim.clear_before))
+    per_pixel = dataclasses.replace(point, threshold_storage="per-pixel").contract()
+    thr = corner_stimulus(per_pixel, 0, 40).thresholds.reshape(per_pixel.num_scales, -1)
+    assert (thr != thr[:, :1]).any()  # per pixel: as before, a pattern
