@@ -274,6 +274,7 @@ def _verify_wrapper(args: argparse.Namespace, sim: str, work: str, waves: bool,
         r = dict(r)
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]
         r["settings"] = args.build_choice.record(options)
+        r["command"] = getattr(args, "command_line", None)  # what rvsm datasheet quotes
         print(json.dumps(r))
     else:
         c = r["counters"]
@@ -373,6 +374,7 @@ def _verify(args: argparse.Namespace) -> int:
         r = dict(r)
         r["mismatch_list"] = r.get("mismatch_list", [])[:10]
         r["settings"] = args.build_choice.record(options)
+        r["command"] = getattr(args, "command_line", None)  # what rvsm datasheet quotes
         print(json.dumps(r))
     else:
         _print_result(r, arch, args.sim, args.protocol)
@@ -425,6 +427,7 @@ def _verify_shards(args: argparse.Namespace, arch: Architecture, options: dict[s
         r = dict(r)
         r["mismatch_list"] = r["mismatch_list"][:10]
         r["settings"] = args.build_choice.record(options)
+        r["command"] = getattr(args, "command_line", None)  # what rvsm datasheet quotes
         print(json.dumps(r))
     else:
         print(f"{args.sim}, {arch_text(r['arch'], r['options'])}: {r['steps']} steps in "

@@ -320,11 +320,15 @@ def _verification_section(inputs: DatasheetInputs) -> list[str]:
         verdict = "PASS" if v["mismatches"] == 0 else f"FAIL ({v['mismatches']} mismatches)"
         what = ", ".join(f"{k} {v[k]}" for k in ("sim", "arch", "steps", "harness")
                          if k in v)
-        run = ("rvsm verify " + " ".join(
-            [str(v["scene"]), "--fixed", str(v["point"])]
-            + [f"--{k} {v[key]}" for k, key in (("sim", "simulator"), ("harness", "harness"),
-                                                 ("steps", "steps")) if v.get(key)])
-            if v.get("scene") and v.get("point") else "rvsm verify ...")
+        run = "rvsm verify ..."
+        if v.get("command"):
+            run = v["command"]
+        elif v.get("scene") and v.get("point"):  # an older result: its main options, "..."
+            run = "rvsm verify " + " ".join(
+                [str(v["scene"]), "--fixed", str(v["point"])]
+                + [f"--{k} {v[key]}" for k, key in (("sim", "simulator"),
+                                                     ("harness", "harness"), ("steps", "steps"))
+                   if v.get(key)] + ["..."])
         lines.append(f"| RTL against the twin | `{run} --json` saved as "
                      f"`{inputs.verify_path}` | {verdict}: {v['compared']:,} spikes "
                      f"compared{'; ' + what if what else ''} |")
