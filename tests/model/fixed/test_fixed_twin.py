@@ -67,7 +67,13 @@ def test_scene_size_follows_scene(scene):
     assert run.point.shape == SIZE and run.meta["height"] == SIZE[0]
 
 
-def test_converges_to_float_as_widths_grow():
+@pytest.mark.parametrize("sensor", [
+    {},  # no noise, per-pixel thresholds
+    # noise on and shared thresholds: the twin and its float model are the same sensor
+    # (no theta, no V_OS in either; rtl/threshold_storage.py)
+    {"noise": True, "seed": 3, "threshold_storage": "shared"},
+], ids=["plain", "shared-noisy"])
+def test_converges_to_float_as_widths_grow(sensor):
     sc = builtin_scene("character", size=(48, 64), num_frames=11)
     widths = [
         {},
@@ -77,12 +83,17 @@ def test_converges_to_float_as_widths_grow():
     flt = None
     agreements = []
     for kw in widths:
-        p = dataclasses.replace(default_design_point(), height=48, width=64, **kw)
+        p = dataclasses.replace(default_design_point(), height=48, width=64, **sensor, **kw)
         if flt is None:
             flt = sample(sc, p.sampler_config()).spikes
         agreements.append(spike_agreement(simulate_fixed(sc, p).spikes, flt)["agreement"])
     assert agreements[0] < agreements[1] < agreements[2]
     assert agreements[2] >= 0.99, agreements
+    if sensor:  # the per-pixel float model (theta, V_OS) is another sensor: it agrees less
+        other = sample(sc, dataclasses.replace(p, threshold_storage="per-pixel")
+                       .sampler_config()).spikes
+        assert spike_agreement(simulate_fixed(sc, p).spikes, other)["agreement"] \
+            < agreements[2]
 
 
 def test_spike_agreement_definition():

@@ -15,9 +15,7 @@ from rvsm.model.fixed.point_toml import design_point_toml, parse_design_point
 from rvsm.model.fixed.twin import simulate_fixed
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.noise.sensor import NoiseParams, NoiseSource
-from rvsm.model.sampling.twin import sample
 from rvsm.model.scene.library import builtin_scene
-from rvsm.model.sensors.cost import spike_agreement
 
 
 def _point(**kw) -> DesignPoint:  # noqa: ANN003
@@ -89,28 +87,3 @@ def test_event_sensor_shares_thresholds_too() -> None:
     run = simulate_fixed(scene, p, keep_codes=True)
     assert np.array_equal(run.spikes, run.contract.run(run.codes, thr))
     assert sample_events(scene, p.event_config()).events.shape == run.spikes.shape
-
-
-def test_shared_twin_converges_to_its_float_model_under_noise() -> None:
-    """As test_fixed_twin's convergence, with noise on and shared thresholds: the twin
-    and the float model are the same sensor (no theta, no V_OS in either)."""
-    sc = builtin_scene("character", size=(48, 64), num_frames=11)
-    widths = [
-        {},
-        {"adc_bits": 12, "weight_bits": 18, "weight_frac_bits": 16, "accumulator_bits": 32},
-        {"adc_bits": 16, "weight_bits": 24, "weight_frac_bits": 22, "accumulator_bits": 40},
-    ]
-    flt = None
-    agreements = []
-    for kw in widths:
-        p = dataclasses.replace(default_design_point(), height=48, width=64, noise=True,
-                                seed=3, threshold_storage="shared", **kw)
-        if flt is None:
-            flt = sample(sc, p.sampler_config()).spikes
-        agreements.append(spike_agreement(simulate_fixed(sc, p).spikes, flt)["agreement"])
-    assert agreements[0] < agreements[1] < agreements[2]
-    assert agreements[2] >= 0.99, agreements
-    # the per-pixel float model (theta, V_OS) is another sensor: it agrees less
-    other = sample(sc, dataclasses.replace(p, threshold_storage="per-pixel")
-                   .sampler_config()).spikes
-    assert spike_agreement(simulate_fixed(sc, p).spikes, other)["agreement"] < agreements[2]
