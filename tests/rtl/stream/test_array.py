@@ -53,6 +53,20 @@ def assert_exact(c: ArrayContract, lanes: int, codes: np.ndarray, thr: np.ndarra
     return result
 
 
+def _spikes_with_update(c, codes: np.ndarray, thr: np.ndarray,
+                        updates: dict[int, np.ndarray]) -> np.ndarray:
+    """The twin's spikes ``(T, S, H, W)`` when the thresholds become ``updates[t]`` from
+    step ``t`` on (a threshold write while the input pauses)."""
+    integ = FixedIntegrator(thr, c.accumulator_bits, c.signed, c.reset)
+    sums = arithmetic_shift(integer_receptive_sums(codes, c.weight_arrays), c.shift)
+    want = []
+    for t in range(len(codes)):
+        if t in updates:
+            integ.thr = updates[t]
+        want.append(integ.step(sums[t]))
+    return np.stack(want)
+
+
 @pytest.mark.parametrize("model", MODEL_NAMES)
 def test_every_model_matches_contract(model: str) -> None:
     c = model_contract(model, 5, 6)
@@ -112,14 +126,7 @@ def test_threshold_write_at_frame_boundary() -> None:
     codes, thr = random_run(c, 4, seed=17)
     rng = np.random.default_rng(19)
     thr2 = rng.integers(1, 60, thr.shape)
-    integ = FixedIntegrator(thr, c.accumulator_bits, c.signed, c.reset)
-    sums = arithmetic_shift(integer_receptive_sums(codes, c.weight_arrays), c.shift)
-    want = []
-    for t in range(len(codes)):
-        if t == 2:
-            integ.thr = thr2
-        want.append(integ.step(sums[t]))
-    want = np.stack(want)
+    want = _spikes_with_update(c, codes, thr, {2: thr2})
     assert not np.array_equal(want, c.run(codes, thr))  # the change is visible
     assert_exact(c, 3, codes, thr, want, threshold_updates={2: thr2})
 
@@ -281,23 +288,16 @@ def test_shared_thresholds_load_update_and_collide(lanes: int) -> None:
     codes, _ = random_run(c, 4, seed=61)
     thr, thr2 = _per_scale(c, [30, 70]), _per_scale(c, [55, 20])
     assert_exact(c, lanes, codes, thr)
-    integ = FixedIntegrator(thr, c.accumulator_bits, c.signed, c.reset)
-    sums = arithmetic_shift(integer_receptive_sums(codes, c.weight_arrays), c.shift)
-    want = []
-    for t in range(len(codes)):
-        if t == 2:
-            integ.thr = thr2
-        want.append(integ.step(sums[t]))
-    assert_exact(c, lanes, codes, thr, np.stack(want), threshold_updates={2: thr2})
+    assert_exact(c, lanes, codes, thr, _spikes_with_update(c, codes, thr, {2: thr2}),
+                 threshold_updates={2: thr2})
     geo = StreamGeometry(c, lanes)
     writes, frames, frames_late, collisions = colliding_threshold_writes(
         geo, thr, 4, seed=67, thr_hi=200)
     assert collisions >= 5
 
     def run(per_frame: list[np.ndarray]) -> np.ndarray:
-        integ = FixedIntegrator(thr, c.accumulator_bits, c.signed, c.reset)
-        return np.stack([integ.__setattr__("thr", per_frame[t].reshape(thr.shape))
-                         or integ.step(sums[t]) for t in range(4)])
+        return _spikes_with_update(c, codes, thr, {t: per_frame[t].reshape(thr.shape)
+                                                   for t in range(4)})
 
     want = run(frames)
     assert not np.array_equal(want, run(frames_late))
