@@ -19,7 +19,7 @@ from rvsm.rtl.architectures.registry import (
 )
 from rvsm.rtl.capabilities import Architecture, Option
 from rvsm.rtl.flow_files import DEFAULT_CLOCK_MHZ
-from rvsm.sim.cli.args import add_force_argument, sized_contract
+from rvsm.sim.cli.args import add_force_argument, parse_size_arg, sized_contract
 from rvsm.sim.cli.build_choice import ARCH_DEFAULTS, choose_build
 from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, PLAIN, Output, check_outputs
@@ -149,6 +149,7 @@ def _verilog(args: argparse.Namespace) -> int:
         yosys_stats,
     )
 
+    parse_size_arg(args.size)  # a bad --size is named before the point file is read
     choose_build(args, "verilog", args.point,
                  {**ARCH_DEFAULTS, "freq_mhz": ("clock_mhz", DEFAULT_CLOCK_MHZ)})
     arch, options = command_architecture(args)
