@@ -18,6 +18,19 @@ from rvsm.rtl.toolchain import ToolFailure, describe_status, live_groups, run_to
 from tests.conftest import default_signals
 
 
+def _start_with_tool(script: str, pid_file) -> tuple[subprocess.Popen, int]:
+    """Run ``script`` in a Python child and wait until the tool it starts has written its
+    PID to ``pid_file``: ``(the child, the tool's PID)``, the tool alive."""
+    proc = subprocess.Popen([sys.executable, "-c", script], preexec_fn=default_signals)
+    end = time.monotonic() + 20
+    while not (pid_file.exists() and pid_file.read_text().strip()):
+        assert time.monotonic() < end and proc.poll() is None
+        time.sleep(0.05)
+    child = int(pid_file.read_text())
+    assert _alive(child)
+    return proc, child
+
+
 def _alive(pid: int) -> bool:
     """True while ``pid`` runs (a zombie counts as dead)."""
     try:
@@ -85,13 +98,7 @@ def test_interrupted_parent_kills_the_tool_group(tmp_path: Path, sig: int) -> No
         except KeyboardInterrupt:
             sys.exit(130)
     """)
-    proc = subprocess.Popen([sys.executable, "-c", script], preexec_fn=default_signals)
-    end = time.monotonic() + 20
-    while not (pid_file.exists() and pid_file.read_text().strip()):
-        assert time.monotonic() < end and proc.poll() is None
-        time.sleep(0.05)
-    child = int(pid_file.read_text())
-    assert _alive(child)
+    proc, child = _start_with_tool(script, pid_file)
     time.sleep(0.5)  # the parent is waiting for its tool now
     os.kill(proc.pid, sig)
     assert proc.wait(timeout=20) == 130
@@ -139,13 +146,7 @@ def test_a_parent_killed_outright_takes_its_tools_along(tmp_path: Path) -> None:
         from rvsm.rtl.toolchain import run_tool
         run_tool(["sh", "-c", "sleep 60 & echo $! > {pid_file}; wait"])
     """)
-    proc = subprocess.Popen([sys.executable, "-c", script], preexec_fn=default_signals)
-    end = time.monotonic() + 20
-    while not (pid_file.exists() and pid_file.read_text().strip()):
-        assert time.monotonic() < end and proc.poll() is None
-        time.sleep(0.05)
-    child = int(pid_file.read_text())
-    assert _alive(child)
+    proc, child = _start_with_tool(script, pid_file)
     proc.kill()
     proc.wait(timeout=20)
     assert _wait_dead(child)
