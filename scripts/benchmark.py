@@ -16,8 +16,9 @@ twice it).
 
 ``api/s`` is the same work through the public whole-array API with its defaults, as a
 user calls it: ``sample(scene, SamplerConfig(model=...))`` and ``simulate_fixed(scene,
-DesignPoint(model=...))`` (the spikes collected into one ``(T, S, H, W)`` array, the fixed
-twin's min/max statistics on); ``api/fused`` is its rate over the fused row's (wall), and
+DesignPoint(model=...))`` (the spikes collected into one ``(T, S, H, W)`` array; the fixed
+twin's min/max statistics off, their default; ``ranges cost`` prints what turning them on
+costs); ``api/fused`` is its rate over the fused row's (wall), and
 ``api/fused cpu`` the same per CPU second. The two are timed alternately in one process
 (best of ``--repeat`` each), so load drifts hit both.
 """
@@ -146,6 +147,17 @@ def verdict(rate: float, target: float | None) -> str:
     return "met" if rate >= target else "MISSED"
 
 
+def print_ranges_cost(scene, repeat: int) -> None:
+    """The cost of the fixed twin's min/max datapath statistics (``ranges=True``, off by
+    default): fixed dog4 noise off with and without them, alternated, best of ``repeat``."""
+    point = DesignPoint(model="dog4")
+    runs = [lambda r=r: stream_fixed(scene, point, NullSink(), ranges=r) for r in (False, True)]
+    ld = load()
+    (off, _), (on, _) = best_times(runs, repeat)
+    print(f"\nranges cost: fixed dog4 off with ranges=True {on:.3f} s against {off:.3f} s "
+          f"without: {on / off:.2f}x the time (load {ld})")
+
+
 def peak_rss(steps: int, out_dir: Path) -> tuple[float, float, str]:
     """``(peak RSS bytes, wall seconds, command)`` of the long dog4 run."""
     spf = 100
@@ -214,6 +226,8 @@ def main() -> None:
               f"{rate / ref_rate:7.1f}x {tgt:>8s} {verdict(rate, target):>6s} {ld:>5s} "
               f"{cpu_rate:11.3g} {api_text((t_fused, cpu_fused), api_times, rate)}",
               flush=True)
+    if args.only in "fixed dog4":  # the ranges line goes with the fixed dog4 rows
+        print_ranges_cost(scene, args.repeat)
     if args.long_steps:
         ld = load()
         with tempfile.TemporaryDirectory() as tmp:

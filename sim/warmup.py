@@ -19,7 +19,11 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["warm_kernels"]
+__all__ = ["HEARTBEAT_SECONDS", "warm_kernels"]
+
+#: A run that compiles for longer says it is still at work this often (seconds): make
+#: setup never waits more than this without a line.
+HEARTBEAT_SECONDS = 10.0
 
 
 #: The CLI runs that reach every kernel: (label, argv after ``rvsm``).
@@ -52,11 +56,18 @@ def _runs(work: Path) -> list[tuple[str, list[str]]]:
     ]
 
 
-def warm_kernels(echo: Callable[[str], None] = print) -> float:
+def warm_kernels(echo: Callable[[str], None] | None = None) -> float:
     """Run every engine path once on a tiny scene (compiling and caching its kernels); the
-    seconds it took. Raises :class:`RuntimeError` naming the run that
-    failed."""
+    seconds it took. ``echo`` says each run's start, time and, every
+    :data:`HEARTBEAT_SECONDS` while it compiles, that it still does (default: standard
+    output as it is now, past the runs' own redirected output). Raises
+    :class:`RuntimeError` naming the run that failed."""
     from rvsm.sim.cli.main import main
+    from rvsm.sim.cosim.builds.build_notes import still
+
+    if echo is None:
+        out = sys.stdout
+        echo = lambda line: print(line, file=out, flush=True)  # noqa: E731
 
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="rvsm-warmup-") as tmp:
@@ -65,7 +76,8 @@ def warm_kernels(echo: Callable[[str], None] = print) -> float:
             t0 = time.perf_counter()
             echo(f"rvsm warm-up {n}/{len(runs)}: {label} ...")
             said = io.StringIO()
-            with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            with still(f"compiling: warm-up {n}/{len(runs)}, {label}", HEARTBEAT_SECONDS,
+                       echo), contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
                 status = main(argv)
             if status != 0:
                 last = said.getvalue().strip().splitlines()[-1:] or [""]
@@ -77,7 +89,8 @@ def warm_kernels(echo: Callable[[str], None] = print) -> float:
 
 if __name__ == "__main__":
     try:
-        seconds = warm_kernels(lambda line: print(line, file=sys.stderr, flush=True))
+        err = sys.stderr  # bound now: each run's own output is redirected while it runs
+        seconds = warm_kernels(lambda line: print(line, file=err, flush=True))
     except KeyboardInterrupt:
         print("rvsm warm-up: interrupted", file=sys.stderr)
         sys.exit(130)

@@ -41,7 +41,7 @@ def fit_point(scene: Scene, point: DesignPoint) -> DesignPoint:
 
 
 def make_twin(scene: Scene, point: DesignPoint, thresholds: np.ndarray, engine: str = "fused",
-              tile_rows: int = DEFAULT_TILE_ROWS, ranges: bool = True,
+              tile_rows: int = DEFAULT_TILE_ROWS, ranges: bool = False,
               block_steps: int = DEFAULT_BLOCK_STEPS, keep_codes: bool = False,
               histograms: bool = False) -> FusedFixedTwin | NumpyFixedTwin:
     """The engine that runs ``point`` on ``scene`` (arguments as :func:`stream_fixed`):
@@ -61,7 +61,7 @@ def stream_fixed(
     engine: str = "fused",
     tile_rows: int = DEFAULT_TILE_ROWS,
     progress: bool = False,
-    ranges: bool = True,
+    ranges: bool = False,
     block_steps: int = DEFAULT_BLOCK_STEPS,
     keep_codes: bool = False,
     histograms: bool = False,
@@ -70,9 +70,11 @@ def stream_fixed(
 
     Returns a :class:`~.results.FixedRun` whose ``spikes`` is ``None`` (they went to the
     sink). A scene whose ``(H, W)`` differs from the point's runs on the same point
-    resized to it (:func:`fit_point`); ``meta`` records the size used. ``ranges=False``
-    lets the fused engine skip the min/max datapath statistics (they stay None; the
-    saturation counts are always kept): about 1.5x faster. ``keep_codes`` keeps every
+    resized to it (:func:`fit_point`); ``meta`` records the size used. The
+    saturation counts are always kept; ``ranges=True`` also tracks the min/max datapath
+    statistics (``sum_min`` .. ``acc_max``; None otherwise) in the fused engine, at about
+    1.3x its time (``make bench``'s ``ranges cost`` line), which is why it is off by
+    default; the numpy engine always tracks them. ``keep_codes`` keeps every
     step's ADC codes in ``codes`` (for stimulus files) and ``histograms`` fills the
     profiling histograms; both run the numpy engine (dark current in blocks of
     ``block_steps``). The event sensor's twin (``array.sensor = "dvs"``) runs the numpy
@@ -114,7 +116,7 @@ def simulate_fixed(
     keep_codes: bool = False,
     histograms: bool = False,
     engine: str = "fused",
-    ranges: bool = True,
+    ranges: bool = False,
 ) -> FixedRun:
     """Run the fixed twin of ``point`` over a whole scene: :func:`stream_fixed` into an
     array, ``spikes (T, S, H, W) int8``; the arguments are :func:`stream_fixed`'s."""

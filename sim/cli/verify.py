@@ -314,7 +314,9 @@ def _long_run_settings(args: argparse.Namespace) -> LongRunSettings:
         raise RvsmError(f"--chunk-steps must be >= 1, got {args.chunk_steps}")
     if args.harness == "cycle" and args.code_coverage:
         raise RvsmError("--code-coverage needs --harness chunk (or auto) and --sim verilator")
-    return LongRunSettings(args.harness, not (args.quiet or args.json), args.chunk_steps,
+    # --json keeps standard output for the result; the progress (bar, phases, a sharded
+    # run's segments) goes to stderr either way, so a long run is never a silent wait
+    return LongRunSettings(args.harness, not args.quiet, args.chunk_steps,
                            args.code_coverage)
 
 

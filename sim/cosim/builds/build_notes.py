@@ -9,7 +9,7 @@ import contextlib
 import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 __all__ = ["HEARTBEAT_SECONDS", "note", "still"]
 
@@ -25,9 +25,12 @@ def note(text: str) -> None:
 
 
 @contextlib.contextmanager
-def still(text: str, every: float | None = None) -> Iterator[None]:
+def still(text: str | Callable[[], str], every: float | None = None,
+          echo: Callable[[str], None] | None = None) -> Iterator[None]:
     """While the block runs, say ``rvsm: still TEXT (M:SS elapsed)`` every ``every`` s
-    (default :data:`HEARTBEAT_SECONDS`)."""
+    (default :data:`HEARTBEAT_SECONDS`). ``text`` may be a callable, asked at each line
+    (a count that moves); ``echo`` writes the line (default :func:`note`'s stderr, as it
+    is when the line is said: give one bound to a stream to say it past a redirection)."""
     period = HEARTBEAT_SECONDS if every is None else every
     done = threading.Event()
     t0 = time.monotonic()
@@ -35,7 +38,11 @@ def still(text: str, every: float | None = None) -> Iterator[None]:
     def beat() -> None:
         while not done.wait(period):
             s = int(time.monotonic() - t0)
-            note(f"still {text} ({s // 60}:{s % 60:02d} elapsed)")
+            line = f"still {text() if callable(text) else text} ({s // 60}:{s % 60:02d} elapsed)"
+            if echo is None:
+                note(line)
+            else:
+                echo(f"rvsm: {line}")
 
     thread = threading.Thread(target=beat, name="rvsm-build-heartbeat", daemon=True)
     thread.start()

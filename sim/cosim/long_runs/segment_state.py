@@ -6,7 +6,10 @@ A segment of steps ``t0 .. t1 - 1`` starts the RTL from the fixed twin's state a
 simulator's boundary as ``$readmemh`` / ``$writememh`` files, one per memory bank
 (:class:`~rvsm.sim.cosim.builds.chunk_harness.StateMemory`: ``acc_s<S>.b<K>.hex``,
 ``thr_s<S>.b<K>.hex``), loaded and dumped by the harness by hierarchical name, never
-through a port of the array.
+through a port of the array. A point with shared thresholds (``threshold.storage =
+"shared"``) has no threshold memories: its state is the accumulators alone, and its
+per-scale threshold registers are written through the threshold bus at the start of
+every segment, as in every long run, and never change.
 
 Word layout (the array's, :mod:`rvsm.rtl.stream.array`): per scale, word ``y*G + g``
 holds the ``P`` lanes of pixels ``(y, g*P + i)``, lane ``i`` at bits ``[i*B +: B]``,
@@ -66,10 +69,14 @@ class SegmentState:
         self.banks = [(k, i, min(b, n - i)) for k, i in enumerate(range(0, n, b))]
 
     def _memories(self, state: np.ndarray) -> list[tuple[str, np.ndarray, int, bool]]:
-        """``(kind, words (S, N, P), bits, signed)`` of the accumulators and thresholds."""
+        """``(kind, words (S, N, P), bits, signed)`` of the accumulators and, for
+        per-pixel thresholds, the threshold memories."""
         sched = self.geo.schedule
-        return [("acc", sched.threshold_words(state), self.acc_bits, True),
-                ("thr", sched.threshold_words(self.source.thresholds), self.thr_bits, False)]
+        memories = [("acc", sched.threshold_words(state), self.acc_bits, True)]
+        if self.source.contract.shared_thresholds is None:
+            memories.append(("thr", sched.threshold_words(self.source.thresholds),
+                             self.thr_bits, False))
+        return memories
 
     def write_start(self, folder: Path) -> None:
         """The state at ``t0`` as the harness's ``state_in/`` files."""

@@ -53,6 +53,7 @@ start of segment 0 is the reset state, not loaded.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import secrets
@@ -67,6 +68,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures.registry import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.capabilities import Architecture
 from rvsm.sim.cosim.builds.build_cache import build
+from rvsm.sim.cosim.builds.build_notes import note, still
 from rvsm.sim.cosim.long_runs.long_run import DEFAULT_CHUNK_STEPS, check_chunks
 
 __all__ = ["SegmentWork", "check_shards", "segment_bounds"]
@@ -180,16 +182,21 @@ def check_shards(
         raise RvsmError(f"the fault's segment {fault[0]} is not one of 0..{len(bounds) - 1}")
     results: list[dict] = []
     t_fan = time.perf_counter()
-    with executor_for(workers, scheduler) as ex:
+    where = scheduler or (f"{workers} worker(s)" if workers else "this process")
+    if progress:
+        note(f"running {len(items)} segments of about {bounds[0][1] - bounds[0][0]} steps "
+             f"on {where}")
+    heartbeat = still(lambda: f"running {len(items)} segments: {len(results)} done") \
+        if progress else contextlib.nullcontext()
+    with heartbeat, executor_for(workers, scheduler) as ex:
         for done in ex.run(items):
             if done.error is not None:
                 raise done.error
             results.append(done.value)
             if progress:
                 r = done.value
-                print(f"segment {r['index']} (steps {r['segment'][0]}..{r['segment'][1] - 1}) "
-                      f"done: {r['mismatches']} mismatches, {r['segment_seconds']:.0f} s",
-                      flush=True)
+                note(f"segment {r['index']} (steps {r['segment'][0]}..{r['segment'][1] - 1}) "
+                     f"done: {r['mismatches']} mismatches, {r['segment_seconds']:.0f} s")
     wall = time.perf_counter() - t_start
     return _whole(results, sb, source, bounds, wall, time.perf_counter() - t_fan, workers,
                   scheduler, a.name, resolved, chunk_steps, root)

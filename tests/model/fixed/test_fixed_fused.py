@@ -39,13 +39,13 @@ def test_fused_equals_numpy(model, noise, reset, case):
                         reset=reset, phi=150.0, **extra)
     assert exact_dtype(point) is dtype
     ref = simulate_fixed(scene, point, engine="numpy", block_steps=7)
-    run = simulate_fixed(scene, point)
+    run = simulate_fixed(scene, point, ranges=True)
     np.testing.assert_array_equal(run.spikes, ref.spikes)
     for name in STATS:
         np.testing.assert_array_equal(getattr(run.stats, name), getattr(ref.stats, name))
     assert run.meta == ref.meta
     fast = ArraySink()
-    quick = stream_fixed(scene, point, fast, chunk_steps=6, tile_rows=5, ranges=False)
+    quick = stream_fixed(scene, point, fast, chunk_steps=6, tile_rows=5)  # default: off
     np.testing.assert_array_equal(fast.spikes, ref.spikes)
     np.testing.assert_array_equal(quick.stats.saturated, ref.stats.saturated)
     assert quick.stats.sum_min is None
@@ -59,7 +59,7 @@ def test_ranges_of_rows_wider_than_a_vector(case):
     point = DesignPoint(height=9, width=71, model="dog4", noise=True, seed=1, phi=90.0,
                         **extra)
     ref = simulate_fixed(scene, point, engine="numpy")
-    run = simulate_fixed(scene, point)
+    run = simulate_fixed(scene, point, ranges=True)
     np.testing.assert_array_equal(run.spikes, ref.spikes)
     for name in STATS:
         np.testing.assert_array_equal(getattr(run.stats, name), getattr(ref.stats, name))
@@ -76,7 +76,8 @@ def test_tiles_chunks_threads_and_streamed_numpy_engine():
             numba.set_num_threads(threads)
             for tile, chunk in ((1, 1), (7, 5), (64, 1000)):
                 sink = ArraySink()
-                run = stream_fixed(scene, point, sink, chunk_steps=chunk, tile_rows=tile)
+                run = stream_fixed(scene, point, sink, chunk_steps=chunk, tile_rows=tile,
+                                   ranges=True)
                 np.testing.assert_array_equal(sink.spikes, ref.spikes)
                 np.testing.assert_array_equal(run.stats.acc_max, ref.stats.acc_max)
     finally:
