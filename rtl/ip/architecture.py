@@ -24,6 +24,7 @@ from rvsm.rtl.capabilities import Architecture, Option
 from rvsm.rtl.ip.axi_lite import AxiLiteSignature
 from rvsm.rtl.ip.axis import spike_tdata_layout, video_lane_bits
 from rvsm.rtl.ip.drive import decode_output, simulate_ip
+from rvsm.rtl.ip.register_harness import ip_registers
 from rvsm.rtl.ip.register_map import regs_c_header, regs_json, regs_markdown
 from rvsm.rtl.ip.wrapper import IP_ARCH, RvsmAxisIp, ip_regmap
 from rvsm.rtl.ports import port_map
@@ -191,4 +192,5 @@ STREAM_AXIS = Architecture(
     extra_outputs=_extra_outputs,
     extra_suffixes=(".regs.md", ".regs.json", ".regs.h"),
     beats=STREAM_BEATS,
+    formal={"registers": ip_registers},
 )

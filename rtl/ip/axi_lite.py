@@ -29,7 +29,7 @@ with that write's data in ``wdata``.
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, Const, Module, Mux, Signal, unsigned
+from amaranth.hdl import Cat, Const, Module, Mux, Signal, Value, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -108,6 +108,17 @@ class AxiLiteRegisters(wiring.Component):
         self.written = {r.name: Signal(name=f"{r.name}_written".lower())
                         for r in regmap.registers}
         self.wdata = Signal(32, name="reg_wdata")
+        self._probes: dict[str, Value] = {}
+
+    @property
+    def probes(self) -> dict[str, Value]:
+        """Internal registers a formal harness observes (:mod:`rvsm.rtl.ip.register_harness`),
+        once elaborated: ``aw_have`` / ``w_have`` (a write address / data accepted, not
+        yet committed) with ``aw_addr``, ``w_data`` and ``w_strb`` (what was accepted), and
+        ``ar_have`` (a read address accepted, its data not yet registered)."""
+        if not self._probes:
+            raise RuntimeError("the register file's probes exist once it is elaborated")
+        return self._probes
 
     def read_value(self, reg: str) -> Cat:
         """The 32-bit value a read of ``reg`` returns."""
@@ -146,6 +157,8 @@ class AxiLiteRegisters(wiring.Component):
         w_data = Signal(32, name="w_data_r", reset_less=True)
         w_strb = Signal(4, name="w_strb_r", reset_less=True)
         bvalid, bresp = Signal(name="bvalid_r"), Signal(2, name="bresp_r")
+        self._probes.update(aw_have=aw_have, w_have=w_have, aw_addr=aw_addr, w_data=w_data,
+                            w_strb=w_strb)
         m.d.comb += [bus.awready.eq(~aw_have & ~bvalid), bus.wready.eq(~w_have & ~bvalid),
                      bus.bvalid.eq(bvalid), bus.bresp.eq(bresp)]
         with m.If(bus.awvalid & bus.awready):
@@ -195,6 +208,7 @@ class AxiLiteRegisters(wiring.Component):
         bus, rm = self.bus, self.regmap
         regs = list(rm.registers)
         ar_have = Signal(name="ar_have")
+        self._probes["ar_have"] = ar_have
         sel = Signal(len(regs), name="ar_sel_r", reset_less=True)
         rvalid = Signal(name="rvalid_r")
         rdata = Signal(32, name="rdata_r", reset_less=True)

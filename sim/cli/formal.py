@@ -12,7 +12,7 @@ from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.sim.cli.args import parse_size_arg
 from rvsm.sim.cli.commands import summary
 from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
-from rvsm.sim.cli.rtl import add_arch_arguments, command_architecture
+from rvsm.sim.cli.rtl import add_arch_arguments, add_interface_arguments, command_architecture
 
 #: The most pixels ``rvsm formal`` takes: solvers handle tiny arrays only (a 3x3
 #: parallel array needs about 2 minutes to prove; docs/formal.md), so a full-size point
@@ -21,11 +21,14 @@ MAX_FORMAL_PIXELS = 64
 
 
 def _check_names() -> str:
-    """Every registered architecture's formal checks, from the registry (``--help``)."""
-    from rvsm.rtl.architectures.registry import ARCHITECTURES
+    """Every registered architecture's and wrapper's formal checks, from the registry
+    (``--help``)."""
+    from rvsm.rtl.architectures.registry import ARCHITECTURES, WRAPPERS
 
-    return "; ".join(f"{name}: {', '.join(a.formal)}" for name, a in ARCHITECTURES.items()
-                     if a.formal)
+    named = [(name, a) for name, a in ARCHITECTURES.items()]
+    named += [(f"{name} --interface {interface}", w)
+              for (name, interface), w in WRAPPERS.items()]
+    return "; ".join(f"{name}: {', '.join(a.formal)}" for name, a in named if a.formal)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -49,6 +52,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", choices=MODEL_NAMES,
                    help="override the point's sampling model (one point, every model)")
     add_arch_arguments(p)
+    add_interface_arguments(p, "native: the array's own checks; axis: the AXI IP's "
+                            "(docs/ip.md), its register file (--check registers)")
     p.add_argument("--depth", type=int, metavar="N",
                    help="steps (clock cycles) to check; default the harness's")
     p.add_argument("--mode", choices=("prove", "bmc", "cover"),
@@ -127,14 +132,18 @@ def _formal(args: argparse.Namespace) -> int:
 
 def _formal_plan(args: argparse.Namespace) -> int:
     """``rvsm formal --plan PLAN.toml``: every run of the plan (:mod:`rvsm.sim.formal.plan`)."""
-    from rvsm.rtl.architectures.registry import ARCHITECTURES
+    from rvsm.rtl.architectures.registry import ARCHITECTURES, NATIVE, WRAPPERS
     from rvsm.sim.formal.plan import load_formal_plan
     from rvsm.sim.formal.plan_run import run_formal_plan
 
-    options = {o.name for a in ARCHITECTURES.values() for o in a.options}
+    options = {o.name for a in (*ARCHITECTURES.values(), *WRAPPERS.values())
+               for o in a.options}
+    interface = None if args.interface == NATIVE else args.interface
     given = [n for n, v in (("POINT", args.point), ("--size", args.size),
                             ("--model", args.model), ("--check", args.check),
-                            *((f"--{o}", getattr(args, o)) for o in sorted(options)))
+                            ("--interface", interface),
+                            *((f"--{o.replace('_', '-')}", getattr(args, o))
+                              for o in sorted(options)))
              if v is not None]
     if given:
         raise RvsmError(f"{', '.join(given)} cannot be combined with --plan: the plan "

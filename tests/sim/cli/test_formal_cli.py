@@ -123,6 +123,27 @@ def test_stream_checks_run_side_by_side(formal_point_toml: Path, formal_point,
     assert (out / "tail" / "formal.log").is_file()
 
 
+def test_the_ip_register_file_is_proven(formal_point_toml: Path, tmp_path: Path,
+                                        capsys: pytest.CaptureFixture) -> None:
+    """``--interface axis`` checks the AXI IP: its register file (docs/ip.md)."""
+    from rvsm.rtl.ip.register_harness import RegisterFileProperties
+
+    argv = ["formal", str(formal_point_toml), "--arch", "stream", "--interface", "axis",
+            "--size", "3x4", "--lanes", "2", "-o", str(tmp_path / "o")]
+    assert main([*argv, "--check", "registers", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert (report["arch"], report["options"]) == ("stream_axis",
+                                                   {"lanes": 2, "fifo_depth": 16})
+    assert [(c["check"], c["mode"], c["status"], c["depth"]) for c in report["checks"]] == [
+        ("registers", "prove", "pass", RegisterFileProperties.depth)]
+    for bad, message in ((["--check", "tail"], "unknown formal check 'tail' for --arch "
+                          "stream_axis"), (["--interface", "native", "--fifo-depth", "8"],
+                                           "--interface axis only")):
+        assert main([*argv, *bad]) == 2
+        err = capsys.readouterr().err.strip()
+        assert message in err and len(err.splitlines()) == 1
+
+
 @pytest.mark.parametrize("extra, message", [
     (("--jobs", "0"), "--jobs"),
     (("--model", "dog9"), "--model"),
@@ -156,12 +177,13 @@ def test_full_size_point_is_refused_at_once(tmp_path: Path,
 def test_help_names_every_registered_check(capsys: pytest.CaptureFixture) -> None:
     """``rvsm formal --help`` listed 5 of the stream's 8 checks (issue 34): the list now
     comes from the registry."""
-    from rvsm.rtl.architectures.registry import ARCHITECTURES
+    from rvsm.rtl.architectures.registry import ARCHITECTURES, WRAPPERS
     from rvsm.sim.cli.main import main
 
     with pytest.raises(SystemExit):
         main(["formal", "--help"])
     text = " ".join(capsys.readouterr().out.split())
-    for name, arch in ARCHITECTURES.items():
+    for name, arch in (*ARCHITECTURES.items(), *WRAPPERS.items()):
         for check in arch.formal:
             assert check in text, (name, check)
+    assert "stream --interface axis: registers" in text

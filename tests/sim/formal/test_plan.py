@@ -97,7 +97,8 @@ def test_a_counterexample_makes_the_plan_exit_1(tiny_plan: Path, tmp_path: Path,
 
 def test_plan_refuses_a_point_and_its_options(tiny_plan: Path, tmp_path: Path,
                                               capsys: pytest.CaptureFixture) -> None:
-    for extra in ([str(TINY)], ["--size", "2x2"], ["--lanes", "2"], ["--check", "x"]):
+    for extra in ([str(TINY)], ["--size", "2x2"], ["--lanes", "2"], ["--check", "x"],
+                  ["--interface", "axis"], ["--fifo-depth", "8"]):
         assert main(["formal", "--plan", str(tiny_plan), "-o", str(tmp_path / "o"),
                      *extra]) == 2
         err = capsys.readouterr().err.strip()
