@@ -67,6 +67,8 @@ formal: setup
 	    $(BIN)/rvsm formal $$point --arch stream --size 3x4 --lanes 2 --model dog2 \
 	      --check protocol state thresholds tail -j $(JOBS) $$mode \
 	      -o build/formal/$$name-stream$$tag; \
+	    $(BIN)/rvsm formal $$point --arch stream --interface axis --check registers \
+	      --size 3x4 --lanes 2 $$mode -o build/formal/$$name-ip$$tag; \
 	  done; \
 	done
 	$(MAKE) formal-equivalence
