@@ -19,11 +19,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["HEARTBEAT_SECONDS", "warm_kernels"]
-
-#: A run that compiles for longer says it is still at work this often (seconds): make
-#: setup never waits more than this without a line.
-HEARTBEAT_SECONDS = 10.0
+__all__ = ["warm_kernels"]
 
 
 #: The CLI runs that reach every kernel: (label, argv after ``rvsm``).
@@ -58,9 +54,10 @@ def _runs(work: Path) -> list[tuple[str, list[str]]]:
 
 def warm_kernels(echo: Callable[[str], None] | None = None) -> float:
     """Run every engine path once on a tiny scene (compiling and caching its kernels); the
-    seconds it took. ``echo`` says each run's start, time and, every
-    :data:`HEARTBEAT_SECONDS` while it compiles, that it still does (default: standard
-    output as it is now, past the runs' own redirected output). Raises
+    seconds it took. ``echo`` says each run's start, time and, every 10 s while it
+    compiles (:data:`~rvsm.sim.cosim.builds.build_notes.HEARTBEAT_SECONDS`), that it
+    still does (default: standard output as it is now, past the runs' own redirected
+    output). Raises
     :class:`RuntimeError` naming the run that failed."""
     from rvsm.sim.cli.main import main
     from rvsm.sim.cosim.builds.build_notes import still
@@ -76,8 +73,8 @@ def warm_kernels(echo: Callable[[str], None] | None = None) -> float:
             t0 = time.perf_counter()
             echo(f"rvsm warm-up {n}/{len(runs)}: {label} ...")
             said = io.StringIO()
-            with still(f"compiling: warm-up {n}/{len(runs)}, {label}", HEARTBEAT_SECONDS,
-                       echo), contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            with still(f"compiling: warm-up {n}/{len(runs)}, {label}", echo=echo), \
+                    contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
                 status = main(argv)
             if status != 0:
                 last = said.getvalue().strip().splitlines()[-1:] or [""]

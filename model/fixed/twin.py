@@ -73,8 +73,9 @@ def stream_fixed(
     resized to it (:func:`fit_point`); ``meta`` records the size used. The
     saturation counts are always kept; ``ranges=True`` also tracks the min/max datapath
     statistics (``sum_min`` .. ``acc_max``; None otherwise) in the fused engine, at about
-    1.3x its time (``make bench``'s ``ranges cost`` line), which is why it is off by
-    default; the numpy engine always tracks them. ``keep_codes`` keeps every
+    1.1x its time (``make bench``'s ``ranges cost`` line: 1.08x at 250x400 dog4), off by
+    default so the default call runs at the benchmark's speed; the numpy engine always
+    tracks them. ``keep_codes`` keeps every
     step's ADC codes in ``codes`` (for stimulus files) and ``histograms`` fills the
     profiling histograms; both run the numpy engine (dark current in blocks of
     ``block_steps``). The event sensor's twin (``array.sensor = "dvs"``) runs the numpy

@@ -13,8 +13,7 @@ import subprocess
 import time
 from pathlib import Path
 
-from rvsm.sim.cosim.builds.build_notes import still
-from rvsm.sim.warmup import HEARTBEAT_SECONDS
+from rvsm.sim.cosim.builds.build_notes import HEARTBEAT_SECONDS, still
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -13,8 +13,9 @@ from collections.abc import Callable, Iterator
 
 __all__ = ["HEARTBEAT_SECONDS", "note", "still"]
 
-#: Seconds between two "still ..." lines of a phase.
-HEARTBEAT_SECONDS = 30.0
+#: Seconds between two "still ..." lines of a phase: no wait is longer without a line
+#: (issue 33: a fresh clone's ``make demo`` may not sit silent for more than 10 s).
+HEARTBEAT_SECONDS = 10.0
 
 
 def note(text: str) -> None:

@@ -97,16 +97,20 @@ def _run_with_progress(sb: SimBuild, inputs: dict, run_dir: Path, total: int, de
     stop = threading.Event()
     bar = progress_bar(total, desc, progress)
 
+    done = [0]
+
+    def catch_up() -> None:
+        try:
+            now = int(progress_file.read_text().split("/")[0])
+        except (OSError, ValueError):
+            return
+        if now > done[0]:
+            bar.update(now - done[0])
+            done[0] = now
+
     def follow() -> None:
-        done = 0
         while not stop.wait(0.5):
-            try:
-                now = int(progress_file.read_text().split("/")[0])
-            except (OSError, ValueError):
-                continue
-            if now > done:
-                bar.update(now - done)
-                done = now
+            catch_up()
 
     thread = threading.Thread(target=follow, daemon=True) if progress else None
     if thread is not None:
@@ -117,6 +121,8 @@ def _run_with_progress(sb: SimBuild, inputs: dict, run_dir: Path, total: int, de
         stop.set()
         if thread is not None:
             thread.join()
+            catch_up()  # the last steps, which a poll every 0.5 s may not have seen
+            bar.refresh()
         bar.close()
 
 
