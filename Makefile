@@ -35,7 +35,7 @@ demo: setup
 	$(BIN)/rvsm demo -o $(OUT)
 
 test: setup
-	$(BIN)/python -m pytest -n $(JOBS) -q
+	$(BIN)/python -m pytest -n $(JOBS) --dist worksteal -q
 
 regress: setup
 	$(BIN)/python -m pytest -n $(JOBS) -q -m "slow or not slow"

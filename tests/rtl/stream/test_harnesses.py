@@ -104,15 +104,17 @@ def test_synthesis_is_chosen_per_group(formal_point):
     assert StreamEquivalence(contract, 2).smtbmc_options("bmc") == ()
 
 
-@pytest.mark.parametrize("group", PROPERTY_GROUPS)
+@pytest.mark.parametrize("group", [g if g == "protocol" else pytest.param(
+    g, marks=pytest.mark.slow) for g in PROPERTY_GROUPS])  # the rest: make formal, -m slow
 def test_shipped_array_holds_to_the_bound(formal_point, tmp_path, group):
     harness = StreamProperties(_contract(formal_point), 2, groups=(group,))
     result = run_sby(harness, tmp_path, mode="bmc", depth=harness.depth)
     assert result.status == "PASS", result.log.read_text()[-2000:]
 
 
-@pytest.mark.parametrize("model, lanes, reset", [("dog2", 2, "subtract"),
-                                                 ("fsm", 1, "zero")])
+@pytest.mark.parametrize("model, lanes, reset", [
+    pytest.param("dog2", 2, "subtract", marks=pytest.mark.slow),  # 73 s; make formal too
+    ("fsm", 1, "zero")])
 def test_bounded_equivalence_with_the_parallel_array(formal_point, tmp_path, model,
                                                      lanes, reset):
     size = (3, 4) if lanes == 2 else (3, 3)

@@ -38,6 +38,7 @@ def test_cli_verify_design_point(tmp_path: Path, capsys: pytest.CaptureFixture) 
     assert out["compared"] == 40 * 4 * 4 * 6
 
 
+@pytest.mark.slow  # 45 s; the long-run harness's replay stays in the default suite
 def test_stimulus_file_replays_on_icarus(tmp_path: Path, capsys: pytest.CaptureFixture,
                                          monkeypatch: pytest.MonkeyPatch) -> None:
     """``rvsm stimulus`` writes what the testbench reads: ``rvsm verify --stimulus FILE``."""

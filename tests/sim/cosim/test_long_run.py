@@ -29,7 +29,10 @@ from rvsm.sim.cosim.builds.chunk_harness import (
 from rvsm.sim.cosim.long_runs.long_run import check_chunks
 from rvsm.sim.cosim.verify import AUTO_CHUNK_BEATS, choose_harness, run_rtl
 
-SIMS = ["icarus", "verilator"]
+#: Icarus in the default suite; the Verilator variants (a build each, 30-45 s) run with
+#: ``-m slow`` (``make regress``); the default suite still builds Verilator elsewhere
+#: (code coverage, protocol scripts, the event mode, regressions)
+SIMS = ["icarus", pytest.param("verilator", marks=pytest.mark.slow)]
 
 
 def _random_stimulus(c: ArrayContract, steps: int, seed: int,

@@ -18,7 +18,10 @@ from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.sim.cosim.verify import run_rtl
 
-SIMS = ["icarus", "verilator"]
+#: Icarus in the default suite; the Verilator variants (a build each, 30-45 s) run with
+#: ``-m slow`` (``make regress``); the default suite still builds Verilator elsewhere
+#: (code coverage, protocol scripts, the event mode, regressions)
+SIMS = ["icarus", pytest.param("verilator", marks=pytest.mark.slow)]
 
 
 @pytest.fixture

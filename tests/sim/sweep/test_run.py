@@ -150,6 +150,7 @@ size = "4x4"
 """
 
 
+@pytest.mark.slow  # 38 s: two syntheses; test_hw_cost_synthesised_once stays
 def test_hw_cost_is_two_syntheses_combined_as_lane_cost_does(tmp_path):
     from rvsm.model.fixed.design_point import default_design_point
     from rvsm.rtl.fpga.lane_cost import lane_cost
