@@ -54,7 +54,7 @@ def _runs(work: Path) -> list[tuple[str, list[str]]]:
 
 def warm_kernels(echo: Callable[[str], None] | None = None) -> float:
     """Run every engine path once on a tiny scene (compiling and caching its kernels); the
-    seconds it took. ``echo`` says each run's start, time and, every 10 s while it
+    seconds it took. ``echo`` says each run's start, time and, every 8 s while it
     compiles (:data:`~rvsm.sim.cosim.builds.build_notes.HEARTBEAT_SECONDS`), that it
     still does (default: standard output as it is now, past the runs' own redirected
     output). Raises
