@@ -69,9 +69,10 @@ from rvsm.rtl.architectures.registry import DEFAULT_ARCHITECTURE, get_architectu
 from rvsm.rtl.capabilities import Architecture
 from rvsm.sim.cosim.builds.build_cache import build
 from rvsm.sim.cosim.builds.build_notes import note, still
+from rvsm.sim.cosim.builds.chunk_harness import StateMemories, state_memories
 from rvsm.sim.cosim.long_runs.long_run import DEFAULT_CHUNK_STEPS, check_chunks
 
-__all__ = ["SegmentWork", "check_shards", "segment_bounds"]
+__all__ = ["SegmentWork", "check_shards", "check_state_fault", "segment_bounds"]
 
 
 def segment_bounds(num_steps: int, shards: int) -> list[tuple[int, int]]:
@@ -127,6 +128,27 @@ class SegmentWork:
         return r
 
 
+def check_state_fault(flip: str, state: StateMemories) -> None:
+    """Refuse a ``FILE:WORD:BIT`` seeded fault that names no bank, word or bit of the
+    design's state (:class:`RvsmError`, exit 2, naming what it does have) before any
+    segment starts: the testbench would otherwise crash on it."""
+    parts = flip.split(":")
+    if len(parts) != 3:
+        raise RvsmError(f"--state-fault must be K:FILE:WORD:BIT, got FILE:WORD:BIT {flip!r}")
+    name, word, bit = parts
+    banks = {b.file: b for b in state.banks}
+    bank = banks.get(name)
+    if bank is None:
+        raise RvsmError(f"--state-fault: {name!r} is not a state file of this design; its "
+                        f"files are {', '.join(sorted(banks))}")
+    if not word.isdigit() or int(word) >= bank.depth:
+        raise RvsmError(f"--state-fault: word {word!r} of {name} is out of range: it has "
+                        f"words 0..{bank.depth - 1}")
+    if not bit.isdigit() or int(bit) >= bank.width:
+        raise RvsmError(f"--state-fault: bit {bit!r} of {name} is out of range: its words "
+                        f"have bits 0..{bank.width - 1}")
+
+
 def check_shards(
     source: StimulusChunks,
     shards: int,
@@ -164,6 +186,8 @@ def check_shards(
     t_start = time.perf_counter()
     # one build for every segment, before fanning out (the cache is keyed by digest)
     sb = build(source.contract, sim, root, arch=a, harness=True, **resolved)
+    if fault is not None:
+        check_state_fault(fault[1], state_memories(sb.verilog.read_text(), sb.top))
     spec = dict(source.spec)
     if not spec:
         if source.stimulus is None:

@@ -153,3 +153,24 @@ def test_bad_shards_are_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture,
     assert main([*args, *bad]) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "w" / "builds").exists()
+
+
+@pytest.mark.parametrize("flip, message", [
+    ("1:acc_s1.b3.hex:5:20", "'acc_s1.b3.hex' is not a state file of this design; its files "
+                             "are acc_s0.b0.hex, acc_s1.b0.hex"),
+    ("1:acc_s1.b0.hex:24:0", "word '24' of acc_s1.b0.hex is out of range: it has words 0..23"),
+    ("1:acc_s1.b0.hex:5:36", "bit '36' of acc_s1.b0.hex is out of range: its words have bits "
+                             "0..35"),
+])
+def test_a_seeded_fault_outside_the_state_is_bad_input(
+        tmp_path: Path, capsys: pytest.CaptureFixture, flip: str, message: str) -> None:
+    """A ``--state-fault`` naming a bank, word or bit the design's state does not have:
+    exit 2 with one line naming what it has, before any segment runs (it crashed the
+    testbench, exit 3, when a user named a fourth bank of the full sensor's three)."""
+    args = ["verify", "coin", "--fixed", str(_point(tmp_path, "shared")), "--steps", "6",
+            "--lanes", "2", "--harness", "chunk", "--sim", "icarus", "--work",
+            str(tmp_path / "w"), "--shards", "2", "--workers", "0", "--state-fault", flip]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == f"rvsm: error: --state-fault: {message}", err
+    assert not list((tmp_path / "w").glob("runs/segment*"))
