@@ -14,7 +14,7 @@ setup: $(STAMP)
 
 $(STAMP): pyproject.toml scripts/install-system-deps.sh
 	$(PYTHON) -m venv $(VENV)
-# every step that can take long prints a line at least every 10 s (scripts/heartbeat.sh)
+# every step that can take long prints a line at least every 8 s (scripts/heartbeat.sh)
 	scripts/heartbeat.sh "upgrading pip" $(BIN)/python -m pip install --quiet --upgrade pip
 	scripts/heartbeat.sh "installing the Python packages" \
 	  $(BIN)/python -m pip install --quiet -e ".[dev,community]"

@@ -1,7 +1,7 @@
 """No silent wait in set-up: the kernel warm-up says it is still compiling while a run
 takes long (:func:`rvsm.sim.cosim.builds.build_notes.still`, bound past each run's
 redirected output), and every long step of ``make setup``
-runs under ``scripts/heartbeat.sh``, which prints a line every 10 s and keeps the step's
+runs under ``scripts/heartbeat.sh``, which prints a line every 8 s and keeps the step's
 exit status (issue 33: a fresh clone sat 99 s at ``0%`` without a word)."""
 
 from __future__ import annotations
@@ -45,12 +45,12 @@ def test_heartbeat_text_may_move() -> None:
                          "rvsm: still running 4 segments: 1 done (0:00 elapsed)"]
 
 
-def test_heartbeat_script_prints_every_ten_seconds_and_keeps_the_status() -> None:
+def test_heartbeat_script_prints_every_eight_seconds_and_keeps_the_status() -> None:
     script = str(ROOT / "scripts" / "heartbeat.sh")
     run = subprocess.run(["sh", script, "sleeping", "sh", "-c", "sleep 11; exit 4"],
                          capture_output=True, text=True, timeout=60)
     assert run.returncode == 4
-    assert run.stderr.strip() == "rvsm setup: still sleeping (10 s)"
+    assert run.stderr.strip() == "rvsm setup: still sleeping (8 s)"
     quick = subprocess.run(["sh", script, "nothing", "true"], capture_output=True, text=True,
                            timeout=60)
     assert quick.returncode == 0 and quick.stderr == ""
