@@ -57,8 +57,7 @@ def warm_kernels(echo: Callable[[str], None] | None = None) -> float:
     seconds it took. ``echo`` says each run's start, time and, every 8 s while it
     compiles (:data:`~rvsm.sim.cosim.builds.build_notes.HEARTBEAT_SECONDS`), that it
     still does (default: standard output as it is now, past the runs' own redirected
-    output). Raises
-    :class:`RuntimeError` naming the run that failed."""
+    output). Raises :class:`RuntimeError` naming the run that failed."""
     from rvsm.sim.cli.main import main
     from rvsm.sim.cosim.builds.build_notes import still
 

@@ -73,7 +73,7 @@ class SegmentState:
         per-pixel thresholds, the threshold memories."""
         sched = self.geo.schedule
         memories = [("acc", sched.threshold_words(state), self.acc_bits, True)]
-        if self.source.contract.shared_thresholds is None:
+        if self.source.contract.threshold_storage == "per-pixel":
             memories.append(("thr", sched.threshold_words(self.source.thresholds),
                              self.thr_bits, False))
         return memories
