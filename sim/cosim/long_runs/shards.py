@@ -57,6 +57,7 @@ import contextlib
 import json
 import os
 import secrets
+import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -112,12 +113,18 @@ class SegmentWork:
         """Unique Dask key."""
         return f"segment-{self.index}-{self.t0}-{self.t1}-{self.token}"
 
+    @property
+    def run_name(self) -> str:
+        """Its run folder's name, ``segment<K>-<token>-<sim>-...``: the run's token tells
+        its folders from another run's sharing the work folder."""
+        return f"segment{self.index}-{self.token}"
+
     def run(self) -> dict[str, Any]:
         """Run the segment (:func:`~.long_run.check_chunks` with ``segment``)."""
         t = time.perf_counter()
         source = open_stimulus_chunks(self.spec)
         r = check_chunks(source, self.sim, work_dir=self.work_dir,
-                         name=f"segment{self.index}", build_root=self.build_root,
+                         name=self.run_name, build_root=self.build_root,
                          arch=self.arch, chunk_steps=self.chunk_steps,
                          segment=(self.t0, self.t1), state_flip=self.state_flip,
                          **self.options)
@@ -212,18 +219,34 @@ def check_shards(
              f"on {where}")
     heartbeat = still(lambda: f"running {len(items)} segments: {len(results)} done") \
         if progress else contextlib.nullcontext()
-    with heartbeat, executor_for(workers, scheduler) as ex:
-        for done in ex.run(items):
-            if done.error is not None:
-                raise done.error
-            results.append(done.value)
-            if progress:
-                r = done.value
-                note(f"segment {r['index']} (steps {r['segment'][0]}..{r['segment'][1] - 1}) "
-                     f"done: {r['mismatches']} mismatches, {r['segment_seconds']:.0f} s")
+    try:
+        with heartbeat, executor_for(workers, scheduler) as ex:
+            for done in ex.run(items):
+                if done.error is not None:
+                    raise done.error
+                results.append(done.value)
+                if progress:
+                    r = done.value
+                    note(f"segment {r['index']} (steps {r['segment'][0]}.."
+                         f"{r['segment'][1] - 1}) done: {r['mismatches']} mismatches, "
+                         f"{r['segment_seconds']:.0f} s")
+    except (KeyboardInterrupt, SystemExit):
+        # the workers are gone: the segments they ran leave half-made run folders
+        _remove_unfinished(work, token, results)
+        raise
+    _remove_unfinished(work, token, results)  # a segment rerun after its worker died
     wall = time.perf_counter() - t_start
     return _whole(results, sb, source, bounds, wall, time.perf_counter() - t_fan, workers,
                   scheduler, a.name, resolved, chunk_steps, root)
+
+
+def _remove_unfinished(work: Path, token: str, results: list[dict]) -> None:
+    """Remove this run's segment folders (``<work>/runs/segment*-<token>-*``) that no
+    finished segment's result names."""
+    kept = {Path(r["run_dir"]).resolve() for r in results}
+    for folder in (work / "runs").glob(f"segment*-{token}-*"):
+        if folder.resolve() not in kept:
+            shutil.rmtree(folder, ignore_errors=True)
 
 
 def _whole(results: list[dict], sb: Any, source: StimulusChunks,

@@ -110,3 +110,26 @@ def test_interrupt_at_a_phase(tmp_path: Path, reference: dict, phase: str,
 def test_interrupt_at_each_phase(tmp_path: Path, reference: dict, phase: str,
                                  sig: int) -> None:
     _interrupt_case(tmp_path, phase, sig, reference)
+
+
+def test_interrupting_a_sharded_run_on_workers_leaves_nothing(tmp_path: Path) -> None:
+    """SIGINT while 2 Dask workers run a sharded run's segments (each with its simulator
+    and twin): exit 130 with one line, no process left, and no half-made segment run
+    folder (the workers die before their segments can clean up: the run removes them;
+    it once left both)."""
+    args = _args(tmp_path, "--frames", "201", "--steps-per-frame", "10", "--shards", "2",
+                 "--workers", "2")
+    args[args.index("--steps") + 1] = "2000"  # long enough to be interrupted mid-segment
+    status, err, seen = _signal_at(args, signal.SIGINT, lambda kids, err: sum(
+        Path(cmd.split(" ")[0]).name == "vvp" for cmd in kids.values()) >= 1)
+    assert status == 130, err
+    assert "Traceback" not in err, err
+    lines = [ln for ln in err.replace("\r", "\n").splitlines() if ln.startswith("rvsm: ")
+             and not ln.startswith(("rvsm: generating", "rvsm: building", "rvsm: built",
+                                    "rvsm: running", "rvsm: still"))]
+    assert len(lines) == 1 and lines[0].startswith("rvsm: interrupted"), err
+    _assert_no_orphans(seen)
+    work = tmp_path / "w"
+    assert _leftovers(work) == []
+    runs = work / "runs"
+    assert not runs.exists() or [p.name for p in runs.iterdir()] == []
