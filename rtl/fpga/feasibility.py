@@ -194,7 +194,9 @@ class Feasibility:
         """``"feasible at P = 40"`` or what breaks, with figures."""
         head = f"P = {self.lanes} at {self.clock_needed_hz / 1e6:.1f} MHz"
         if self.feasible:
-            return f"feasible on {self.device} at {head}"
+            io = self.checks.get("io")
+            return f"feasible on {self.device} at {head}" + (
+                f"; I/O {io.figure:,.0f} / {io.budget:,.0f} {io.unit}" if io else "")
         bad = self.broken or self.unknown
         word = "breaks" if self.broken else "unverified"
         return f"{word} on {self.device} at {head}: " + "; ".join(c.text() for c in bad)

@@ -59,6 +59,15 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="report: the camera's steps per second for --fits")
     p.add_argument("--memory-organisation", default=None,
                    help="report: rtl | per-scale | packed (default packed)")
+    p.add_argument("--package", default=None,
+                   help="report: the package for --fits, e.g. CABGA554 (default: the "
+                   "device's first; see rvsm sweep devices)")
+    p.add_argument("--io-links", default=None, choices=("bank", "side"),
+                   help="report: what one I/O link's edge clock reaches: a bank (default) "
+                   "or both banks of a side")
+    p.add_argument("--json", action="store_true",
+                   help="report: print one JSON object (files, recommendation, and per "
+                   "device every design's verdicts with its I/O figures) instead of text")
     p.set_defaults(func=run_sweep_command)
 
 
@@ -122,6 +131,12 @@ def _report(args: argparse.Namespace) -> int:
                                               ("pareto.png", None)))], [db], args.force)
     files, rec = write_report(db, out, tolerance=args.tolerance,
                               constraint=_constraint(args, db))
+    if args.json:
+        import json
+
+        print(json.dumps({"files": [str(f) for f in files], "report": rec}, indent=1,
+                         default=str))
+        return 0
     for f in files:
         print(f"wrote {f}")
     if rec is not None and "label" in rec:
@@ -144,7 +159,8 @@ def _constraint(args: argparse.Namespace, db: Path):
     from rvsm.sim.sweep.store import open_existing
 
     given = {"fits": args.fits, "camera": args.camera, "rate_hz": args.rate_hz,
-             "memory_organisation": args.memory_organisation}
+             "memory_organisation": args.memory_organisation, "package": args.package,
+             "io_links": args.io_links}
     if all(v is None for v in given.values()):
         return None
     with open_existing(db) as store:
@@ -157,7 +173,8 @@ def _constraint(args: argparse.Namespace, db: Path):
                 "camera": {"size": f"{cam.height}x{cam.width}", "rate_hz": cam.rate_hz,
                            **({"clock_mhz": cam.clock_hz / 1e6} if cam.clock_hz else {})},
                 "memory_organisation": stored.organisation,
-                "max_utilisation": stored.max_utilisation}
+                "max_utilisation": stored.max_utilisation, "io_links": stored.io_links,
+                **({"package": stored.package} if stored.package else {})}
     if args.fits is not None:
         data["fits"] = [n.strip() for n in args.fits.split(",") if n.strip()]
     if args.camera is not None or args.rate_hz is not None:
@@ -167,6 +184,7 @@ def _constraint(args: argparse.Namespace, db: Path):
         if args.rate_hz is not None:
             camera["rate_hz"] = args.rate_hz
         data["camera"] = camera
-    if args.memory_organisation is not None:
-        data["memory_organisation"] = args.memory_organisation
+    for key in ("memory_organisation", "package", "io_links"):
+        if getattr(args, key) is not None:
+            data[key] = getattr(args, key)
     return parse_constraint(data, "rvsm sweep report")

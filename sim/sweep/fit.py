@@ -6,11 +6,14 @@ A sweep file may say, before its tables::
     camera = { size = "250x400", rate_hz = 40000 }    # clock_mhz = 100 fixes the clock
     memory_organisation = "packed"                    # rtl | per-scale | packed (default)
     max_utilisation = 0.8                             # LUT4 / FF share allowed (default)
+    package = "CABGA554"                              # default: the device's first
+    io_links = "bank"                                 # bank (default) | side
 
 :func:`assess_design` checks one design of a results database against each device
 (:func:`rvsm.rtl.fpga.feasibility.assess`: its state at the camera's size packed into
 the device's block RAMs, its logic at the lanes the rate needs from the sweep's lane
-cost, its Fmax from the device's timing model or the sweep's own place and route);
+cost, its Fmax from the device's timing model or the sweep's own place and route, its
+pixels in and spikes out over the package's pairs);
 :func:`fit_markdown` ranks the feasible designs by PSNR cost and says, for each other
 one, which budget it breaks and by how much.
 """
@@ -33,12 +36,14 @@ from rvsm.rtl.fpga.feasibility import (
     MeasuredFmax,
     assess,
 )
+from rvsm.rtl.fpga.io_budget import SCOPES
 
 __all__ = ["CONSTRAINT_KEYS", "FitConstraint", "assess_design", "devices_text",
            "fit_markdown", "parse_constraint"]
 
 #: Top-level keys of a sweep file that state the device constraint.
-CONSTRAINT_KEYS = ("fits", "camera", "memory_organisation", "max_utilisation")
+CONSTRAINT_KEYS = ("fits", "camera", "memory_organisation", "max_utilisation", "package",
+                   "io_links")
 
 
 @dataclass(frozen=True)
@@ -50,11 +55,16 @@ class FitConstraint:
     camera: Camera
     organisation: str = "packed"
     max_utilisation: float = DEFAULT_MAX_UTILISATION
+    #: The package (None: each device's default) and what one link's clock reaches.
+    package: str | None = None
+    io_links: str = "bank"
 
     def text(self) -> str:
         """``"ecp5-85 at 250x400 at 40,000 Hz (packed state, 80 % of the logic)"``."""
-        return (f"{', '.join(self.devices)} at {self.camera.text()} ({self.organisation} "
-                f"state memory, at most {100 * self.max_utilisation:.0f} % of LUT4 and FF)")
+        pkg = f" in {self.package}" if self.package else ""
+        return (f"{', '.join(self.devices)}{pkg} at {self.camera.text()} ({self.organisation} "
+                f"state memory, at most {100 * self.max_utilisation:.0f} % of LUT4 and FF, "
+                f"I/O links per {self.io_links})")
 
 
 def parse_constraint(data: dict[str, Any], source: str) -> FitConstraint | None:
@@ -87,7 +97,21 @@ def parse_constraint(data: dict[str, Any], source: str) -> FitConstraint | None:
     if isinstance(util, bool) or not isinstance(util, (int, float)) or not 0 < util <= 1:
         raise RvsmError(f"{source}: max_utilisation must be a number in (0, 1], "
                         f"got {util!r}")
-    return FitConstraint(tuple(dict.fromkeys(names)), camera, org, float(util))
+    package = data.get("package")
+    if package is not None:
+        if not isinstance(package, str):
+            raise RvsmError(f"{source}: package must be a name like \"CABGA554\"")
+        for n in names:
+            try:
+                get_budget(n).package_io(package)
+            except RvsmError as exc:
+                raise RvsmError(f"{source}: package: {exc}") from None
+    links = data.get("io_links", "bank")
+    if links not in SCOPES:
+        raise RvsmError(f"{source}: io_links must be one of {', '.join(SCOPES)}, got "
+                        f"{links!r}")
+    return FitConstraint(tuple(dict.fromkeys(names)), camera, org, float(util), package,
+                         links)
 
 
 def _logic(row: dict[str, Any]) -> LogicCost | None:
@@ -119,7 +143,8 @@ def assess_design(toml: str, row: dict[str, Any], constraint: FitConstraint
         fam_measured = measured if dev.family == "ecp5" else None  # measured on an ECP5
         out[name] = assess(layout, dev, cam, logic, measured=fam_measured,
                            max_utilisation=constraint.max_utilisation,
-                           organisation=constraint.organisation)
+                           organisation=constraint.organisation,
+                           package=constraint.package, io_links=constraint.io_links)
     return out
 
 
@@ -127,7 +152,7 @@ def _verdict_cells(f: Feasibility) -> str:
     c = f.checks
     return (f"{f.lanes} | {f.clock_needed_hz / 1e6:.1f} MHz | "
             f"{_ratio(c['memory'])} | {_ratio(c['lut4'])} | {_ratio(c['ff'])} | "
-            f"{_ratio(c['fmax'])}")
+            f"{_ratio(c['fmax'])} | {_ratio(c['io'])}")
 
 
 def _psnr(d) -> float:
@@ -153,15 +178,18 @@ def fit_markdown(designs: list, constraint: FitConstraint) -> list[str]:
              "(rtl/fpga/feasibility.py). Cells are *needed / budget*: DP16KD or the "
              "device's block RAM (the state packed as stated, the line buffer in "
              "distributed RAM where the device has it), LUT4 and FF at P lanes against "
-             "the allowed share of the device, and clock needed / Fmax in MHz; **x** "
+             "the allowed share of the device, clock needed / Fmax in MHz, and the I/O "
+             "(pairs used / pairs of the edge-clock banks, or the binding pair count when "
+             "it breaks: rtl/fpga/io_budget.py); **x** "
              "marks a broken budget, ? one without a figure. The PSNR cost is against each "
              "design's own float model (a design with fewer scales also loses what its "
              "float model loses: compare the mean PSNR of the fixed twin).", ""]
     head = ("| rank | design | worst \\|cost\\| | mean PSNR | P | clock | block RAM | LUT4 | "
-            "FF | clock / Fmax (MHz) |\n|---|---|---|---|---|---|---|---|---|---|")
+            "FF | clock / Fmax (MHz) | I/O pairs |\n|---|---|---|---|---|---|---|---|---|---|---|")
     for name in constraint.devices:
         dev = get_budget(name)
-        lines += [f"### {name}", "", dev.summary() + ".", ""]
+        lines += [f"### {name}", "", dev.summary() + ".", "",
+                  dev.package_io(constraint.package).summary() + ".", ""]
         ok = sorted((d for d in designs if d.feasibility[name].feasible),
                     key=lambda d: (d.worst_cost, d.label))
         lines += [f"**{len(ok)} of {len(designs)} designs fit.**", ""]
@@ -178,8 +206,8 @@ def fit_markdown(designs: list, constraint: FitConstraint) -> list[str]:
         if bad:
             lines += ["Designs that do not fit, and why:", "",
                       "| design | worst \\|cost\\| | mean PSNR | P | clock | block RAM | LUT4 | "
-                      "FF | clock / Fmax (MHz) | breaks |",
-                      "|---|---|---|---|---|---|---|---|---|---|"]
+                      "FF | clock / Fmax (MHz) | I/O pairs | breaks |",
+                      "|---|---|---|---|---|---|---|---|---|---|---|"]
             for d in bad:
                 f = d.feasibility[name]
                 why = "; ".join(c.text() for c in (f.broken or f.unknown))
@@ -194,6 +222,9 @@ def fit_markdown(designs: list, constraint: FitConstraint) -> list[str]:
 
 
 def devices_text() -> str:
-    """One line per device budget (``rvsm sweep devices``)."""
-    rows = [b.summary() + (f" [{b.notes}]" if b.notes else "") for b in BUDGETS.values()]
+    """One line per device budget (``rvsm sweep devices``), and one per package's I/O."""
+    rows = []
+    for b in BUDGETS.values():
+        rows.append(b.summary() + (f" [{b.notes}]" if b.notes else ""))
+        rows += [f"  I/O {p.summary()}" for p in b.io]
     return "\n".join(rows)

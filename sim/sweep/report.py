@@ -341,8 +341,8 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
     one of the most recent sweep file in the database that states one, if any).
     Returns the files written and the recommended design (``label``, ``toml``,
     ``worst_cost``, ``lut4_per_lane``, ``ff_per_lane``, ``memory_bits``; with a
-    constraint also ``fits``: per device the feasible designs ranked by PSNR cost, each
-    ``{label, worst_cost, summary}``, and ``infeasible``: ``{label, summary}``) or None.
+    constraint also per device ``fits``: the feasible designs ranked by PSNR cost ``{label,
+    worst_cost, summary}``, ``infeasible``: ``{label, summary}``, ``verdicts``) or None.
     """
     with open_existing(db) as store:
         rows = store.results()
@@ -390,6 +390,8 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
                                       "summary": d.feasibility[name].summary()}
                                      for d in designs if not d.feasibility[name].feasible]
                               for name in constraint.devices}
+        info["verdicts"] = {name: [{"label": d.label, **d.feasibility[name].to_dict()}
+                                   for d in designs] for name in constraint.devices}
     return files, info
 
 
