@@ -25,12 +25,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         "rows already in the database. rvsm sweep report RESULTS.sqlite [-o DIR] [--fits "
         "DEVICE --camera HxW --rate-hz R]: markdown report, PSNR-cost and Pareto plots, and "
         "the designs that fit a device ranked by PSNR cost. rvsm sweep devices: the devices "
-        "and their budgets. See docs/design-space.md.",
+        "and their budgets. rvsm sweep io POINT.toml [--rate-hz R] [--package P] "
+        "[--io-links bank|side] [--json]: the point's I/O on each package. See "
+        "docs/design-space.md.",
     )
-    p.add_argument("target", metavar="SWEEP.toml | run | report | devices",
-                   help="a sweep file, or the action `run` / `report` / `devices`")
+    p.add_argument("target", metavar="SWEEP.toml | run | report | devices | io",
+                   help="a sweep file, or the action `run` / `report` / `devices` / `io`")
     p.add_argument("path", nargs="?", metavar="FILE",
-                   help="the sweep file (run) or the results database (report)")
+                   help="the sweep file (run), the results database (report) or a point "
+                   "file (io: its pixels in and spikes out over each package's pins)")
     p.add_argument("-o", "--output", default=None,
                    help="run: results database (default build/SWEEP.sqlite: nothing is "
                    "written beside the sweep file); report: output folder (default "
@@ -56,7 +59,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--camera", default=None, metavar="HxW",
                    help="report: the camera's size for --fits (default: the sweep file's)")
     p.add_argument("--rate-hz", type=float, default=None,
-                   help="report: the camera's steps per second for --fits")
+                   help="report: the camera's steps per second for --fits; io: the "
+                   "camera's rate (default 40000)")
     p.add_argument("--memory-organisation", default=None,
                    help="report: rtl | per-scale | packed (default packed)")
     p.add_argument("--package", default=None,
@@ -80,6 +84,8 @@ def run_sweep_command(args: argparse.Namespace) -> int:
             raise RvsmError(f"unexpected argument {args.path!r}: rvsm sweep devices")
         print(devices_text())
         return 0
+    if args.target == "io":
+        return _io(args)
     if args.target == "report":
         if not args.path:
             raise RvsmError("rvsm sweep report needs the results database: "
@@ -149,6 +155,40 @@ def _report(args: argparse.Namespace) -> int:
             print(f"  {i}. {d['label']}: {d['worst_cost']:.3f} dB, {d['summary']}")
         for d in bad:
             print(f"  x {d['label']}: {d['summary']}")
+    return 0
+
+
+def _io(args: argparse.Namespace) -> int:
+    import json
+
+    from rvsm.sim.sweep.fit import point_io_plans
+
+    if not args.path:
+        raise RvsmError("rvsm sweep io needs a point file: rvsm sweep io POINT.toml "
+                        "[--rate-hz R] [--package P] [--io-links bank|side] [--json]")
+    rate = 40000.0 if args.rate_hz is None else args.rate_hz
+    plans = point_io_plans(args.path, rate, args.package, args.io_links)
+    if args.json:
+        print(json.dumps([p.to_dict() for p in plans], indent=1))
+        return 0
+    i = plans[0].input
+    print(f"{args.path} at {rate:,.0f} Hz, core {plans[0].core_hz / 1e6:g} MHz: in "
+          f"{i.bits_per_s / 1e9:.1f} Gbit/s ({i.bits_per_cycle} bits a core cycle), out "
+          f"{plans[0].output.bits_per_s / 1e9:.1f} Gbit/s "
+          f"({plans[0].output.bits_per_cycle}); {i.gearing} gearing, "
+          f"{i.bits_per_pair_per_cycle} bits a pair a core cycle "
+          f"({i.rate_per_pair_bps / 1e6:g} Mbit/s): {i.data_pairs} input and "
+          f"{plans[0].output.data_pairs} output data pairs")
+    for p in plans:
+        figure, budget, unit, _ = p.verdict()
+        links_in, links_out = p.links
+        print(f"{p.package}, links per {p.scope}: {'fits' if p.fits else 'BREAKS'} "
+              f"{figure:g} / {budget:g} {unit}; {links_in} input and {links_out} output "
+              f"links")
+        for u in p.placement.uses:
+            print(f"  {u.group.name}: {u.group.pairs} pairs ({u.group.lvds_out_pairs} "
+                  f"true LVDS): in {u.in_data} + out {u.out_data} data pairs, "
+                  f"{u.pairs_used} used")
     return 0
 
 

@@ -24,9 +24,10 @@ import json
 from dataclasses import dataclass
 from typing import Any
 
-from rvsm.model.fixed.point_toml import parse_design_point
+from rvsm.model.fixed.point_toml import load_point_file, parse_design_point
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.block_ram import ORGANISATIONS, StateLayout
+from rvsm.rtl.fpga.camera import clock_needed_hz
 from rvsm.rtl.fpga.devices import BUDGETS, get_budget
 from rvsm.rtl.fpga.feasibility import (
     DEFAULT_MAX_UTILISATION,
@@ -36,10 +37,10 @@ from rvsm.rtl.fpga.feasibility import (
     MeasuredFmax,
     assess,
 )
-from rvsm.rtl.fpga.io_budget import SCOPES
+from rvsm.rtl.fpga.io_budget import SCOPES, IoPlan, io_plan
 
 __all__ = ["CONSTRAINT_KEYS", "FitConstraint", "assess_design", "devices_text",
-           "fit_markdown", "parse_constraint"]
+           "fit_markdown", "parse_constraint", "point_io_plans"]
 
 #: Top-level keys of a sweep file that state the device constraint.
 CONSTRAINT_KEYS = ("fits", "camera", "memory_organisation", "max_utilisation", "package",
@@ -219,6 +220,27 @@ def fit_markdown(designs: list, constraint: FitConstraint) -> list[str]:
             lines += [f"State memories of {(ok or bad)[0].label} at P = {memo.lanes}:", ""]
             lines += [f"- {r}" for r in memo.packing.rows()] + [""]
     return lines
+
+
+def point_io_plans(point_file: str, rate_hz: float, package: str | None = None,
+                   io_links: str | None = None) -> list[IoPlan]:
+    """The I/O plans of a point file at its own size and ``rate_hz`` steps/s, its core
+    clock ``[rtl] freq_mhz`` (else the clock its lanes need) on its ``[rtl] device``
+    (else the ECP5-85): every package of its part (or ``package``, e.g. an
+    ``"LFE5UM5G-85F CABGA381"``), links per bank and per side (or ``io_links``)."""
+    point, settings = load_point_file(point_file)
+    if not rate_hz > 0:
+        raise RvsmError(f"--rate-hz must be > 0, got {rate_hz:g}")
+    dev = get_budget(settings.device or "ecp5-85")
+    core = (settings.freq_mhz * 1e6 if settings.freq_mhz else
+            clock_needed_hz(point.height, point.width, settings.lanes or 1, rate_hz))
+    packages = ([dev.package_io(package)] if package else
+                [p for p in dev.io if p.part == dev.io[0].part])  # the -5G: same pins
+    if any(p.estimate_only for p in packages):
+        raise RvsmError(f"{dev.name}: no per-bank I/O figures (estimate only); "
+                        "rvsm sweep devices lists the ECP5 packages that have them")
+    return [io_plan(point.contract(), rate_hz, p, core, scope=s)
+            for p in packages for s in ([io_links] if io_links else SCOPES)]
 
 
 def devices_text() -> str:

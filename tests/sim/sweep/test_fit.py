@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -133,3 +134,22 @@ def test_cli_devices_and_bad_values_exit_2(tmp_path, capsys, fake_synthesis):
     assert main(["sweep", "report", str(db), "--fits", "nosuch", "--camera", "4x4",
                  "--rate-hz", "1"]) == 2
     assert "choose one of" in capsys.readouterr().err
+
+
+def test_point_io_command_gives_the_figures_docs_quote(capsys, monkeypatch):
+    root = Path(__file__).resolve().parents[3]
+    doc = (root / "docs" / "design-space.md").read_text()
+    block = doc.split("<!-- io-figures -->\n```text\n", 1)[1].split("```", 1)[0]
+    monkeypatch.chdir(root)
+    assert main(["sweep", "io", "points/ecp5-85-40khz.toml"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    missing = [ln for ln in block.splitlines() if ln not in out]
+    assert not missing, f"docs/design-space.md quotes lines rvsm sweep io does not print: " \
+                        f"{missing}"
+    assert main(["sweep", "io", "points/ecp5-85-40khz.toml", "--package", "CABGA381",
+                 "--io-links", "bank", "--json"]) == 0
+    (plan,) = json.loads(capsys.readouterr().out)
+    assert (plan["fits"], plan["figure"], plan["budget"]) == (False, 35, 29)
+    assert main(["sweep", "io"]) == 2 and "needs a point file" in capsys.readouterr().err
+    assert main(["sweep", "io", "points/ecp5-85-40khz.toml", "--package", "QFN9"]) == 2
+    assert "choose one of: LFE5U-85F CABGA381" in capsys.readouterr().err
