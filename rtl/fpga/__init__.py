@@ -5,5 +5,6 @@ Modules (import them directly; this package imports nothing, so the CLI starts f
 :mod:`.tools` (running the tools), :mod:`.flow` (Verilog -> synthesis -> place and
 route, several placer seeds), :mod:`.ecp5_memory` (state-memory banks as DP16KD with the
 output register), :mod:`.report` (parsing, :class:`~.report.FpgaReport`), :mod:`.sensor` (camera
-throughput and state-memory arithmetic).
+throughput and state-memory arithmetic), :mod:`.package_io` (pins, pairs and gearing per
+package and bank), :mod:`.io_budget` (pixels in and spikes out over those pairs).
 """
