@@ -119,7 +119,8 @@ class PackageIo:
     """The I/O one package of a part offers (module docstring). ``part`` the die or
     variant, ``user_io`` pins (None: unknown), ``banks`` (empty: no per-bank figures),
     ``gearings``, ``serdes_channels`` at ``serdes_gbps``, ``source`` of the figures;
-    ``estimate_only``: no per-bank or gearing model, so no I/O verdict."""
+    ``estimate_only``: no per-bank, gearing or SerDes model (its 0 SerDes channels mean
+    "not modelled"), so no I/O verdict."""
 
     part: str
     package: str

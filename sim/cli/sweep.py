@@ -64,14 +64,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--memory-organisation", default=None,
                    help="report: rtl | per-scale | packed (default packed)")
     p.add_argument("--package", default=None,
-                   help="report: the package for --fits, e.g. CABGA554 (default: the "
+                   help="report, io: the package, e.g. CABGA554 (default: the "
                    "device's first; see rvsm sweep devices)")
     p.add_argument("--io-links", default=None, choices=("bank", "side"),
-                   help="report: what one I/O link's edge clock reaches: a bank (default) "
+                   help="report, io: what one I/O link's edge clock reaches: a bank (default) "
                    "or both banks of a side")
     p.add_argument("--json", action="store_true",
                    help="report: print one JSON object (files, recommendation, and per "
-                   "device every design's verdicts with its I/O figures) instead of text")
+                   "device every design's verdicts with its I/O figures) instead of text; "
+                   "io: the plans as a JSON list")
     p.set_defaults(func=run_sweep_command)
 
 
