@@ -80,8 +80,8 @@ class SerialiserSignature(wiring.Signature):
 
 
 class Deserialiser(wiring.Component):
-    """``pairs`` pins to 4-bit words in clock domain ``domain`` (created here: its clock is
-    SCLK; its reset is the user's, e.g. a ``ResetSynchronizer``). ``latency``: SCLK cycles
+    """``pairs`` pins to 4-bit words in clock domain ``domain`` (defined by the user; this
+    drives its clock, SCLK; its reset is the user's, e.g. a ``ResetSynchronizer``). ``latency``: SCLK cycles
     from a word's last bit to ``words``, behavioural model."""
 
     latency = 1
@@ -94,7 +94,6 @@ class Deserialiser(wiring.Component):
     def elaborate(self, platform: object) -> Module:
         m = Module()
         pairs = len(self.pins)
-        m.domains += ClockDomain(self.domain)
         sclk = Signal()
         m.d.comb += ClockSignal(self.domain).eq(sclk)
         if self.primitive == "ecp5":
@@ -127,8 +126,8 @@ class Deserialiser(wiring.Component):
 
 
 class Serialiser(wiring.Component):
-    """4-bit words in clock domain ``domain`` (created here: its clock is SCLK, reset by
-    the user) to ``pairs`` pins and a forwarded clock. Behavioural model: ``clock`` is a
+    """4-bit words in clock domain ``domain`` (defined by the user; this drives its clock,
+    SCLK) to ``pairs`` pins and a forwarded clock. Behavioural model: ``clock`` is a
     bit clock, ``clock_out`` is that clock passed on (one rising edge per bit)."""
 
     def __init__(self, pairs: int, primitive: str = "behavioural", domain: str = "tx"):
@@ -139,7 +138,6 @@ class Serialiser(wiring.Component):
     def elaborate(self, platform: object) -> Module:
         m = Module()
         pairs = len(self.pins)
-        m.domains += ClockDomain(self.domain)
         sclk = Signal()
         m.d.comb += ClockSignal(self.domain).eq(sclk)
         if self.primitive == "ecp5":

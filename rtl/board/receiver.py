@@ -27,7 +27,7 @@ clock has run again, so the link trains again from SEARCH. Error counters surviv
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, DomainRenamer, Module, Signal, unsigned
+from amaranth.hdl import Cat, ClockDomain, DomainRenamer, Module, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.cdc import FFSynchronizer, PulseSynchronizer, ResetSynchronizer
 from amaranth.lib.fifo import AsyncFIFO
@@ -73,6 +73,7 @@ class LinkReceiver(wiring.Component):
     def elaborate(self, platform: object) -> Module:
         m = Module()
         fmt, n, f = self.format, self.format.pairs, self.format.framing_pair
+        m.domains += ClockDomain("rx")  # its clock is the gearing's SCLK
         m.submodules.gearing = gear = Deserialiser(n, self.primitive, "rx")
         m.d.comb += [gear.clock.eq(self.clock), gear.pins.eq(self.pins)]
 

@@ -13,7 +13,7 @@ lost and sets ``overflow`` (sticky). The link words of a beat are
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, Const, Module, Mux, Signal
+from amaranth.hdl import Cat, ClockDomain, Const, Module, Mux, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
 from amaranth.lib.fifo import AsyncFIFO
@@ -58,6 +58,7 @@ class LinkTransmitter(wiring.Component):
     def elaborate(self, platform: object) -> Module:
         m = Module()
         fmt, n, f = self.format, self.format.pairs, self.format.framing_pair
+        m.domains += ClockDomain("tx")  # its clock is the gearing's SCLK
         m.submodules.gearing = ser = Serialiser(n, self.primitive, "tx")
         m.d.comb += [ser.clock.eq(self.clock), self.pins.eq(ser.pins),
                      self.clock_out.eq(ser.clock_out)]
