@@ -14,6 +14,7 @@ whose ``sof``/``eol`` disagree with the array's position (counted from the last
 
 from __future__ import annotations
 
+import numpy as np
 from amaranth.hdl import Cat, Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
@@ -24,9 +25,11 @@ from rvsm.rtl.board.receiver import LinkReceiver
 from rvsm.rtl.board.status import LinkControlSignature, LinkStatusSignature
 from rvsm.rtl.board.transmitter import LinkTransmitter
 from rvsm.rtl.stream.array import RvsmStreamArray
+from rvsm.rtl.ports import verilog_ports
 from rvsm.rtl.stream.dimensions import StreamGeometry
+from rvsm.rtl.verilog_memories import convert_verilog
 
-__all__ = ["BoardFrontEnd", "link_formats"]
+__all__ = ["BoardFrontEnd", "front_end_verilog", "link_formats"]
 
 #: Bits of the framing error counter (saturating).
 FRAMING_BITS = 16
@@ -67,6 +70,11 @@ class BoardFrontEnd(wiring.Component):
     def lag(self) -> int:
         """The array's lag (beats): output ``p`` leaves after input beat ``p + lag``."""
         return self.geometry.lag
+
+    def threshold_writes(self, thresholds: np.ndarray) -> list[tuple[int, int]]:
+        """``(thr_addr, thr_data)`` of every threshold write for thresholds ``(S, H, W)``
+        (the array's, :meth:`StreamGeometry.threshold_writes`)."""
+        return self.geometry.threshold_writes(thresholds)
 
     def elaborate(self, platform: object) -> Module:
         m = Module()
@@ -109,3 +117,10 @@ class BoardFrontEnd(wiring.Component):
                      tx.beats.payload.eol.eq(out.group == geo.groups - 1),
                      tx.beats.valid.eq(array.spikes.valid)]
         return m
+
+
+def front_end_verilog(front_end: BoardFrontEnd, top: str = "rvsm_board") -> str:
+    """Verilog of ``front_end`` with module name ``top``; ports named as
+    :func:`rvsm.rtl.ports.verilog_ports` (``rx_pins``, ``status_locked``, ``thr_we``, ...)
+    plus ``clk`` and ``rst`` of the core domain."""
+    return convert_verilog(front_end, top, verilog_ports(front_end))
