@@ -120,4 +120,5 @@ def beat_ints(payload: np.ndarray, sof: np.ndarray, eol: np.ndarray) -> list[int
     """Beats as the receiver's stream words: payload bits, then ``sof``, ``eol`` above."""
     bits = payload.shape[1]
     return [int.from_bytes(np.packbits(p, bitorder="little").tobytes(), "little")
-            | int(s) << bits | int(e) << (bits + 1) for p, s, e in zip(payload, sof, eol)]
+            | int(s) << bits | int(e) << (bits + 1)
+            for p, s, e in zip(payload, sof, eol, strict=True)]

@@ -24,8 +24,8 @@ from rvsm.rtl.board.model import LinkFormat
 from rvsm.rtl.board.receiver import LinkReceiver
 from rvsm.rtl.board.status import LinkControlSignature, LinkStatusSignature
 from rvsm.rtl.board.transmitter import LinkTransmitter
-from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.ports import verilog_ports
+from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.verilog_memories import convert_verilog
 

@@ -44,8 +44,9 @@ __all__ = ["PRIMITIVES", "Deserialiser", "DeserialiserSignature", "Serialiser",
 PRIMITIVES = ("behavioural", "ecp5")
 
 
-def _check(primitive: str) -> str:
+def _check(component: wiring.Component, primitive: str) -> str:
     if primitive not in PRIMITIVES:
+        component._MustUse__silence = True  # an __init__ that raises is not an unused design
         raise RvsmError(f"unknown gearing {primitive!r}; choose one of: {', '.join(PRIMITIVES)}")
     return primitive
 
@@ -63,6 +64,12 @@ class DeserialiserSignature(wiring.Signature):
             "words": Out(data.ArrayLayout(unsigned(GEAR_BITS), pairs)),
         })
 
+    def __eq__(self, other: object) -> bool:
+        return type(other) is type(self) and other.pairs == self.pairs
+
+    def __hash__(self) -> int:
+        return hash((type(self), self.pairs))
+
 
 class SerialiserSignature(wiring.Signature):
     """A serialiser of ``pairs`` pins: ``clock`` (the transmit edge/bit clock) and
@@ -78,16 +85,22 @@ class SerialiserSignature(wiring.Signature):
             "clock_out": Out(1),
         })
 
+    def __eq__(self, other: object) -> bool:
+        return type(other) is type(self) and other.pairs == self.pairs
+
+    def __hash__(self) -> int:
+        return hash((type(self), self.pairs))
+
 
 class Deserialiser(wiring.Component):
     """``pairs`` pins to 4-bit words in clock domain ``domain`` (defined by the user; this
-    drives its clock, SCLK; its reset is the user's, e.g. a ``ResetSynchronizer``). ``latency``: SCLK cycles
-    from a word's last bit to ``words``, behavioural model."""
+    drives its clock, SCLK; its reset is the user's, e.g. a ``ResetSynchronizer``).
+    ``latency``: SCLK cycles from a word's last bit to ``words``, behavioural model."""
 
     latency = 1
 
     def __init__(self, pairs: int, primitive: str = "behavioural", domain: str = "rx"):
-        self.primitive = _check(primitive)
+        self.primitive = _check(self, primitive)
         self.domain = domain
         super().__init__(DeserialiserSignature(pairs))
 
@@ -131,7 +144,7 @@ class Serialiser(wiring.Component):
     bit clock, ``clock_out`` is that clock passed on (one rising edge per bit)."""
 
     def __init__(self, pairs: int, primitive: str = "behavioural", domain: str = "tx"):
-        self.primitive = _check(primitive)
+        self.primitive = _check(self, primitive)
         self.domain = domain
         super().__init__(SerialiserSignature(pairs))
 

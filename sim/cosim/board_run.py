@@ -8,8 +8,8 @@ stopped between two parts: a lost lock, then training again), runs the testbench
 calls on the Icarus netlist of :mod:`rvsm.sim.cosim.builds.icarus_netlist` (Amaranth's
 Verilog has ``always @*`` processes whose inputs never change from their initial values,
 e.g. a state machine's outputs in its first state; Icarus never runs them, so they stay
-``x``; as netlist cells they do not), and returns its result: every spike out of the transmitter compared with the
-fixed twin, and the link status the ports report.
+``x``; as netlist cells they do not), and returns its result: every spike out of the
+transmitter compared with the fixed twin, and the link status the ports report.
 """
 
 from __future__ import annotations

@@ -82,7 +82,8 @@ async def board_links(dut) -> None:  # noqa: ANN001
     capture = deserialise(tx_format, tx_bits)
     t, ns, h, w = expected.shape
     got = spike_beats_to_frames(capture, ns, h, w, int(stim["lanes"]))[:t]
-    result = {"compared": int(expected.size), "spikes": int(np.count_nonzero(expected)), "stream_seconds": time.perf_counter() - t0,
+    result = {"compared": int(expected.size), "spikes": int(np.count_nonzero(expected)),
+              "stream_seconds": time.perf_counter() - t0,
               "status": status, "tx_link_errors": capture.errors.tolist(),
               "frames": int(got.shape[0])}
     if got.shape != expected.shape:
