@@ -2,8 +2,9 @@
 
 :class:`LinkTransmitter` writes each beat (``payload``, ``sof``, ``eol``) into an
 ``AsyncFIFO`` (core domain ``sync`` -> its SCLK domain ``tx``); there, one link word
-per two SCLK cycles: training (after the ``tx`` reset for :data:`RESET_TRAINING`
-words, and while ``train`` is high), else a beat when the FIFO has one, else an idle
+per two SCLK cycles: training (for :data:`RESET_TRAINING` words after the ``tx``
+reset, which follows the core domain's ``rst`` through a ``ResetSynchronizer``, and
+while ``train`` is high), else a beat when the FIFO has one, else an idle
 word (:mod:`rvsm.rtl.board.model`: TRAIN on the data pairs, framing ``SYNC << 4``). Each
 word leaves as two 4-bit gear words, bits 0-3 first, through the
 :class:`~rvsm.rtl.board.gearing.Serialiser`. A beat arriving while the FIFO is full is
@@ -13,7 +14,7 @@ lost and sets ``overflow`` (sticky). The link words of a beat are
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, ClockDomain, Const, Module, Mux, Signal
+from amaranth.hdl import Cat, ClockDomain, Const, Module, Mux, ResetSignal, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
 from amaranth.lib.fifo import AsyncFIFO
@@ -62,7 +63,7 @@ class LinkTransmitter(wiring.Component):
         m.submodules.gearing = ser = Serialiser(n, self.primitive, "tx")
         m.d.comb += [ser.clock.eq(self.clock), self.pins.eq(ser.pins),
                      self.clock_out.eq(ser.clock_out)]
-        m.submodules.tx_reset = ResetSynchronizer(Const(0, 1), domain="tx")
+        m.submodules.tx_reset = ResetSynchronizer(ResetSignal("sync"), domain="tx")
         m.submodules.fifo = fifo = AsyncFIFO(width=fmt.payload_bits + 2, depth=FIFO_DEPTH,
                                              r_domain="tx", w_domain="sync")
         m.d.comb += [fifo.w_data.eq(self.beats.payload.as_value()),
