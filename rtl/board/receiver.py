@@ -1,0 +1,220 @@
+"""The source-synchronous receiver: pins to beats in the core clock domain.
+
+:class:`LinkReceiver` joins, for a :class:`~rvsm.rtl.board.model.LinkFormat`::
+
+    pins, forwarded clock
+      -> Deserialiser (gearing.py: IDDRX2F or the behavioural model), 4 bits a pair per SCLK
+      -> WordAligner per pair (aligner.py): 8-bit words every other SCLK, bit slip on TRAIN
+      -> Deskew (deskew.py): pairs lined up on MARK
+      -> the link state machine: SEARCH (until every pair is aligned) -> DESKEW (until
+         every pair has shown MARK) -> LOCKED (data: framing lane read, beats written)
+      -> AsyncFIFO (SCLK domain ``rx`` -> core domain ``sync``): beats out as a stream
+         (payload, sof, eol; valid/ready)
+
+Errors (the model's rules, :func:`~rvsm.rtl.board.model.deserialise`): in SEARCH and
+DESKEW an aligned pair whose word is neither TRAIN nor MARK; when LOCKED, a data pair
+that differs from the framing lane's TRAIN/MARK during training or from TRAIN in an idle
+word, a framing word without the SYNC nibble, a beat whose parity disagrees (framing
+lane). :data:`LOSS_WORDS` bad words in a row on one pair (or on the framing lane when
+LOCKED) drop the link back to SEARCH, and so does ``control.train`` while high.
+
+Clock loss: a heartbeat (bit 3 of a free-running SCLK counter) is watched from the core
+domain; :data:`CLOCK_TIMEOUT` core cycles without a change make the clock dead, which
+clears ``locked`` and holds the SCLK domain in reset (``ResetSynchronizer``) until the
+clock has run again, so the link trains again from SEARCH. Error counters survive it
+(they are not reset by the domain reset).
+"""
+
+from __future__ import annotations
+
+from amaranth.hdl import Cat, ClockDomain, DomainRenamer, Module, Signal, unsigned
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.cdc import FFSynchronizer, PulseSynchronizer, ResetSynchronizer
+from amaranth.lib.fifo import AsyncFIFO
+from amaranth.lib.wiring import In, Out
+
+from rvsm.rtl.board.aligner import WordAligner
+from rvsm.rtl.board.deskew import Deskew
+from rvsm.rtl.board.gearing import Deserialiser
+from rvsm.rtl.board.model import EOL, MARK, PARITY, SOF, SYNC, TRAIN, VALID, LinkFormat
+from rvsm.rtl.board.status import COUNTER_BITS, LinkControlSignature, LinkStatusSignature
+
+__all__ = ["CLOCK_TIMEOUT", "FIFO_DEPTH", "LOSS_WORDS", "LinkReceiver", "beat_layout"]
+
+#: Bad words in a row that drop the link to SEARCH.
+LOSS_WORDS = 4
+#: Core cycles without a heartbeat change that make the forwarded clock dead.
+CLOCK_TIMEOUT = 64
+#: Beats the clock-crossing FIFO holds.
+FIFO_DEPTH = 16
+
+
+def beat_layout(payload_bits: int) -> data.StructLayout:
+    """A received (or transmitted) beat: ``payload``, ``sof`` (first beat of a frame),
+    ``eol`` (last beat of a row)."""
+    return data.StructLayout({"payload": unsigned(payload_bits), "sof": 1, "eol": 1})
+
+
+class LinkReceiver(wiring.Component):
+    """Receiver of a :class:`LinkFormat` link: ``clock`` and ``pins`` (the board's
+    forwarded clock and pairs), ``control`` in; ``beats`` (a stream in the core domain
+    ``sync``), ``status`` out. ``primitive``: the gearing (:mod:`.gearing`)."""
+
+    def __init__(self, fmt: LinkFormat, primitive: str = "behavioural"):
+        self.format = fmt
+        self.primitive = primitive
+        super().__init__({
+            "clock": In(1), "pins": In(fmt.pairs),
+            "beats": Out(stream.Signature(beat_layout(fmt.payload_bits))),
+            "status": Out(LinkStatusSignature(fmt.pairs)),
+            "control": In(LinkControlSignature()),
+        })
+
+    def elaborate(self, platform: object) -> Module:
+        m = Module()
+        fmt, n, f = self.format, self.format.pairs, self.format.framing_pair
+        m.domains += ClockDomain("rx")  # its clock is the gearing's SCLK
+        m.submodules.gearing = gear = Deserialiser(n, self.primitive, "rx")
+        m.d.comb += [gear.clock.eq(self.clock), gear.pins.eq(self.pins)]
+
+        # the forwarded clock's heartbeat, watched from the core domain
+        beat_count = Signal(4, reset_less=True)
+        m.d.rx += beat_count.eq(beat_count + 1)
+        heart = Signal()
+        m.submodules.heart_sync = FFSynchronizer(beat_count[3], heart, o_domain="sync")
+        heart_seen, quiet = Signal(), Signal(range(CLOCK_TIMEOUT + 1), init=CLOCK_TIMEOUT)
+        alive = Signal()
+        m.d.sync += heart_seen.eq(heart)
+        with m.If(heart != heart_seen):
+            m.d.sync += quiet.eq(0)
+        with m.Elif(quiet != CLOCK_TIMEOUT):
+            m.d.sync += quiet.eq(quiet + 1)
+        m.d.comb += alive.eq(quiet != CLOCK_TIMEOUT)
+        rx_reset = Signal()
+        m.d.comb += rx_reset.eq(~alive)
+        m.submodules.rx_reset = ResetSynchronizer(rx_reset, domain="rx")
+
+        # alignment, deskew and the link state machine, all in the SCLK domain
+        rx = DomainRenamer("rx")
+        phase = Signal()
+        m.d.rx += phase.eq(~phase)
+        strobe = phase
+        aligners = [rx(WordAligner()) for _ in range(n)]
+        for i, a in enumerate(aligners):
+            m.submodules[f"aligner{i}"] = a
+            m.d.comb += [a.gear.eq(gear.words[i]), a.strobe.eq(strobe)]
+        m.submodules.deskew = deskew = rx(Deskew(n))
+        m.d.comb += deskew.strobe.eq(strobe)
+        for i, a in enumerate(aligners):
+            m.d.comb += deskew.words[i].eq(a.word)
+        train = Signal()
+        m.submodules.train_sync = FFSynchronizer(self.control.train, train, o_domain="rx")
+        all_aligned = Signal()
+        m.d.comb += all_aligned.eq(Cat(a.aligned for a in aligners).all())
+
+        err = Signal(n)        # one-cycle error pulses (at a strobe)
+        bad_run = [Signal(range(LOSS_WORDS + 1), name=f"bad_run{i}") for i in range(n)]
+        drop = Signal()
+        locked_rx = Signal()
+        words = deskew.out
+        frame = words[f]
+        payload = Cat(words[i] for i in range(fmt.data_pairs))[:fmt.payload_bits]
+        beat_ok = Signal()
+        m.submodules.fifo = fifo = AsyncFIFO(width=fmt.payload_bits + 2, depth=FIFO_DEPTH,
+                                             r_domain="sync", w_domain="rx")
+        overflow_rx = Signal()
+        with m.FSM(domain="rx"):
+            with m.State("SEARCH"):
+                for a in aligners:
+                    m.d.comb += [a.search.eq(1), a.restart.eq(train | drop)]
+                for i, a in enumerate(aligners):  # an aligned pair must keep training
+                    m.d.comb += err[i].eq(strobe & a.aligned
+                                          & (a.word != TRAIN) & (a.word != MARK))
+                with m.If(all_aligned & ~train & ~drop):
+                    m.next = "DESKEW"
+            with m.State("DESKEW"):
+                m.d.comb += deskew.start.eq(1)
+                for i, a in enumerate(aligners):
+                    m.d.comb += err[i].eq(strobe & (a.word != TRAIN) & (a.word != MARK))
+                with m.If(train | drop):
+                    m.d.comb += [a.restart.eq(1) for a in aligners]
+                    m.next = "SEARCH"
+                with m.Elif(deskew.done):
+                    m.next = "LOCKED"
+            with m.State("LOCKED"):
+                m.d.comb += [deskew.start.eq(1), locked_rx.eq(1)]
+                training = (frame == TRAIN) | (frame == MARK)
+                data_mode = frame[4:] == SYNC
+                with m.If(strobe):
+                    with m.If(training):
+                        m.d.comb += err[:f].eq(Cat(words[i] != frame for i in range(f)))
+                    with m.Elif(~data_mode):
+                        m.d.comb += err[f].eq(1)
+                    with m.Elif(frame & VALID):
+                        m.d.comb += [err[f].eq(payload.xor() != (frame & PARITY).any()),
+                                     beat_ok.eq(1)]
+                    with m.Else():
+                        m.d.comb += err[:f].eq(Cat(words[i] != TRAIN for i in range(f)))
+                with m.If(train | drop):
+                    m.d.comb += [a.restart.eq(1) for a in aligners]
+                    m.next = "SEARCH"
+        for i in range(n):
+            with m.If(strobe):
+                with m.If(err[i]):
+                    m.d.rx += bad_run[i].eq(bad_run[i] + (bad_run[i] != LOSS_WORDS))
+                with m.Else():
+                    m.d.rx += bad_run[i].eq(0)
+        m.d.comb += drop.eq(Cat(r == LOSS_WORDS for r in bad_run).any())
+        m.d.comb += [fifo.w_data.eq(Cat(payload, (frame & SOF).any(), (frame & EOL).any())),
+                     fifo.w_en.eq(beat_ok)]
+        m.d.comb += overflow_rx.eq(beat_ok & ~fifo.w_rdy)
+
+        # counters: SCLK-domain Gray counters (not reset by the domain reset), read in
+        # the core domain through a synchroniser per bit
+        clear = Signal()
+        m.submodules.clear_sync = clear_sync = PulseSynchronizer("sync", "rx")
+        m.d.comb += [clear_sync.i.eq(self.control.counters_reset), clear.eq(clear_sync.o)]
+        for i in range(n):
+            count = Signal(COUNTER_BITS, reset_less=True, name=f"errors{i}")
+            gray = Signal(COUNTER_BITS, reset_less=True, name=f"errors{i}_gray")
+            with m.If(clear):
+                m.d.rx += count.eq(0)
+            with m.Elif(err[i] & (count != (1 << COUNTER_BITS) - 1)):
+                m.d.rx += count.eq(count + 1)
+            m.d.rx += gray.eq(count ^ (count >> 1))
+            synced = Signal(COUNTER_BITS, name=f"errors{i}_sync")
+            m.submodules[f"errors{i}_sync"] = FFSynchronizer(gray, synced, o_domain="sync")
+            m.d.comb += self.status.lane_errors[i].eq(_from_gray(synced))
+        lost = Signal(reset_less=True)
+        with m.If(clear):
+            m.d.rx += lost.eq(0)
+        with m.Elif(overflow_rx):
+            m.d.rx += lost.eq(1)
+        m.submodules.overflow_sync = FFSynchronizer(lost, self.status.overflow,
+                                                    o_domain="sync")
+
+        # status in the core domain
+        locked_sync, aligned_sync = Signal(), Signal()
+        m.submodules.locked_sync = FFSynchronizer(locked_rx, locked_sync, o_domain="sync")
+        m.submodules.aligned_sync = FFSynchronizer(all_aligned, aligned_sync,
+                                                   o_domain="sync")
+        m.d.comb += [self.status.locked.eq(locked_sync & alive),
+                     self.status.aligned.eq(aligned_sync & alive)]
+        was_locked = Signal()
+        m.d.sync += was_locked.eq(self.status.locked)
+        with m.If(self.control.counters_reset):
+            m.d.sync += self.status.lock_losses.eq(0)
+        with m.Elif(was_locked & ~self.status.locked
+                    & (self.status.lock_losses != (1 << COUNTER_BITS) - 1)):
+            m.d.sync += self.status.lock_losses.eq(self.status.lock_losses + 1)
+
+        # beats out of the FIFO
+        m.d.comb += [self.beats.payload.as_value().eq(fifo.r_data),
+                     self.beats.valid.eq(fifo.r_rdy), fifo.r_en.eq(self.beats.ready)]
+        return m
+
+
+def _from_gray(gray: Signal) -> Cat:
+    """Binary value of a Gray code (bit k = XOR of gray bits k and above)."""
+    width = len(gray)
+    return Cat(gray[k:].xor() for k in range(width))
