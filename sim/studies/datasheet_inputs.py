@@ -10,7 +10,8 @@ results of other commands, each checked before anything is computed or written.
 - ``--formal FILE.json``: ``rvsm formal POINT --size HxW --json`` (each check's status);
 - ``--mutate FILE.json``: ``rvsm mutate POINT --json`` (mutations killed, survivors);
 - ``--regress FILE``: the results database of ``rvsm regress PLAN -o FILE.sqlite`` or its
-  JUnit XML (``--junit FILE.xml``).
+  JUnit XML (``--junit FILE.xml``);
+- ``--commands FILE.toml``: the command lines of saved results that do not record theirs.
 
 A missing or malformed file is an :class:`~rvsm.model.infra.errors.RvsmError` naming it
 (exit status 2), raised before the output folder is touched.
@@ -35,7 +36,8 @@ from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.text_files import read_utf8_text
 
-__all__ = ["PointFile", "RegressSummary", "load_fpga_report", "load_point_file",
+__all__ = ["COMMAND_KEYS", "PointFile", "RegressSummary", "load_commands",
+           "load_fpga_report", "load_point_file",
            "load_formal_report", "load_mutate_report",
            "load_regress", "load_regress_database", "load_regress_junit",
            "load_verify_result", "read_json_object", "read_result_text"]
@@ -225,3 +227,31 @@ def load_regress_junit(path: str | os.PathLike) -> RegressSummary:
                       "skipped" if c.find("skipped") is not None else "pass")
             cases.append((s.get("name", ""), c.get("name", ""), status))
     return RegressSummary(tuple(s.get("name", "") for s in suites), tuple(cases))
+
+
+#: The saved results a ``--commands`` file may give the command of.
+COMMAND_KEYS = ("fpga", "quality", "verify", "formal", "mutate", "regress")
+
+
+def load_commands(path: str | os.PathLike) -> dict[str, tuple[str, str]]:
+    """A ``--commands`` TOML file: for a saved result that does not record its own
+    command line, ``[verify] command = "rvsm verify ..."`` (whole, no "...") and
+    ``source = "..."`` (where the command comes from: the docs that quote it)."""
+    text = read_result_text(path, "commands")
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise RvsmError(f"{path}: not valid TOML: {exc}") from None
+    out = {}
+    for key, table in data.items():
+        if key not in COMMAND_KEYS or not isinstance(table, dict):
+            raise RvsmError(f"{path}: unknown table [{key}]; valid tables: "
+                            f"{', '.join(COMMAND_KEYS)}")
+        cmd, source = table.get("command"), table.get("source")
+        if not isinstance(cmd, str) or not cmd.startswith("rvsm ") or "..." in cmd:
+            raise RvsmError(f"{path}: [{key}] command must be a whole rvsm command line "
+                            "(no \"...\")")
+        if not isinstance(source, str) or not source.strip():
+            raise RvsmError(f"{path}: [{key}] source must say where the command comes from")
+        out[key] = (cmd, source)
+    return out
