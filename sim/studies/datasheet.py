@@ -316,11 +316,9 @@ def _interfaces_section(inputs: DatasheetInputs, feas: Feasibility) -> list[str]
     lines += ["", *interfaces_lines(
         contract, p, fifo, regmap, get_architecture("stream").port_map(contract, lanes=p),
         ip.port_map(contract, **opts), feas.clock_needed_hz, inputs.docs)]
-    path = inputs.point_file.path
-    lines += ["", f"Sources: `rvsm verilog {path} --lanes {p} --interface axis -o build` "
-              "writes the same register map (`rvsm_axis_ip.regs.md/.json/.h`) and ports "
-              f"(`rvsm_axis_ip.ports.json`); `rvsm verilog {path} --lanes {p}` the bare "
-              "array's `ports.json`; state memories from rtl/fpga/block_ram.py.", ""]
+    lines += ["", "Sources: the architectures' port maps and register map, as `rvsm verilog` "
+              "writes them beside the Verilog (`ports.json`, `rvsm_axis_ip.regs.md/.json/.h`);"
+              f" state memories from rtl/fpga/block_ram.py; commands: {REPRODUCE}.", ""]
     return lines
 
 
@@ -373,6 +371,6 @@ def build_datasheet(inputs: DatasheetInputs) -> Datasheet:
     clk, clk_fig = _clock_section(inputs, feas)
     lines += res + clk + _interfaces_section(inputs, feas)
     qual, qual_figs = _quality_section(inputs)
-    lines += qual + verification_lines(inputs, SECTIONS[5]) + reproduce_lines(inputs)
+    lines += qual + verification_lines(inputs, SECTIONS[5]) + reproduce_lines(inputs, feas.lanes)
     return Datasheet("\n".join(lines), {"resources.png": res_fig, "clock.png": clk_fig,
                                         **qual_figs})

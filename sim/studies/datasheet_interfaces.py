@@ -50,7 +50,9 @@ def lane_field_rows(lanes: int, stride: int, width: int, what: str) -> list[str]
         rows = [row(0), f"| [{stride}i+{width - 1}:{stride}i] | `code<i>`, i = 0..{lanes - 1} "
                 f"| {width} | {what} of lane i: pixel (y, g*{lanes} + i) |", row(lanes - 1)]
     if stride > width:
-        rows.append(f"| [{stride}i+{stride - 1}:{stride}i+{width}] | padding of each lane | "
+        pad = f"[{stride}i+{stride - 1}]" if stride - width == 1 else \
+            f"[{stride}i+{stride - 1}:{stride}i+{width}]"
+        rows.append(f"| {pad} | padding of each lane | "
                     f"{stride - width} | ignored (each code padded to {stride} bits) |")
     return rows
 
@@ -110,7 +112,8 @@ def _register_lines(regmap: RegisterMap, fifo: int) -> list[str]:
               "| register | bits | field | access | reset | meaning |",
               "|---|---|---|---|---|---|"]
     lines += [f"| `{r.name}` | {_bits(f.lsb, f.width)} | `{f.name}` | {f.access} | "
-              f"{f.reset} | {f.desc} |" for r in regmap.registers for f in r.fields]
+              f"{f.reset if f.reset < 10 else f'0x{f.reset:X}'} | {f.desc} |"
+              for r in regmap.registers for f in r.fields]
     return lines
 
 

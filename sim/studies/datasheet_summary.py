@@ -60,8 +60,11 @@ def _verified(inputs: DatasheetInputs) -> str:
     v = inputs.verify
     if v is not None:
         ok = "0 mismatches" if v["mismatches"] == 0 else f"{v['mismatches']:,} MISMATCHES"
-        parts.append(f"RTL against the twin over {_verify_steps(v)} at full size: {ok} in "
-                     f"{v['compared']:,} accumulator-steps compared")
+        spikes = (f" ({v['expected_spikes']:,} spikes)"
+                  if isinstance(v.get("expected_spikes"), int) else "")
+        size = f" at {v['height']}x{v['width']}" if v.get("height") else ""
+        parts.append(f"RTL against the twin over {_verify_steps(v)}{size}: {ok} in "
+                     f"{v['compared']:,} accumulator-steps compared{spikes}")
     if inputs.regress is not None:
         r = inputs.regress
         parts.append(f"regression {r.count('pass')} of {len(r.cases)} pass")
@@ -73,7 +76,12 @@ def _verified(inputs: DatasheetInputs) -> str:
     if inputs.mutate is not None:
         m = inputs.mutate
         parts.append(f"mutation {m['killed']} of {m['mutations']} killed")
-    return "; ".join(parts) + " (Verification)" if parts else "nothing given (Verification)"
+    return ("; ".join(parts) if parts else "nothing given") + f" ({_see('Verification')})"
+
+
+def _see(section: str) -> str:
+    """A link to ``section`` of the page."""
+    return f"[{section}](#{'-'.join(section.lower().split())})"
 
 
 def summary_lines(inputs: DatasheetInputs, feas: Feasibility) -> list[str]:
@@ -94,10 +102,11 @@ def summary_lines(inputs: DatasheetInputs, feas: Feasibility) -> list[str]:
         how = "measured (nextpnr)" if fp and fp.get("fmax_mhz") else "timing model"
         clk = (f"{clock / 1e6:.1f} MHz needed; Fmax {fmax.budget:.1f} MHz {how}: "
                + margin_text(fmax.budget, clock / 1e6, "MHz"))
-    rows.append(("clock", clk + " (Clock)"))
+    rows.append(("clock", clk + f" ({_see('Clock')})"))
     rows.append(("lanes", f"P = {p} pixels a cycle: {geo.groups} beats a row, "
                           f"{geo.beats_per_frame:,} a step"))
-    thr = f"{inputs.rate_hz:,.0f} steps/s of {h}x{w} = {h * w * inputs.rate_hz:.3g} pixel-steps/s"
+    thr = (f"{inputs.rate_hz:,.0f} steps/s of {h}x{w} = {h * w * inputs.rate_hz:,.0f} "
+           "pixel-steps/s")
     if fmax.budget is not None:
         thr += f"; at Fmax up to {fmax.budget * 1e6 * p / (h * w):,.0f} steps/s"
     rows.append(("throughput", thr))
@@ -114,15 +123,17 @@ def summary_lines(inputs: DatasheetInputs, feas: Feasibility) -> list[str]:
                  f"{st.accumulators / 1e6:.3f} Mbit, line buffers {st.line_buffers / 1e3:.1f} "
                  "Kbit, thresholds " + (f"in {c.num_scales} shared registers" if shared
                                         else f"{st.thresholds / 1e6:.3f} Mbit")
-                 + f"; {feas.packing.bram} {dev.bram_kind.name} (Memory map and interfaces)"))
+                 + f"; {feas.packing.bram} {dev.bram_kind.name} "
+                 f"({_see('Memory map and interfaces')})"))
     if fp is not None:
         used = ", ".join(f"{k} {fp[key]['used']:,} of {fp[key]['available']:,} "
                          f"({100 * fp[key]['used'] / fp[key]['available']:.1f} %)"
                          for k, key in (("LUT4", "lut4"), ("FF", "ff"),
                                         (dev.bram_kind.name, "bram")))
-        rows.append(("utilisation", f"measured (place and route): {used} (Resources)"))
+        rows.append(("utilisation",
+                     f"measured (place and route): {used} ({_see('Resources')})"))
     else:
-        rows.append(("utilisation", f"estimate only: {feas.summary()} (Resources)"))
+        rows.append(("utilisation", f"estimate only: {feas.summary()} ({_see('Resources')})"))
     q = inputs.quality.rows_with(False) or inputs.quality.rows
     if q:
         n = len(q)
@@ -133,7 +144,7 @@ def summary_lines(inputs: DatasheetInputs, feas: Feasibility) -> list[str]:
                      f"twin {twin:.2f} dB, mean of {n} scenes, noise off: "
                      f"{better_or_worse(twin - own, 2)} dB against its own float model "
                      f"({own:.2f} dB), {better_or_worse(twin - dflt, 2)} dB against the "
-                     f"default dog4 float model ({dflt:.2f} dB) (Image quality)"))
+                     f"default dog4 float model ({dflt:.2f} dB) ({_see('Image quality')})"))
     rows.append(("verified", _verified(inputs)))
     return ["## Summary", "", "| | |", "|---|---|",
             *[f"| {k} | {v} |" for k, v in rows], "",
@@ -156,8 +167,9 @@ def _recorded(result: dict[str, Any] | None, key: str, inputs: DatasheetInputs,
     return None
 
 
-def reproduce_steps(inputs: DatasheetInputs) -> list[ReproduceStep]:
-    """The page's command, then each saved result's (module docstring)."""
+def reproduce_steps(inputs: DatasheetInputs, lanes: int) -> list[ReproduceStep]:
+    """The page's command, each saved result's (module docstring), then the Verilog
+    builds at ``lanes`` whose port and register files the interfaces section shows."""
     pf = inputs.point_file
     steps = [ReproduceStep("this page (from the saved results below)", inputs.command,
                            "the command that made it")]
@@ -166,7 +178,7 @@ def reproduce_steps(inputs: DatasheetInputs) -> list[ReproduceStep]:
         got = _recorded(fp, "fpga", inputs, inputs.fpga_path) or (
             f"rvsm fpga {(fp.get('settings') or {}).get('point', pf.path)} --json -o "
             f"{fp.get('work_dir', 'build/fpga')} > {inputs.fpga_path}",
-            "reconstructed from the result's settings (point, work folder)")
+            "reconstructed from the result's settings: its point and work folder")
         steps.append(ReproduceStep(f"place and route (`{inputs.fpga_path}`)", *got))
     if inputs.quality_path is not None:
         got = _recorded({"command": inputs.quality.command}, "quality", inputs,
@@ -194,16 +206,24 @@ def reproduce_steps(inputs: DatasheetInputs) -> list[ReproduceStep]:
             f"rvsm regress regressions/{inputs.regress.suites[0]}.toml --junit "
             f"{inputs.regress_path}", "reconstructed from the JUnit suite's name")
         steps.append(ReproduceStep(f"regression (`{inputs.regress_path}`)", *got))
+    p = lanes
+    if p:
+        steps += [ReproduceStep(
+            "the AXI IP's Verilog, register map (`.regs.md/.json/.h`) and ports "
+            "(`.ports.json`) of the interfaces section", f"rvsm verilog {pf.path} --lanes {p} "
+            "--interface axis -o build/ip", "the command that writes them"),
+            ReproduceStep("the bare array's Verilog and ports", f"rvsm verilog {pf.path} "
+                          f"--lanes {p} -o build/native", "the command that writes them")]
     return steps
 
 
-def reproduce_lines(inputs: DatasheetInputs) -> list[str]:
+def reproduce_lines(inputs: DatasheetInputs, lanes: int) -> list[str]:
     """The Reproduce section: each command whole, in a code block, with its origin."""
     lines = ["## Reproduce", "", "Every figure on this page, remade. Run from the "
              "repository's root; a command ending in `> FILE` saves the JSON the page "
              "reads. The long ones (place and route, the full-size run, mutation) take "
              "tens of minutes each on 2 cores.", ""]
-    for s in reproduce_steps(inputs):
+    for s in reproduce_steps(inputs, lanes):
         lines += [f"**{s.what}** ({s.origin})" + (":" if s.command else "."), ""]
         lines += ["```", s.command, "```", ""] if s.command else []
     return lines
