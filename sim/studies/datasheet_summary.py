@@ -193,9 +193,12 @@ def reproduce_steps(inputs: DatasheetInputs, lanes: int) -> list[ReproduceStep]:
             continue
         got = _recorded(result, key, inputs, path)
         if got is None and key == "mutate":
-            got = (f"rvsm mutate {pf.path} --size {'x'.join(map(str, result['size']))} "
-                   f"--lanes {result.get('lanes', 2)} --checks "
-                   f"{','.join(result.get('checks', ['cosim', 'formal']))} --json > {path}",
+            size, lanes, checks = result.get("size"), result.get("lanes"), result.get("checks")
+            got = (" ".join([f"rvsm mutate {pf.path}"]
+                            + ([f"--size {size[0]}x{size[1]}"] if size else [])
+                            + ([f"--lanes {lanes}"] if lanes else [])
+                            + ([f"--checks {','.join(checks)}"] if checks else [])
+                            + [f"--json > {path}"]),
                    "reconstructed from the result's size, lanes and checks, on this point")
         if got is None:
             got = ("", "NOT RECORDED: the result holds no command line; give it with "
