@@ -172,9 +172,7 @@ def _docs_from(out: Path) -> str:
     """The relative path from the output folder to the project's ``docs/`` (links)."""
     import os
 
-    import rvsm.sim
-
-    docs = Path(rvsm.sim.__file__).resolve().parents[1] / "docs"
+    docs = Path(__file__).resolve().parents[2] / "docs"  # sim/cli/ -> the project's root
     return Path(os.path.relpath(docs, out.resolve())).as_posix()
 
 

@@ -30,16 +30,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from rvsm.model.fixed.point_toml import to_toml_dict
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.block_ram import StateLayout
 from rvsm.rtl.fpga.camera import clock_needed_hz, state_memory
-from rvsm.rtl.fpga.devices import DeviceBudget
 from rvsm.rtl.fpga.feasibility import Camera, Feasibility, LogicCost, MeasuredFmax, assess
 from rvsm.sim.studies import datasheet_figures as figs
-from rvsm.sim.studies.datasheet_inputs import PointFile, RegressSummary
+from rvsm.sim.studies.datasheet_inputs import DatasheetInputs
+from rvsm.sim.studies.datasheet_interfaces import Interfaces, interfaces_lines, interfaces_of
 from rvsm.sim.studies.datasheet_summary import (
     REPRODUCE,
     margin_text,
@@ -47,7 +45,6 @@ from rvsm.sim.studies.datasheet_summary import (
     summary_lines,
 )
 from rvsm.sim.studies.datasheet_verification import verification_lines
-from rvsm.sim.studies.point_quality import PointQuality
 
 __all__ = ["Datasheet", "DatasheetInputs", "build_datasheet", "logic_of"]
 
@@ -57,46 +54,6 @@ SECTIONS = ("Design point", "Resources", "Clock", "Memory map and interfaces",
             "Image quality", "Verification")
 #: Before and after them.
 FIRST, LAST = "Summary", "Reproduce"
-
-
-@dataclass(frozen=True)
-class DatasheetInputs:
-    """Everything the page shows: the point file, ``device`` budget, camera ``rate_hz``,
-    ``lanes`` (None: the point's ``[rtl] lanes``, else the fewest that fit), state memory
-    ``organisation``, the quality study (and ``picture``: ``(scene, step, images)`` or
-    None) and the optional saved results with their paths; ``lane_cost``: a
-    :class:`~rvsm.rtl.fpga.lane_cost.LaneCost` record (None: not synthesised);
-    ``command``: the command line that made the page; ``quality_path``: the saved
-    quality result (None: run by the page's command); ``commands``: per saved result
-    (``fpga``, ``quality``, ``verify``, ``formal``, ``mutate``, ``regress``) the
-    command that made it and where that command comes from, for results that do not
-    record theirs (``--commands FILE.toml``); ``docs``: the path from the page to the
-    project's ``docs/`` folder (for links)."""
-
-    point_file: PointFile
-    device: DeviceBudget
-    rate_hz: float
-    quality: PointQuality
-    quality_source: str
-    lanes: int | None = None
-    organisation: str = "rtl"
-    fifo_depth: int = 16
-    picture: tuple[str, int, dict[str, np.ndarray]] | None = None
-    fpga: dict[str, Any] | None = None
-    fpga_path: str | None = None
-    lane_cost: dict[str, Any] | None = None
-    verify: dict[str, Any] | None = None
-    verify_path: str | None = None
-    regress: RegressSummary | None = None
-    regress_path: str | None = None
-    formal: dict[str, Any] | None = None
-    formal_path: str | None = None
-    mutate: dict[str, Any] | None = None
-    mutate_path: str | None = None
-    command: str = "rvsm datasheet"
-    quality_path: str | None = None
-    commands: dict[str, tuple[str, str]] = field(default_factory=dict)
-    docs: str = "../docs"
 
 
 @dataclass
@@ -301,21 +258,14 @@ def _clock_section(inputs: DatasheetInputs, feas: Feasibility) -> tuple[list[str
     return lines, figs.clock_figure(lanes, clocks, fmax.budget, feas.lanes, label)
 
 
-def _interfaces_section(inputs: DatasheetInputs, feas: Feasibility) -> list[str]:
-    from rvsm.rtl.architectures.registry import get_architecture
-    from rvsm.sim.studies.datasheet_interfaces import interfaces_lines
-
+def _interfaces_section(inputs: DatasheetInputs, feas: Feasibility,
+                        io: Interfaces) -> list[str]:
     contract = inputs.point_file.point.contract()
-    p, fifo = feas.lanes, inputs.fifo_depth
-    opts = {"lanes": p, "fifo_depth": fifo}
-    ip = get_architecture("stream", "axis")
-    regmap = ip.register_map(contract, **ip.resolve(opts))
-    lines = [f"## {SECTIONS[3]}", "", f"State memories at P = {p} ({feas.organisation} "
-             f"organisation) on {inputs.device.name}:", ""]
+    lines = [f"## {SECTIONS[3]}", "", f"State memories at P = {feas.lanes} "
+             f"({feas.organisation} organisation) on {inputs.device.name}:", ""]
     lines += [f"- {r}" for r in feas.packing.rows()]
-    lines += ["", *interfaces_lines(
-        contract, p, fifo, regmap, get_architecture("stream").port_map(contract, lanes=p),
-        ip.port_map(contract, **opts), feas.clock_needed_hz, inputs.docs)]
+    lines += ["", *interfaces_lines(contract, io, inputs.fifo_depth, feas.clock_needed_hz,
+                                    inputs.docs)]
     lines += ["", "Sources: the architectures' port maps and register map, as `rvsm verilog` "
               "writes them beside the Verilog (`ports.json`, `rvsm_axis_ip.regs.md/.json/.h`);"
               f" state memories from rtl/fpga/block_ram.py; commands: {REPRODUCE}.", ""]
@@ -366,10 +316,11 @@ def build_datasheet(inputs: DatasheetInputs) -> Datasheet:
              f"{inputs.device.name}", "",
              "Contents: " + ", ".join(f"[{t}](#{_anchor(t)})" for t in (FIRST, *SECTIONS, LAST))
              + f". Every figure's command is in {REPRODUCE}, at the end.", ""]
-    lines += summary_lines(inputs, feas) + _point_section(inputs, logic, feas)
+    io = interfaces_of(point.contract(), feas.lanes, inputs.fifo_depth)
+    lines += summary_lines(inputs, feas, io) + _point_section(inputs, logic, feas)
     res, res_fig = _resources_section(inputs, feas)
     clk, clk_fig = _clock_section(inputs, feas)
-    lines += res + clk + _interfaces_section(inputs, feas)
+    lines += res + clk + _interfaces_section(inputs, feas, io)
     qual, qual_figs = _quality_section(inputs)
     lines += qual + verification_lines(inputs, SECTIONS[5]) + reproduce_lines(inputs, feas.lanes)
     return Datasheet("\n".join(lines), {"resources.png": res_fig, "clock.png": clk_fig,

@@ -1,5 +1,6 @@
 """What ``rvsm datasheet`` reads: the design point (with its ``[rtl]`` table) and the saved
-results of other commands, each checked before anything is computed or written.
+results of other commands, each checked before anything is computed or written, and
+:class:`DatasheetInputs`, everything the page is made from.
 
 - the point TOML: the design point, and its ``[rtl]`` table read raw (``lanes``, ...),
   so the page can state the lanes the point was built for whether or not the loader
@@ -27,6 +28,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
@@ -35,8 +38,10 @@ else:  # pragma: no cover
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.text_files import read_utf8_text
+from rvsm.rtl.fpga.devices import DeviceBudget
+from rvsm.sim.studies.point_quality import PointQuality
 
-__all__ = ["COMMAND_KEYS", "PointFile", "RegressSummary", "load_commands",
+__all__ = ["COMMAND_KEYS", "DatasheetInputs", "PointFile", "RegressSummary", "load_commands",
            "load_fpga_report", "load_point_file",
            "load_formal_report", "load_mutate_report",
            "load_regress", "load_regress_database", "load_regress_junit",
@@ -148,6 +153,46 @@ class RegressSummary:
     def count(self, status: str) -> int:
         """Cases with ``status``."""
         return sum(1 for c in self.cases if c[2] == status)
+
+
+@dataclass(frozen=True)
+class DatasheetInputs:
+    """Everything the page shows: the point file, ``device`` budget, camera ``rate_hz``,
+    ``lanes`` (None: the point's ``[rtl] lanes``, else the fewest that fit), state memory
+    ``organisation``, the quality study (and ``picture``: ``(scene, step, images)`` or
+    None) and the optional saved results with their paths; ``lane_cost``: a
+    :class:`~rvsm.rtl.fpga.lane_cost.LaneCost` record (None: not synthesised);
+    ``command``: the command line that made the page; ``quality_path``: the saved
+    quality result (None: run by the page's command); ``commands``: per saved result
+    (``fpga``, ``quality``, ``verify``, ``formal``, ``mutate``, ``regress``) the
+    command that made it and where that command comes from, for results that do not
+    record theirs (``--commands FILE.toml``); ``docs``: the path from the page to the
+    project's ``docs/`` folder (for links)."""
+
+    point_file: PointFile
+    device: DeviceBudget
+    rate_hz: float
+    quality: PointQuality
+    quality_source: str
+    lanes: int | None = None
+    organisation: str = "rtl"
+    fifo_depth: int = 16
+    picture: tuple[str, int, dict[str, np.ndarray]] | None = None
+    fpga: dict[str, Any] | None = None
+    fpga_path: str | None = None
+    lane_cost: dict[str, Any] | None = None
+    verify: dict[str, Any] | None = None
+    verify_path: str | None = None
+    regress: RegressSummary | None = None
+    regress_path: str | None = None
+    formal: dict[str, Any] | None = None
+    formal_path: str | None = None
+    mutate: dict[str, Any] | None = None
+    mutate_path: str | None = None
+    command: str = "rvsm datasheet"
+    quality_path: str | None = None
+    commands: dict[str, tuple[str, str]] = field(default_factory=dict)
+    docs: str = "../docs"
 
 
 def load_formal_report(path: str | os.PathLike) -> dict[str, Any]:

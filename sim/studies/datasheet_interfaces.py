@@ -5,21 +5,25 @@ array (``--interface native``) and of the AXI IP (``--interface axis``) with a b
 table of every payload (``codes_payload``, ``spikes_payload``, ``s_axis_tdata``,
 ``m_axis_tdata``), the AXI4-Lite registers with every bit field
 (:func:`~rvsm.rtl.ip.register_map.ip_register_map`), and the reset, initialisation and
-flush sequence of both interfaces with this point's cycle counts
-(:class:`~rvsm.rtl.stream.dimensions.StreamGeometry`). The two payloads pack
-differently and the section says so first.
+flush sequence of both interfaces with this point's cycle counts. The two payloads pack
+differently and the section says so first. Everything comes through the architecture
+registry (:func:`interfaces_of`): the streaming array's beat geometry and port map, the
+IP's register map, port map and timing.
 """
 
 from __future__ import annotations
 
+import gc
+import warnings
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
-from rvsm.model.fixed.contract import ArrayContract
-from rvsm.rtl.ip.register_map import RegisterMap
-from rvsm.rtl.stream.dimensions import StreamGeometry
+from amaranth.hdl import UnusedElaboratable
 
-__all__ = ["axi_pixel_to_spike", "field_rows", "interfaces_lines", "lane_field_rows"]
+from rvsm.model.fixed.contract import ArrayContract
+
+__all__ = ["Interfaces", "field_rows", "interfaces_lines", "interfaces_of", "lane_field_rows"]
 
 #: Fields listed one by one up to this many; a longer run of lanes is shown as a
 #: formula with its first and last lane.
@@ -57,12 +61,42 @@ def lane_field_rows(lanes: int, stride: int, width: int, what: str) -> list[str]
     return rows
 
 
-def axi_pixel_to_spike(geo: StreamGeometry) -> int:
-    """Cycles from a pixel's beat on ``s_axis`` to its spikes on ``m_axis`` (back to
-    back, FIFO empty): ``lag + RELEASE_CYCLES`` of :class:`~rvsm.rtl.ip.wrapper.RvsmAxisIp`."""
-    from rvsm.rtl.ip.wrapper import RvsmAxisIp
+@dataclass(frozen=True)
+class Interfaces:
+    """Both interfaces of a point at ``P`` lanes: ``geometry`` the streaming array's
+    beat geometry (lag, groups, beats per frame, pixel-to-spike cycles, threshold
+    words), ``ip_timing`` the IP's timing (its ``ports.json`` ``timing``:
+    ``release_cycles``, ``init_cycles``, ...), ``regmap`` its register map and the
+    two port maps (with the payloads' bit ``fields``)."""
 
-    return geo.lag + RvsmAxisIp.RELEASE_CYCLES
+    geometry: Any
+    ip_timing: dict[str, int]
+    regmap: Any
+    native_ports: list[dict[str, Any]]
+    axi_ports: list[dict[str, Any]]
+
+    @property
+    def axi_pixel_to_spike(self) -> int:
+        """Cycles from a pixel's beat on ``s_axis`` to its spikes on ``m_axis`` (back to
+        back, FIFO empty): ``lag + release_cycles``."""
+        return self.geometry.lag + self.ip_timing["release_cycles"]
+
+
+def interfaces_of(contract: ArrayContract, lanes: int, fifo_depth: int) -> Interfaces:
+    """:class:`Interfaces` of the streaming array and its AXI IP, from the registry."""
+    from rvsm.rtl.architectures.registry import get_architecture
+
+    stream, ip = get_architecture("stream"), get_architecture("stream", "axis")
+    opts = ip.resolve({"lanes": lanes, "fifo_depth": fifo_depth})
+    with warnings.catch_warnings():  # built to be described, never elaborated
+        warnings.simplefilter("ignore", UnusedElaboratable)
+        dut = ip.build(contract, **opts)
+        timing = ip.describe(dut)["timing"]
+        del dut
+        gc.collect()
+    return Interfaces(stream.beats.geometry(contract, lanes), timing,
+                      ip.register_map(contract, **opts),
+                      stream.port_map(contract, lanes=lanes), ip.port_map(contract, **opts))
 
 
 def _port_table(rows: list[dict[str, Any]]) -> list[str]:
@@ -99,7 +133,7 @@ def _packing_note(native: dict[str, Any], axi: dict[str, Any], c: ArrayContract,
             f"{axi_code_bits} bits a lane (each code padded) in `s_axis_tdata`.")
 
 
-def _register_lines(regmap: RegisterMap, fifo: int) -> list[str]:
+def _register_lines(regmap: Any, fifo: int) -> list[str]:
     lines = [f"AXI4-Lite registers of the IP (`--interface axis`, P = {regmap.lanes}, "
              f"output FIFO {fifo} beats; 32-bit, byte offsets, {1 << regmap.addr_bits} B "
              "window; SLVERR for an unmapped address, a partial write, a write to a "
@@ -117,10 +151,10 @@ def _register_lines(regmap: RegisterMap, fifo: int) -> list[str]:
     return lines
 
 
-def _sequence_lines(c: ArrayContract, geo: StreamGeometry, clock_hz: float) -> list[str]:
-    us = 1e6 / clock_hz
+def _sequence_lines(c: ArrayContract, io: Interfaces, clock_hz: float) -> list[str]:
+    us, geo = 1e6 / clock_hz, io.geometry
     shared = geo.shared_thresholds
-    init = c.num_scales * geo.threshold_words
+    init = io.ip_timing["init_cycles"]
     thr = (f"one register per scale, configured to {', '.join(map(str, c.shared_thresholds))}"
            if shared else f"{init:,} threshold words, at the top rail "
            f"{(1 << c.threshold_bits) - 1} until written")
@@ -155,34 +189,30 @@ def _sequence_lines(c: ArrayContract, geo: StreamGeometry, clock_hz: float) -> l
         "frame 0 again."]
 
 
-def interfaces_lines(contract: ArrayContract, lanes: int, fifo_depth: int,
-                     regmap: RegisterMap, native_ports: list[dict[str, Any]],
-                     axi_ports: list[dict[str, Any]], clock_hz: float,
-                     docs: str) -> list[str]:
-    """The section's body (after its title and the state memories): ``native_ports`` and
-    ``axi_ports`` the architectures' port maps (with payload ``fields``), ``docs`` the
+def interfaces_lines(contract: ArrayContract, io: Interfaces, fifo_depth: int,
+                     clock_hz: float, docs: str) -> list[str]:
+    """The section's body (after its title and the state memories); ``docs`` the
     relative path from the page to the project's ``docs/`` folder."""
-    from rvsm.rtl.ip.axis import video_lane_bits
-
-    c, geo = contract, StreamGeometry(contract, lanes)
-    native, axi = _ports_by_name(native_ports), _ports_by_name(axi_ports)
-    b = video_lane_bits(c.adc_bits)
+    c, geo = contract, io.geometry
+    native, axi = _ports_by_name(io.native_ports), _ports_by_name(io.axi_ports)
+    b = axi["s_axis_tdata"]["width"] // geo.lanes  # each code padded to a byte multiple
     lines = [f"Guides: [integration guide]({docs}/integration.md) (the native interface, "
              f"timing diagrams) and [IP guide]({docs}/ip.md) (the AXI IP, its driver "
              "sequence in C).", "",
              _packing_note(native["spikes_payload"], axi["m_axis_tdata"], c, b), ""]
-    lines += _register_lines(regmap, fifo_depth)
+    lines += _register_lines(io.regmap, fifo_depth)
     lines += ["", "Ports of the bare streaming array (`--interface native`):", "",
-              *_port_table(native_ports)]
+              *_port_table(io.native_ports)]
     lines += _payload(f"`codes_payload` ({native['codes_payload']['width']} bits; beats in "
                       f"raster order: frame, row y, group g = 0..{geo.groups - 1})",
                       lane_field_rows(geo.lanes, c.adc_bits, c.adc_bits, "ADC code"))
     lines += _payload(f"`spikes_payload` ({native['spikes_payload']['width']} bits)",
                       field_rows(native["spikes_payload"]["fields"]))
-    lines += ["", "Ports of the AXI IP (`--interface axis`):", "", *_port_table(axi_ports)]
+    lines += ["", "Ports of the AXI IP (`--interface axis`):", "",
+              *_port_table(io.axi_ports)]
     lines += _payload(f"`s_axis_tdata` ({axi['s_axis_tdata']['width']} bits)",
                       lane_field_rows(geo.lanes, b, c.adc_bits, "ADC code"))
     lines += _payload(f"`m_axis_tdata` ({axi['m_axis_tdata']['width']} bits)",
                       field_rows(axi["m_axis_tdata"]["fields"]))
-    lines += _sequence_lines(c, geo, clock_hz)
+    lines += _sequence_lines(c, io, clock_hz)
     return lines

@@ -18,13 +18,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from rvsm.rtl.fpga.camera import state_memory
-from rvsm.rtl.stream.dimensions import StreamGeometry
-from rvsm.sim.studies.datasheet_interfaces import axi_pixel_to_spike
+from rvsm.sim.studies.datasheet_inputs import DatasheetInputs
+from rvsm.sim.studies.datasheet_interfaces import Interfaces
 from rvsm.sim.studies.point_quality import better_or_worse
 
 if TYPE_CHECKING:
     from rvsm.rtl.fpga.feasibility import Feasibility
-    from rvsm.sim.studies.datasheet import DatasheetInputs
 
 __all__ = ["ReproduceStep", "margin_text", "reproduce_lines", "reproduce_steps",
            "summary_lines"]
@@ -84,13 +83,13 @@ def _see(section: str) -> str:
     return f"[{section}](#{'-'.join(section.lower().split())})"
 
 
-def summary_lines(inputs: DatasheetInputs, feas: Feasibility) -> list[str]:
-    """The summary table (module docstring)."""
+def summary_lines(inputs: DatasheetInputs, feas: Feasibility, io: Interfaces) -> list[str]:
+    """The summary table (module docstring); ``io`` the interfaces at ``feas.lanes``."""
     point, dev, fp = inputs.point_file.point, inputs.device, inputs.fpga
     c = point.contract()
     h, w = point.shape
     p, clock = feas.lanes, feas.clock_needed_hz
-    geo = StreamGeometry(c, p)
+    geo = io.geometry
     fmax = feas.checks["fmax"]
     rows: list[tuple[str, str]] = [
         ("device", f"{dev.name}: {dev.part.split(' (')[0]}, placed by {dev.tool}"),
@@ -113,8 +112,8 @@ def summary_lines(inputs: DatasheetInputs, feas: Feasibility) -> list[str]:
     us = 1e6 / clock
     rows.append(("latency", f"pixel to spike {geo.pixel_to_spike} cycles = "
                             f"{geo.pixel_to_spike * us:.2f} us native, "
-                            f"{axi_pixel_to_spike(geo)} cycles = "
-                            f"{axi_pixel_to_spike(geo) * us:.2f} us AXI, at "
+                            f"{io.axi_pixel_to_spike} cycles = "
+                            f"{io.axi_pixel_to_spike * us:.2f} us AXI, at "
                             f"{clock / 1e6:.1f} MHz (lag {geo.lag} beats)"))
     st = state_memory(c)
     shared = c.shared_thresholds is not None

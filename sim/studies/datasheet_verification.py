@@ -9,10 +9,9 @@ commands are in the page's Reproduce section.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-if TYPE_CHECKING:
-    from rvsm.sim.studies.datasheet import DatasheetInputs
+from rvsm.sim.studies.datasheet_inputs import DatasheetInputs
 
 __all__ = ["verification_lines", "verify_counts"]
 
