@@ -103,7 +103,7 @@ def summary_lines(inputs: DatasheetInputs, feas: Feasibility, io: Interfaces) ->
                + margin_text(fmax.budget, clock / 1e6, "MHz"))
     rows.append(("clock", clk + f" ({_see('Clock')})"))
     rows.append(("lanes", f"P = {p} pixels a cycle: {geo.groups} beats a row, "
-                          f"{geo.beats_per_frame:,} a step"))
+                          f"{geo.beats_per_frame:,} beats a step (frame)"))
     thr = (f"{inputs.rate_hz:,.0f} steps/s of {h}x{w} = {h * w * inputs.rate_hz:,.0f} "
            "pixel-steps/s")
     if fmax.budget is not None:
