@@ -109,14 +109,16 @@ bench-fpga: setup
 
 # the shipped point's datasheet, remade from its saved results (docs/datasheet-ecp5-85-40khz/
 # results: rvsm fpga from make bench-fpga, rvsm quality, the 40,000-step rvsm verify, rvsm
-# formal, rvsm mutate and the JUnit of regressions/ecp5-85-40khz.toml, each named in the page); tests/sim/studies/
+# formal, rvsm mutate and the JUnit of regressions/ecp5-85-40khz.toml, each named in the page;
+# commands.toml: the command lines the results do not record); tests/sim/studies/
 # test_shipped_datasheet.py checks the page against them
 SHEET = docs/datasheet-ecp5-85-40khz
 datasheet: setup
 	$(BIN)/rvsm datasheet points/ecp5-85-40khz.toml -o $(SHEET) --force \
 	  --fpga $(SHEET)/results/fpga.json --quality $(SHEET)/results/quality.json \
 	  --verify $(SHEET)/results/verify.json --formal $(SHEET)/results/formal.json \
-	  --mutate $(SHEET)/results/mutate.json --regress $(SHEET)/results/regress.xml
+	  --mutate $(SHEET)/results/mutate.json --regress $(SHEET)/results/regress.xml \
+	  --commands $(SHEET)/results/commands.toml
 
 # the guides' timing diagrams, recorded from amaranth.sim (docs/integration.md, docs/ip.md)
 diagrams: setup

@@ -112,14 +112,17 @@ class Register:
 @dataclass(frozen=True)
 class RegisterMap:
     """The registers in offset order, plus what a driver needs to pack threshold words:
-    ``thr_chunks`` data registers of 32 bits hold one word of ``lanes`` thresholds of
-    ``threshold_bits`` (lane ``i`` at bits ``[i*threshold_bits +: threshold_bits]`` of
-    the chunks' concatenation, chunk 0 lowest)."""
+    ``thr_chunks`` data registers of 32 bits hold one word of ``thresholds_per_word``
+    thresholds of ``threshold_bits`` (threshold ``i`` at bits
+    ``[i*threshold_bits +: threshold_bits]`` of the chunks' concatenation, chunk 0
+    lowest): ``lanes`` (P, pixels per beat) with a threshold memory, 1 with shared
+    thresholds (one register per scale)."""
 
     registers: tuple[Register, ...]
     addr_bits: int
     thr_chunks: int
     threshold_bits: int
+    thresholds_per_word: int
     lanes: int
 
     def __post_init__(self) -> None:
@@ -262,7 +265,7 @@ def ip_register_map(contract: ArrayContract, lanes: int, fifo_depth: int, rtl_di
             + ("; writing this register commits the word to THR_ADDR (SLVERR while "
                "STATUS.init)" if last else ""),
             commit=last))
-    return RegisterMap(tuple(regs), ADDR_BITS, chunks, tw, per_word)
+    return RegisterMap(tuple(regs), ADDR_BITS, chunks, tw, per_word, p)
 
 
 def _threshold_address(geo: StreamGeometry, word_bits: int, scale_bits: int) -> Register:
@@ -291,7 +294,9 @@ def regs_json(regmap: RegisterMap, meta: Mapping[str, object]) -> str:
              "fields": [asdict(f) for f in r.fields]} for r in regmap.registers]
     return json.dumps({**meta, "addr_bits": regmap.addr_bits, "data_bits": 32,
                        "thr_chunks": regmap.thr_chunks,
-                       "threshold_bits": regmap.threshold_bits, "lanes": regmap.lanes,
+                       "threshold_bits": regmap.threshold_bits,
+                       "thresholds_per_word": regmap.thresholds_per_word,
+                       "lanes": regmap.lanes,
                        "access": ACCESS, "registers": regs}, indent=2) + "\n"
 
 
@@ -315,7 +320,9 @@ def regs_markdown(regmap: RegisterMap, top: str) -> str:
 
 def regs_c_header(regmap: RegisterMap, top: str, prefix: str | None = None) -> str:
     """``<top>.regs.h``: include-guarded ``#define`` s of every offset, field shift and
-    mask, reset value, and the threshold word's packing."""
+    mask, reset value, and the threshold word's packing: ``THR_CHUNKS`` data registers
+    per word, ``THRESHOLD_BITS`` per threshold, ``THRESHOLDS_PER_WORD`` thresholds per
+    word, and ``LANES`` the IP's pixels per beat (P)."""
     pre = (prefix or top).upper()
     guard = f"{pre}_REGS_H"
     lines = [f"#ifndef {guard}", f"#define {guard}", "",
@@ -323,6 +330,7 @@ def regs_c_header(regmap: RegisterMap, top: str, prefix: str | None = None) -> s
              f"#define {pre}_ADDR_BITS {regmap.addr_bits}u",
              f"#define {pre}_THR_CHUNKS {regmap.thr_chunks}u",
              f"#define {pre}_THRESHOLD_BITS {regmap.threshold_bits}u",
+             f"#define {pre}_THRESHOLDS_PER_WORD {regmap.thresholds_per_word}u",
              f"#define {pre}_LANES {regmap.lanes}u"]
     for r in regmap.registers:
         name = f"{pre}_{r.name}"

@@ -106,6 +106,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mutate", metavar="FILE.json", help="saved rvsm mutate POINT --json")
     p.add_argument("--regress", metavar="FILE", help="rvsm regress results: its database "
                    "(-o RESULTS.sqlite) or its JUnit XML (--junit FILE.xml)")
+    p.add_argument("--commands", metavar="FILE.toml", help="command lines of saved results "
+                   "that do not record theirs ([verify] command = ..., source = where it "
+                   "comes from), for the page's Reproduce section")
     p.add_argument("--picture-scene", metavar="SCENE",
                    help="scene of the reconstruction picture (default the first scored)")
     p.add_argument("--no-synthesis", action="store_true",
@@ -165,6 +168,14 @@ def _same_point(quality, point, path: str) -> None:
                         f"in {', '.join(diff)}); rerun rvsm quality on this point")
 
 
+def _docs_from(out: Path) -> str:
+    """The relative path from the output folder to the project's ``docs/`` (links)."""
+    import os
+
+    docs = Path(__file__).resolve().parents[2] / "docs"  # sim/cli/ -> the project's root
+    return Path(os.path.relpath(docs, out.resolve())).as_posix()
+
+
 def _datasheet(args: argparse.Namespace) -> int:
     from rvsm.rtl.fpga.devices import get_budget
     from rvsm.sim.studies import datasheet_inputs as di
@@ -177,7 +188,7 @@ def _datasheet(args: argparse.Namespace) -> int:
         raise RvsmError(f"--rate-hz must be > 0, got {args.rate_hz:g}")
     device = get_budget(args.device)
     inputs = [args.point, args.fpga, args.quality, args.verify, args.regress, args.formal,
-              args.mutate]
+              args.mutate, args.commands]
     check_outputs([Output(args.output, "-o", FOLDER, DATASHEET_FILES)], inputs, args.force)
     pf = di.load_point_file(args.point)
     lanes = args.lanes or pf.lanes
@@ -195,7 +206,8 @@ def _datasheet(args: argparse.Namespace) -> int:
     verify = di.load_verify_result(args.verify) if args.verify else None
     regress = di.load_regress(args.regress) if args.regress else None
     checks = {"formal": di.load_formal_report(args.formal) if args.formal else None,
-              "mutate": di.load_mutate_report(args.mutate) if args.mutate else None}
+              "mutate": di.load_mutate_report(args.mutate) if args.mutate else None,
+              "commands": di.load_commands(args.commands) if args.commands else {}}
     picture_scene = _scenes([args.picture_scene]) if args.picture_scene else None
     return _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,
                            picture_scene, settings, checks)
@@ -225,7 +237,7 @@ def _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,  # 
                                     **settings)
         source = f"`{quality_command(pf.path, quality)} --json` (run by this page's command)"
     else:
-        source = f"`{quality.command or 'rvsm quality'}` saved as `{args.quality}`"
+        source = f"`rvsm quality` saved as `{args.quality}`"
     picture = None
     if pf.point.kind == default_design_point().kind:  # pictures: spike camera only
         scene_name = (picture_scene or [quality.rows[0].scene])[0]
@@ -235,14 +247,15 @@ def _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,  # 
         step, images = reconstructions(replace(pf.point, noise=False), scene,
                                        method=quality.method, match=quality.match)
         picture = (scene_name, step, images)
+    out = Path(args.output)
     sheet = build_datasheet(DatasheetInputs(
         point_file=pf, device=device, rate_hz=args.rate_hz, quality=quality,
         quality_source=source, lanes=args.lanes, organisation=args.organisation, picture=picture,
         fpga=fpga, fpga_path=args.fpga, lane_cost=lane_cost, verify=verify,
         verify_path=args.verify, regress=regress, regress_path=args.regress,
         formal=checks["formal"], formal_path=args.formal, mutate=checks["mutate"],
-        mutate_path=args.mutate, command=command))
-    out = Path(args.output)
+        mutate_path=args.mutate, command=command, quality_path=args.quality,
+        commands=checks["commands"], docs=_docs_from(out)))
     for name, fig in sheet.figures.items():
         with atomic_path(out / name) as tmp:
             fig.savefig(tmp, format="png")

@@ -2,7 +2,7 @@
 
 :func:`build_datasheet` turns a :class:`DatasheetInputs` (the point, the device, the
 camera rate, and whatever was measured elsewhere) into the page's Markdown and its
-figures, section by section:
+figures, section by section, after a **Summary** table (:mod:`.datasheet_summary`):
 
 1. **Design point** -- every field, and what each costs in state bits at the sensor's
    size (:func:`~rvsm.rtl.fpga.camera.state_memory`: accumulators, thresholds, line
@@ -13,15 +13,16 @@ figures, section by section:
    on :mod:`rvsm.rtl.fpga.devices` budgets), each labelled;
 3. **Clock** -- Fmax against the clock the camera needs, ``H * W/P * rate``;
 4. **Memory map and interfaces** -- the state memories at ``P`` lanes, the AXI4-Lite
-   register map of the IP (:func:`~rvsm.rtl.ip.register_map.ip_register_map`) and the
-   ports of the bare array and of the IP (the architectures' port maps, as ``rvsm
-   verilog`` writes them to ``ports.json``);
+   register map of the IP with every bit field, the ports of the bare array and of the
+   IP with every payload's bit ranges, the reset, initialisation and flush sequence
+   (:mod:`.datasheet_interfaces`);
 5. **Image quality** -- the study of :mod:`rvsm.sim.studies.point_quality` and a picture of
    the reconstructions;
 6. **Verification** -- saved ``rvsm verify --json`` and ``rvsm regress --junit`` results,
    "not run" for what is not given.
 
-Every section ends with a "Sources" line naming the commands behind its figures.
+Every section ends with a "Sources" line naming the code behind its figures and pointing
+to the one **Reproduce** section at the end, which has every command whole.
 """
 
 from __future__ import annotations
@@ -29,17 +30,21 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from rvsm.model.fixed.point_toml import to_toml_dict
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.block_ram import StateLayout
 from rvsm.rtl.fpga.camera import clock_needed_hz, state_memory
-from rvsm.rtl.fpga.devices import DeviceBudget
 from rvsm.rtl.fpga.feasibility import Camera, Feasibility, LogicCost, MeasuredFmax, assess
 from rvsm.sim.studies import datasheet_figures as figs
-from rvsm.sim.studies.datasheet_inputs import PointFile, RegressSummary
-from rvsm.sim.studies.point_quality import PointQuality
+from rvsm.sim.studies.datasheet_inputs import DatasheetInputs
+from rvsm.sim.studies.datasheet_interfaces import Interfaces, interfaces_lines, interfaces_of
+from rvsm.sim.studies.datasheet_summary import (
+    REPRODUCE,
+    margin_text,
+    reproduce_lines,
+    summary_lines,
+)
+from rvsm.sim.studies.datasheet_verification import verification_lines
 
 __all__ = ["Datasheet", "DatasheetInputs", "build_datasheet", "logic_of"]
 
@@ -47,38 +52,8 @@ __all__ = ["Datasheet", "DatasheetInputs", "build_datasheet", "logic_of"]
 PAGE = "datasheet.md"
 SECTIONS = ("Design point", "Resources", "Clock", "Memory map and interfaces",
             "Image quality", "Verification")
-
-
-@dataclass(frozen=True)
-class DatasheetInputs:
-    """Everything the page shows: the point file, ``device`` budget, camera ``rate_hz``,
-    ``lanes`` (None: the point's ``[rtl] lanes``, else the fewest that fit), state memory
-    ``organisation``, the quality study (and ``picture``: ``(scene, step, images)`` or
-    None) and the optional saved results with their paths; ``lane_cost``: a
-    :class:`~rvsm.rtl.fpga.lane_cost.LaneCost` record (None: not synthesised);
-    ``command``: the command line that made the page."""
-
-    point_file: PointFile
-    device: DeviceBudget
-    rate_hz: float
-    quality: PointQuality
-    quality_source: str
-    lanes: int | None = None
-    organisation: str = "rtl"
-    fifo_depth: int = 16
-    picture: tuple[str, int, dict[str, np.ndarray]] | None = None
-    fpga: dict[str, Any] | None = None
-    fpga_path: str | None = None
-    lane_cost: dict[str, Any] | None = None
-    verify: dict[str, Any] | None = None
-    verify_path: str | None = None
-    regress: RegressSummary | None = None
-    regress_path: str | None = None
-    formal: dict[str, Any] | None = None
-    formal_path: str | None = None
-    mutate: dict[str, Any] | None = None
-    mutate_path: str | None = None
-    command: str = "rvsm datasheet"
+#: Before and after them.
+FIRST, LAST = "Summary", "Reproduce"
 
 
 @dataclass
@@ -130,6 +105,18 @@ def _bits(n: float) -> str:
         else f"{n:.0f} bit"
 
 
+def sensor_fields(sensor: str) -> list[Any]:
+    """The design point's fields a ``sensor`` kind uses: a field documented as
+    ``"sensor dvs: ..."`` belongs to that kind alone."""
+    from rvsm.model.fixed.point_fields import FIELDS
+
+    def kind_of(doc: str) -> str | None:
+        head = doc.split(":", 1)[0]
+        return head.split()[1] if head.startswith("sensor ") and " " in head else None
+
+    return [f for f in FIELDS if kind_of(f.doc) in (None, sensor)]
+
+
 def _point_section(inputs: DatasheetInputs, logic: LogicCost | None,
                    feas: Feasibility) -> list[str]:
     pf, point = inputs.point_file, inputs.point_file.point
@@ -139,10 +126,17 @@ def _point_section(inputs: DatasheetInputs, logic: LogicCost | None,
     lines = [f"## {SECTIONS[0]}", "", f"`{pf.path}`: {point.model} "
              f"({point.sensor}), {h}x{w} pixels, {s} scale(s)"
              + (f"; `[rtl]` {', '.join(f'{k} = {v}' for k, v in pf.rtl.items())}"
-                if pf.rtl else "") + ".", "", "| field | value |", "|---|---|"]
-    for sec, table in to_toml_dict(point).items():
-        lines += [f"| `{sec}.{k}` | {v} |" for k, v in table.items()]
-    thr = "shared registers, no memory" if shared else f"{_bits(st.thresholds)}"
+                if pf.rtl else "") + ". The fields this sensor kind uses:", "",
+             "| field | value | meaning |", "|---|---|---|"]
+    values = to_toml_dict(point)
+    lines += [f"| `{f.path}` | {values[f.section][f.key]} | {f.doc} |"
+              for f in sensor_fields(point.sensor) if f.key in values.get(f.section, {})]
+    tb = st.threshold_bits
+    thr_row = (f"| `threshold.storage` | shared | thresholds: one register per scale, "
+               f"S x (A - 1) | {s} x {tb} bit in registers, no memory | 0 (registers) |"
+               if shared else
+               f"| `threshold.storage` | per-pixel | thresholds S x H x W x (A - 1), "
+               f"A - 1 = {tb} | {_bits(st.thresholds)} | {_bits(s * h * w)} per bit of A |")
     per_lane = ("not estimated (no synthesis: see Sources)" if logic is None else
                 f"{logic.lut4_per_lane:,.0f} LUT4 and {logic.ff_per_lane:,.0f} FF per "
                 f"lane, {logic.lut4_base:,.0f} LUT4 fixed ({logic.source})")
@@ -152,9 +146,7 @@ def _point_section(inputs: DatasheetInputs, logic: LogicCost | None,
               "|---|---|---|---|---|",
               f"| `datapath.accumulator_bits` | {st.accumulator_bits} | accumulators "
               f"S x H x W x A | {_bits(st.accumulators)} | {_bits(s * h * w)} per bit |",
-              f"| `datapath.accumulator_bits` | {st.threshold_bits} (A - 1) | thresholds "
-              f"S x H x W x (A-1) | {thr} | "
-              + ("0" if shared else f"{_bits(s * h * w)} per bit") + " |",
+              thr_row,
               f"| `adc.bits` | {st.adc_bits} | line buffers 2L x W x N | "
               f"{_bits(st.line_buffers)} | {_bits(2 * st.radius * w)} per bit |",
               f"| `array.model` | {point.model} | S = {s} scales, L = {st.radius} | "
@@ -165,15 +157,31 @@ def _point_section(inputs: DatasheetInputs, logic: LogicCost | None,
               f"{point.weight_frac_bits} | logic only | - | {per_lane} |", "",
               f"Block RAM at P = {feas.lanes} ({feas.organisation} organisation, "
               f"{inputs.device.name}): {feas.packing.bram} {inputs.device.bram_kind.name}.",
-              "", f"Sources: this page's command (`{inputs.command}`) from "
-              "rtl/fpga/camera.py and rtl/fpga/block_ram.py; logic per lane: "
+              "", "Sources: rtl/fpga/camera.py and rtl/fpga/block_ram.py; logic per lane: "
               + ("the saved `rvsm fpga --slope-lanes` report" if inputs.fpga and
                  (inputs.fpga.get("slope") or {}) else
                  "lane_cost (yosys synth_ecp5 at 16x16, P = 1 and 2), as `rvsm sweep` "
                  "measures it" if inputs.lane_cost else
                  "not run (omit --no-synthesis, or give --fpga from `rvsm fpga POINT "
-                 "--slope-lanes 2 --json`)") + ".", ""]
+                 "--slope-lanes 2 --json`)") + f"; commands: {REPRODUCE}.", ""]
     return lines
+
+
+def budget_text(check: Any) -> str:
+    """A budget check as a designer reads it: ``fits: 192 of 208 DP16KD, 16 spare (8 %
+    of the budget)`` or ``BREAKS: 400 of 208 DP16KD, over by 192 (92 %)``; then its
+    detail (how the figure was obtained)."""
+    fig, bud, unit = check.figure, check.budget, check.unit
+    if fig is None or bud is None:
+        text = f"unknown: {check.detail}"
+        return text
+    if fig <= bud:
+        text = (f"fits: {fig:,.0f} of {bud:,.0f} {unit}, {bud - fig:,.0f} spare "
+                f"({100 * (bud - fig) / bud:.0f} % of the budget)")
+    else:
+        text = (f"BREAKS: {fig:,.0f} of {bud:,.0f} {unit}, over by {fig - bud:,.0f} "
+                f"({100 * (fig - bud) / bud:.0f} %)")
+    return text + (f"; {check.detail}" if check.detail else "")
 
 
 def _pct(used: float | None, avail: float | None) -> float | None:
@@ -200,7 +208,7 @@ def _resources_section(inputs: DatasheetInputs, feas: Feasibility) -> tuple[list
         e = "not estimated" if est[k] is None else \
             f"{est[k]:,.0f} ({_pct(est[k], avail[k]):.1f} %)"
         check = {"LUT4": c["lut4"], "FF": c["ff"]}.get(k, c["memory"])
-        verdict = check.text() if check.ok is not None else \
+        verdict = budget_text(check) if check.ok is not None else \
             "unknown: no logic figure (see Sources)"
         lines.append(f"| {k} | {m} | {e} | {avail[k]:,} | {verdict} |")
     lines += ["", f"Measured column: {where}. The estimate is the feasibility model "
@@ -210,11 +218,10 @@ def _resources_section(inputs: DatasheetInputs, feas: Feasibility) -> tuple[list
               "the LUT4 and FF; it is an **estimate**, not a placed design. "
               f"Verdict of the estimate: {feas.summary()}.", "",
               "![resources](resources.png)", "",
-              "Sources: measured: " + (f"`rvsm fpga {inputs.point_file.path} --json` saved "
-                                       f"as `{inputs.fpga_path}`" if fp else "not run "
-                                       f"(`rvsm fpga {inputs.point_file.path} --json > "
-                                       "fpga.json`, then --fpga fpga.json)")
-              + f"; estimate: `{inputs.command}`.", ""]
+              "Sources: measured: " + (f"`rvsm fpga` saved as `{inputs.fpga_path}`" if fp
+                                       else "not run (give --fpga FILE.json from `rvsm "
+                                       "fpga POINT --json`)")
+              + f"; estimate: rtl/fpga/feasibility.py; commands: {REPRODUCE}.", ""]
     rows = [(k, _pct(meas[k], avail[k]), _pct(est[k], avail[k])) for k in est]
     return lines, figs.resources_figure(rows, dev.name)
 
@@ -233,8 +240,10 @@ def _clock_section(inputs: DatasheetInputs, feas: Feasibility) -> tuple[list[str
              f"**{feas.clock_needed_hz / 1e6:.1f} MHz** at P = {feas.lanes} lanes "
              f"({lanes_from}).", "",
              "Fmax: " + ("unknown" if fmax.budget is None else f"**{fmax.budget:.1f} MHz**")
-             + f" ({how}); " + {True: "the clock is met.", False: "the clock is NOT met.",
-                                None: "not known whether the clock is met."}[fmax.ok], "",
+             + f" ({how}); " + {True: "the clock is met", False: "the clock is NOT met",
+                                None: "not known whether the clock is met"}[fmax.ok]
+             + ("" if fmax.budget is None else ", " + margin_text(
+                 fmax.budget, feas.clock_needed_hz / 1e6, "MHz")) + ".", "",
              "| P | clock needed (MHz) |", "|---|---|"]
     near = [i for i, p in enumerate(lanes) if p == feas.lanes]
     idx = sorted(set(range(max(0, near[0] - 3), min(len(lanes), near[0] + 4)))) if near else []
@@ -243,41 +252,23 @@ def _clock_section(inputs: DatasheetInputs, feas: Feasibility) -> tuple[list[str
     measured = "the saved `rvsm fpga` report" if inputs.fpga and inputs.fpga.get("fmax_mhz") \
         else "no place and route given: the device's timing model (rtl/fpga/devices.py)"
     lines += ["", "![clock](clock.png)", "",
-              f"Sources: Fmax from {measured}; clock from rtl/fpga/camera.py "
-              f"(`{inputs.command}`).", ""]
+              f"Sources: Fmax from {measured}; clock from rtl/fpga/camera.py; commands: "
+              f"{REPRODUCE}.", ""]
     label = "Fmax" + ("" if fmax.budget is None else f" {fmax.budget:.0f} MHz")
     return lines, figs.clock_figure(lanes, clocks, fmax.budget, feas.lanes, label)
 
 
-def _interfaces_section(inputs: DatasheetInputs, feas: Feasibility) -> list[str]:
-    from rvsm.rtl.architectures.registry import get_architecture
-
+def _interfaces_section(inputs: DatasheetInputs, feas: Feasibility,
+                        io: Interfaces) -> list[str]:
     contract = inputs.point_file.point.contract()
-    p, fifo = feas.lanes, inputs.fifo_depth
-    opts = {"lanes": p, "fifo_depth": fifo}
-    ip = get_architecture("stream", "axis")
-    regmap = ip.register_map(contract, **ip.resolve(opts))
-    lines = [f"## {SECTIONS[3]}", "", f"State memories at P = {p} ({feas.organisation} "
-             f"organisation) on {inputs.device.name}:", ""]
+    lines = [f"## {SECTIONS[3]}", "", f"State memories at P = {feas.lanes} "
+             f"({feas.organisation} organisation) on {inputs.device.name}:", ""]
     lines += [f"- {r}" for r in feas.packing.rows()]
-    lines += ["", f"AXI4-Lite registers of the IP (`--interface axis`, P = {p}, output "
-              f"FIFO {fifo} beats; 32-bit, byte offsets, {1 << regmap.addr_bits} B window):",
-              "", "| offset | register | access | reset | meaning |", "|---|---|---|---|---|"]
-    lines += [f"| 0x{r.offset:03X} | `{r.name}` | {r.access} | 0x{r.reset:08X} | {r.desc} |"
-              for r in regmap.registers]
-    for title, arch, options in (("bare streaming array (`--interface native`)",
-                                  get_architecture("stream"), {"lanes": p}),
-                                 ("AXI IP (`--interface axis`)",
-                                  get_architecture("stream", "axis"), opts)):
-        lines += ["", f"Ports of the {title}:", "", "| port | dir | width | meaning |",
-                  "|---|---|---|---|"]
-        lines += [f"| `{r['name']}` | {r['dir']} | {r['width']} | {r['desc']} |"
-                  for r in arch.port_map(contract, **options)]
-    path = inputs.point_file.path
-    lines += ["", f"Sources: `rvsm verilog {path} --lanes {p} --interface axis -o build` "
-              "writes the same register map (`rvsm_axis_ip.regs.md/.json/.h`) and ports "
-              f"(`rvsm_axis_ip.ports.json`); `rvsm verilog {path} --lanes {p}` the bare "
-              "array's `ports.json`; state memories from rtl/fpga/block_ram.py.", ""]
+    lines += ["", *interfaces_lines(contract, io, inputs.fifo_depth, feas.clock_needed_hz,
+                                    inputs.docs)]
+    lines += ["", "Sources: the architectures' port maps and register map, as `rvsm verilog` "
+              "writes them beside the Verilog (`ports.json`, `rvsm_axis_ip.regs.md/.json/.h`);"
+              f" state memories from rtl/fpga/block_ram.py; commands: {REPRODUCE}.", ""]
     return lines
 
 
@@ -287,11 +278,12 @@ def _quality_section(inputs: DatasheetInputs) -> tuple[list[str], dict[str, Any]
     out: dict[str, Any] = {"quality_costs.png": figs.costs_figure(q)}
     lines = [f"## {SECTIONS[4]}", "",
              f"PSNR (dB) and SSIM against the ground truth on {len({r.scene for r in q.rows})}"
-             f" built-in scene(s) at {h}x{w}, {q.steps} steps ({q.frames} frames x "
-             f"{q.steps_per_frame}), seed {q.point.get('seed')}, {q.method} reconstruction, "
-             f"{q.match} brightness matching. **Quantisation cost** = own float - twin (what "
-             "the fixed point costs); **chip cost** = float dog4 (the default design point) "
-             "- twin (what this chip costs a user against the default float model).", ""]
+             f" built-in scene(s) at {h}x{w}, {q.steps_text()}, seed "
+             f"{q.point.get('seed')}, {q.method} reconstruction, {q.match} brightness "
+             "matching. **Twin against own float**: the fixed twin's PSNR against its own "
+             "float model's (what the fixed point costs); **chip against dog4 float**: the "
+             "twin's PSNR against the default design point's float model (dog4), what "
+             "this chip gives a user instead of the default float model.", ""]
     for noise in (False, True):
         if q.rows_with(noise):
             lines += [f"Noise {'on' if noise else 'off'}:", "", *q.markdown(noise), ""]
@@ -305,68 +297,14 @@ def _quality_section(inputs: DatasheetInputs) -> tuple[list[str], dict[str, Any]
                   "![reconstructions](reconstructions.png)", ""]
     else:
         lines += ["No reconstruction picture: drawn for spike-camera points only.", ""]
-    picture = f"; picture: `{inputs.command}`" if inputs.picture is not None else ""
-    lines += [f"Sources: {inputs.quality_source}{picture}.", ""]
+    picture = "; picture: drawn by this page's command" if inputs.picture is not None else ""
+    lines += [f"Sources: {inputs.quality_source}{picture}; commands: {REPRODUCE}.", ""]
     return lines, out
 
 
-def _verification_section(inputs: DatasheetInputs) -> list[str]:
-    lines = [f"## {SECTIONS[5]}", "", "| check | command | result |", "|---|---|---|"]
-    v = inputs.verify
-    if v is None:
-        lines.append("| RTL against the twin | `rvsm verify SCENE --fixed POINT --json` | "
-                     "not run |")
-    else:
-        verdict = "PASS" if v["mismatches"] == 0 else f"FAIL ({v['mismatches']} mismatches)"
-        what = ", ".join(f"{k} {v[k]}" for k in ("sim", "arch", "steps", "harness")
-                         if k in v)
-        run = "rvsm verify ..."
-        if v.get("command"):
-            run = v["command"]
-        elif v.get("scene") and v.get("point"):  # an older result: its main options, "..."
-            run = "rvsm verify " + " ".join(
-                [str(v["scene"]), "--fixed", str(v["point"])]
-                + [f"--{k} {v[key]}" for k, key in (("sim", "simulator"),
-                                                     ("harness", "harness"), ("steps", "steps"))
-                   if v.get(key)] + ["..."])
-        lines.append(f"| RTL against the twin | `{run} --json` saved as "
-                     f"`{inputs.verify_path}` | {verdict}: {v['compared']:,} spikes "
-                     f"compared{'; ' + what if what else ''} |")
-    r = inputs.regress
-    if r is None:
-        lines.append("| regression plan | `rvsm regress PLAN.toml -o RESULTS.sqlite` | "
-                     "not run |")
-    else:
-        n = len(r.cases)
-        lines.append(f"| regression {', '.join(r.suites)} | `rvsm regress` results "
-                     f"`{inputs.regress_path}` | {r.count('pass')} of {n} pass, "
-                     f"{r.count('fail')} fail, {r.count('error')} error |")
-        bad = [c for c in r.cases if c[2] in ("fail", "error")]
-        lines += [f"| - {c[1]} | | {c[2]} |" for c in bad[:20]]
-    f = inputs.formal
-    if f is None:
-        lines.append("| formal checks (tiny size) | `rvsm formal POINT --size HxW --json` | "
-                     "not run |")
-    else:
-        h, w = f["size"]
-        lanes = (f.get("options") or {}).get("lanes")
-        done = "; ".join(f"{c['check']} {c['status']} ({c.get('mode', '?')}, depth "
-                         f"{c.get('depth', '?')})" for c in f["checks"])
-        lines.append(f"| formal checks, {f.get('model', '?')} {h}x{w}"
-                     f"{f', P = {lanes}' if lanes else ''} | `rvsm formal ... --json` saved "
-                     f"as `{inputs.formal_path}` | {'PASS' if f.get('ok') else 'FAIL'}: "
-                     f"{done} |")
-    m = inputs.mutate
-    if m is None:
-        lines.append("| mutation testing (tiny size) | `rvsm mutate POINT --json` | not run |")
-    else:
-        survivors = ", ".join(m["survivors"]) or "none"
-        lines.append(f"| mutation testing ({', '.join(m.get('checks', []))}) | `rvsm mutate "
-                     f"... --json` saved as `{inputs.mutate_path}` | {m['killed']} of "
-                     f"{m['mutations']} mutations killed; survivors: {survivors} |")
-    lines += ["", "Sources: the saved results named above (--verify, --regress, --formal, "
-              "--mutate); a check without one says \"not run\".", ""]
-    return lines
+def _anchor(title: str) -> str:
+    """The Markdown anchor of a section title (GitHub's rule for plain words)."""
+    return "-".join(title.lower().split())
 
 
 def build_datasheet(inputs: DatasheetInputs) -> Datasheet:
@@ -376,13 +314,14 @@ def build_datasheet(inputs: DatasheetInputs) -> Datasheet:
     point = inputs.point_file.point
     lines = [f"# Datasheet: {point.model} {point.shape[0]}x{point.shape[1]} on "
              f"{inputs.device.name}", "",
-             f"Made by `{inputs.command}`. Contents: "
-             + ", ".join(SECTIONS) + ".", ""]
-    lines += _point_section(inputs, logic, feas)
+             "Contents: " + ", ".join(f"[{t}](#{_anchor(t)})" for t in (FIRST, *SECTIONS, LAST))
+             + f". Every figure's command is in {REPRODUCE}, at the end.", ""]
+    io = interfaces_of(point.contract(), feas.lanes, inputs.fifo_depth)
+    lines += summary_lines(inputs, feas, io) + _point_section(inputs, logic, feas)
     res, res_fig = _resources_section(inputs, feas)
     clk, clk_fig = _clock_section(inputs, feas)
-    lines += res + clk + _interfaces_section(inputs, feas)
+    lines += res + clk + _interfaces_section(inputs, feas, io)
     qual, qual_figs = _quality_section(inputs)
-    lines += qual + _verification_section(inputs)
+    lines += qual + verification_lines(inputs, SECTIONS[5]) + reproduce_lines(inputs, feas.lanes)
     return Datasheet("\n".join(lines), {"resources.png": res_fig, "clock.png": clk_fig,
                                         **qual_figs})

@@ -65,20 +65,21 @@ def clock_figure(lanes: Sequence[int], clock_mhz: Sequence[float], fmax_mhz: flo
 
 
 def costs_figure(quality: PointQuality):
-    """Per scene, the quantisation cost and the chip cost (dB), noise off and on."""
+    """Per scene, the twin's PSNR against its own float model and against the default
+    dog4 float model (dB, twin - float: above 0 the chip is better), noise off and on."""
     settings = [n for n in (False, True) if quality.rows_with(n)]
     fig = _figure(6.5, 2.8 * len(settings))
     for k, noise in enumerate(settings):
         rows = quality.rows_with(noise)
         ax = fig.add_subplot(len(settings), 1, k + 1)
         x = np.arange(len(rows))
-        ax.bar(x - 0.2, [r.quantisation_cost_db for r in rows], width=0.4,
-               label="quantisation cost (own float - twin)")
-        ax.bar(x + 0.2, [r.chip_cost_db for r in rows], width=0.4,
-               label="chip cost (dog4 float - twin)")
+        ax.bar(x - 0.2, [-r.quantisation_cost_db for r in rows], width=0.4,
+               label="twin - own float (the fixed point)")
+        ax.bar(x + 0.2, [-r.chip_cost_db for r in rows], width=0.4,
+               label="twin - dog4 float (the chip against the default)")
         ax.axhline(0.0, color="k", lw=0.8)
         ax.set_xticks(x, [r.scene for r in rows])
-        ax.set_ylabel("dB")
+        ax.set_ylabel("dB (above 0: twin better)")
         ax.set_title(f"noise {'on' if noise else 'off'}", fontsize=9)
         ax.legend(fontsize=7)
     fig.tight_layout()

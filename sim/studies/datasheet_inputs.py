@@ -1,5 +1,6 @@
 """What ``rvsm datasheet`` reads: the design point (with its ``[rtl]`` table) and the saved
-results of other commands, each checked before anything is computed or written.
+results of other commands, each checked before anything is computed or written, and
+:class:`DatasheetInputs`, everything the page is made from.
 
 - the point TOML: the design point, and its ``[rtl]`` table read raw (``lanes``, ...),
   so the page can state the lanes the point was built for whether or not the loader
@@ -10,7 +11,8 @@ results of other commands, each checked before anything is computed or written.
 - ``--formal FILE.json``: ``rvsm formal POINT --size HxW --json`` (each check's status);
 - ``--mutate FILE.json``: ``rvsm mutate POINT --json`` (mutations killed, survivors);
 - ``--regress FILE``: the results database of ``rvsm regress PLAN -o FILE.sqlite`` or its
-  JUnit XML (``--junit FILE.xml``).
+  JUnit XML (``--junit FILE.xml``);
+- ``--commands FILE.toml``: the command lines of saved results that do not record theirs.
 
 A missing or malformed file is an :class:`~rvsm.model.infra.errors.RvsmError` naming it
 (exit status 2), raised before the output folder is touched.
@@ -26,6 +28,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
@@ -34,8 +38,11 @@ else:  # pragma: no cover
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.infra.text_files import read_utf8_text
+from rvsm.rtl.fpga.devices import DeviceBudget
+from rvsm.sim.studies.point_quality import PointQuality
 
-__all__ = ["PointFile", "RegressSummary", "load_fpga_report", "load_point_file",
+__all__ = ["COMMAND_KEYS", "DatasheetInputs", "PointFile", "RegressSummary", "load_commands",
+           "load_fpga_report", "load_point_file",
            "load_formal_report", "load_mutate_report",
            "load_regress", "load_regress_database", "load_regress_junit",
            "load_verify_result", "read_json_object", "read_result_text"]
@@ -148,6 +155,46 @@ class RegressSummary:
         return sum(1 for c in self.cases if c[2] == status)
 
 
+@dataclass(frozen=True)
+class DatasheetInputs:
+    """Everything the page shows: the point file, ``device`` budget, camera ``rate_hz``,
+    ``lanes`` (None: the point's ``[rtl] lanes``, else the fewest that fit), state memory
+    ``organisation``, the quality study (and ``picture``: ``(scene, step, images)`` or
+    None) and the optional saved results with their paths; ``lane_cost``: a
+    :class:`~rvsm.rtl.fpga.lane_cost.LaneCost` record (None: not synthesised);
+    ``command``: the command line that made the page; ``quality_path``: the saved
+    quality result (None: run by the page's command); ``commands``: per saved result
+    (``fpga``, ``quality``, ``verify``, ``formal``, ``mutate``, ``regress``) the
+    command that made it and where that command comes from, for results that do not
+    record theirs (``--commands FILE.toml``); ``docs``: the path from the page to the
+    project's ``docs/`` folder (for links)."""
+
+    point_file: PointFile
+    device: DeviceBudget
+    rate_hz: float
+    quality: PointQuality
+    quality_source: str
+    lanes: int | None = None
+    organisation: str = "rtl"
+    fifo_depth: int = 16
+    picture: tuple[str, int, dict[str, np.ndarray]] | None = None
+    fpga: dict[str, Any] | None = None
+    fpga_path: str | None = None
+    lane_cost: dict[str, Any] | None = None
+    verify: dict[str, Any] | None = None
+    verify_path: str | None = None
+    regress: RegressSummary | None = None
+    regress_path: str | None = None
+    formal: dict[str, Any] | None = None
+    formal_path: str | None = None
+    mutate: dict[str, Any] | None = None
+    mutate_path: str | None = None
+    command: str = "rvsm datasheet"
+    quality_path: str | None = None
+    commands: dict[str, tuple[str, str]] = field(default_factory=dict)
+    docs: str = "../docs"
+
+
 def load_formal_report(path: str | os.PathLike) -> dict[str, Any]:
     """An ``rvsm formal --json`` report: ``checks`` (each ``check``, ``mode``, ``depth``,
     ``status``), ``size`` and ``model``."""
@@ -225,3 +272,31 @@ def load_regress_junit(path: str | os.PathLike) -> RegressSummary:
                       "skipped" if c.find("skipped") is not None else "pass")
             cases.append((s.get("name", ""), c.get("name", ""), status))
     return RegressSummary(tuple(s.get("name", "") for s in suites), tuple(cases))
+
+
+#: The saved results a ``--commands`` file may give the command of.
+COMMAND_KEYS = ("fpga", "quality", "verify", "formal", "mutate", "regress")
+
+
+def load_commands(path: str | os.PathLike) -> dict[str, tuple[str, str]]:
+    """A ``--commands`` TOML file: for a saved result that does not record its own
+    command line, ``[verify] command = "rvsm verify ..."`` (whole, no "...") and
+    ``source = "..."`` (where the command comes from: the docs that quote it)."""
+    text = read_result_text(path, "commands")
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise RvsmError(f"{path}: not valid TOML: {exc}") from None
+    out = {}
+    for key, table in data.items():
+        if key not in COMMAND_KEYS or not isinstance(table, dict):
+            raise RvsmError(f"{path}: unknown table [{key}]; valid tables: "
+                            f"{', '.join(COMMAND_KEYS)}")
+        cmd, source = table.get("command"), table.get("source")
+        if not isinstance(cmd, str) or not cmd.startswith("rvsm ") or "..." in cmd:
+            raise RvsmError(f"{path}: [{key}] command must be a whole rvsm command line "
+                            "(no \"...\")")
+        if not isinstance(source, str) or not source.strip():
+            raise RvsmError(f"{path}: [{key}] source must say where the command comes from")
+        out[key] = (cmd, source)
+    return out

@@ -36,7 +36,8 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.scene import Scene
 
 __all__ = ["DEFAULT_FRAMES", "DEFAULT_STEPS_PER_FRAME", "PointQuality", "QualityRow",
-           "noisy_point", "reconstructions", "run_point_quality", "scene_quality"]
+           "better_or_worse", "noisy_point", "reconstructions", "run_point_quality",
+           "scene_quality"]
 
 #: Frames (and steps per frame) of the study by default: 41 frames x 10 = 400 steps, as
 #: ``rvsm table`` and ``sweeps/default-check.toml``.
@@ -159,8 +160,8 @@ class PointQuality:
     def markdown(self, noise: bool) -> list[str]:
         """A Markdown table of the rows at one noise setting, with a mean row."""
         rows = self.rows_with(noise)
-        lines = ["| scene | PSNR twin | own float | dog4 float | quantisation cost | "
-                 "chip cost | SSIM twin | own float | dog4 float |",
+        lines = ["| scene | PSNR twin | own float | dog4 float | twin against own float | "
+                 "chip against dog4 float | SSIM twin | own float | dog4 float |",
                  "|---|---|---|---|---|---|---|---|---|"]
         for r in rows:
             lines.append(_md_row(r.scene, [r.psnr_twin, r.psnr_float, r.psnr_default_float,
@@ -173,13 +174,19 @@ class PointQuality:
             lines.append(_md_row("**mean**", list(cols)))
         return lines
 
+    def steps_text(self) -> str:
+        """``400 steps (40 frame intervals x 10 steps; 41 frames)``: the steps are
+        ``(frames - 1) x steps_per_frame``."""
+        return (f"{self.steps} steps ({self.frames - 1} frame intervals x "
+                f"{self.steps_per_frame} steps; {self.frames} frames)")
+
     def summary(self) -> str:
         """Human-readable lines: the two tables and the run's size and time."""
         h, w = self.size
         out = [f"image quality of {self.point.get('model')} ({self.point.get('sensor')}) "
-               f"at {h}x{w}, {self.steps} steps ({self.frames} frames x "
-               f"{self.steps_per_frame}), seed {self.point.get('seed')}; PSNR in dB; "
-               "quantisation cost = own float - twin, chip cost = dog4 float - twin"]
+               f"at {h}x{w}, {self.steps_text()}, seed {self.point.get('seed')}; PSNR in "
+               "dB; the twin against its own float model (what the fixed point costs) and "
+               "against the default dog4 float model (what the chip costs a user)"]
         for noise in (False, True):
             if self.rows_with(noise):
                 out += ["", f"noise {'on' if noise else 'off'}:", *self.markdown(noise)]
@@ -187,8 +194,18 @@ class PointQuality:
         return "\n".join(out)
 
 
+def better_or_worse(gain_db: float, digits: int = 3) -> str:
+    """``better by X`` (``gain_db > 0``), ``worse by X`` or ``equal`` at ``digits``."""
+    shown = f"{abs(gain_db):.{digits}f}"
+    if float(shown) == 0:
+        return "equal"
+    return f"{'better' if gain_db > 0 else 'worse'} by {shown}"
+
+
 def _md_row(name: str, values: Sequence[float]) -> str:
-    psnr = [f"{v:.2f}" for v in values[:3]] + [f"{v:+.3f}" for v in values[3:5]]
+    """Values: three PSNRs, the two costs (float - twin, dB: shown as the twin better
+    or worse by), three SSIMs."""
+    psnr = [f"{v:.2f}" for v in values[:3]] + [better_or_worse(-v) for v in values[3:5]]
     ssim = [f"{v:.4f}" for v in values[5:]]
     return f"| {name} | " + " | ".join(psnr + ssim) + " |"
 

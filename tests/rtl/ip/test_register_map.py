@@ -67,3 +67,48 @@ def test_markdown_json_header_agree(tmp_path: Path) -> None:
                        "IP_THR_DATA0_OFFSET; }\n")
         subprocess.run(["gcc", "-std=c89", "-pedantic", "-Wall", "-Wextra", "-Werror", "-c", "-o",
                         str(tmp_path / "use.o"), str(src)], check=True)
+
+
+def _expected_defines(rm, pre: str) -> dict[str, int]:  # noqa: ANN001 - RegisterMap
+    """What each ``#define`` of the header must hold, from the Python register map."""
+    want = {f"{pre}_ADDR_BITS": rm.addr_bits, f"{pre}_THR_CHUNKS": rm.thr_chunks,
+            f"{pre}_THRESHOLD_BITS": rm.threshold_bits,
+            f"{pre}_THRESHOLDS_PER_WORD": rm.thresholds_per_word, f"{pre}_LANES": rm.lanes}
+    for r in rm.registers:
+        want[f"{pre}_{r.name}_OFFSET"] = r.offset
+        want[f"{pre}_{r.name}_RESET"] = r.reset
+        for f in r.fields:
+            want[f"{pre}_{r.name}_{f.name.upper()}_SHIFT"] = f.lsb
+            want[f"{pre}_{r.name}_{f.name.upper()}_MASK"] = f.mask
+    return want
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
+@pytest.mark.parametrize("shared", [False, True], ids=["per-pixel", "shared"])
+def test_c_header_compiles_and_each_define_is_the_register_maps(tmp_path: Path,
+                                                                shared: bool) -> None:
+    """gcc compiles a program printing every define of the header; each value is the
+    Python map's, and the lanes define is P (not the thresholds per word)."""
+    import dataclasses
+    import re
+
+    c = model_contract("dog2", 4, 8)
+    if shared:
+        c = dataclasses.replace(c, shared_thresholds=(9, 40))
+    rm = ip_register_map(c, 4, 16, "0123456789abcdef", "fedcba9876543210", "1.2.3")
+    assert rm.lanes == 4 and rm.thresholds_per_word == (1 if shared else 4)
+    header = regs_c_header(rm, "rvsm_axis_ip")
+    names = re.findall(r"^#define (RVSM_AXIS_IP_\w+) \S+", header, re.M)
+    want = _expected_defines(rm, "RVSM_AXIS_IP")
+    assert set(names) == set(want)
+    (tmp_path / "ip.regs.h").write_text(header)
+    prints = "\n".join(f'  printf("{n} %lu\\n", (unsigned long)({n}));' for n in names)
+    (tmp_path / "show.c").write_text('#include <stdio.h>\n#include "ip.regs.h"\n'
+                                     f"int main(void) {{\n{prints}\n  return 0;\n}}\n")
+    exe = tmp_path / "show"
+    subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-o", str(exe),
+                    str(tmp_path / "show.c")], check=True)
+    out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
+    got = {name: int(value) for name, value in (line.split() for line in out.splitlines())}
+    assert got == want
+    assert "RVSM_AXIS_IP_LANES 4u" in header

@@ -14,7 +14,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.sim.cli import datasheet as cli
 from rvsm.sim.cli import main
 from rvsm.sim.studies import point_quality
-from rvsm.sim.studies.datasheet import SECTIONS
+from rvsm.sim.studies.datasheet import FIRST, LAST, SECTIONS
 from rvsm.sim.studies.datasheet_inputs import load_point_file, load_regress
 
 TINY = ["--size", "16x24", "--frames", "3", "--scenes", "coin", "--quiet"]
@@ -99,11 +99,15 @@ def test_datasheet_with_every_saved_result(files, tmp_path):
                str(files["formal"]), "--mutate", str(files["mutate"]), "--quiet"])
     assert rc == 0
     md = (out / "datasheet.md").read_text()
-    assert _sections(md) == list(SECTIONS)
+    assert _sections(md) == [FIRST, *SECTIONS, LAST]
     for name in ("resources.png", "clock.png", "quality_costs.png", "reconstructions.png"):
         assert (out / name).read_bytes().startswith(PNG)
         assert f"]({name})" in md
     assert md.count("Sources:") == len(SECTIONS)
+    # the fake results record no command and no --commands gives one: said, not invented
+    reproduce = md.split("## Reproduce")[1]
+    assert reproduce.count("NOT RECORDED") == 2 and "..." not in reproduce  # verify, formal
+    assert "rvsm mutate " in reproduce and "rvsm regress regressions/smoke.toml" in reproduce
     # the fake fpga report's numbers, and its slope as the logic per lane
     assert "12,345" in md and "6,789" in md and "| DP16KD | 17 (8.2 %)" in md
     assert "123.4 MHz" in md and "1,111 LUT4 and 999 FF per lane" in md
@@ -112,10 +116,18 @@ def test_datasheet_with_every_saved_result(files, tmp_path):
     # lanes from the point's [rtl] table; clock = 16 x 24/4 x 40 kHz
     assert "P = 4 lanes ([rtl] lanes of the point)" in md and "**3.8 MHz**" in md
     assert "`THR_DATA0`" in md and "`s_axis_tdata`" in md and "`codes_payload`" in md
-    assert "PASS: 4,321 spikes compared" in md
-    assert "1 of 2 pass, 1 fail" in md and "| - run-b | | fail |" in md
-    assert ("PASS: protocol pass (bmc, depth 30); tail pass (prove, depth 12)" in md
-            and "dog2 3x4, P = 2" in md)
+    assert "PASS: 0 mismatches in 4,321 accumulator-steps compared" in md
+    assert "1 of 2 test cases pass, 1 fail" in md and "| - run-b | | fail |" in md
+    assert ("PASS: 2 of 2 checks pass: protocol pass (bmc, depth 30); tail pass (prove, "
+            "depth 12)" in md and "dog2 3x4, P = 2" in md)
+    # a per-pixel threshold memory: its own row and its cost; THR_ADDR's word and scale
+    assert "| `threshold.storage` | per-pixel | thresholds S x H x W x (A - 1)" in md
+    # 16 rows x 6 groups = 96 words (7 bits); 4 scales at [17:16]
+    assert "| `THR_ADDR` | [6:0] | `word` |" in md and "| `THR_ADDR` | [17:16] | `scale` |" in md
+    assert "pack differently" in md
+    assert "threshold.contrast" not in md and "adc.log_frac_bits" not in md
+    # the summary's clock row: 123.4 MHz against 3.84 MHz needed, as headroom
+    assert "Fmax 123.4 MHz measured (nextpnr): 3113.5 % headroom" in md
     assert "14 of 15 mutations killed; survivors: stream.odd" in md
     assert "| not run |" not in md.split("## Verification")[1]
     q = json.loads(files["quality"].read_text())
@@ -148,6 +160,19 @@ def test_datasheet_runs_the_study_and_says_what_is_missing(files, tmp_path, monk
     assert "rvsm quality" in md.split("## Image quality")[1]
 
 
+def test_commands_file_gives_the_reproduce_commands(files, tmp_path):
+    commands = tmp_path / "commands.toml"
+    commands.write_text('[verify]\ncommand = "rvsm verify coin --fixed point.toml --steps 20 '
+                        '--json"\nsource = "the test quotes it"\n')
+    out = tmp_path / "sheet"
+    assert main(["datasheet", str(files["point"]), "-o", str(out), "--quality",
+                 str(files["quality"]), "--verify", str(files["verify"]), "--commands",
+                 str(commands), "--no-synthesis", "--quiet"]) == 0
+    reproduce = (out / "datasheet.md").read_text().split("## Reproduce")[1]
+    assert ("(reconstructed: the test quotes it):\n\n```\nrvsm verify coin --fixed "
+            "point.toml --steps 20 --json\n```") in reproduce
+
+
 def test_regress_database_is_read(tmp_path):
     from rvsm.sim.regress.store import RegressionStore
 
@@ -170,7 +195,8 @@ def test_regress_database_is_read(tmp_path):
 
 
 @pytest.mark.parametrize("case", ["missing", "bad_json", "other_point", "bad_lanes",
-                                  "bad_fpga", "device", "bad_rtl", "bad_formal"])
+                                  "bad_fpga", "device", "bad_rtl", "bad_formal",
+                                  "cut_command", "unknown_command"])
 def test_datasheet_refusals_leave_nothing(files, tmp_path, capsys, case):
     out = tmp_path / "sheet"
     other = tmp_path / "other.json"
@@ -195,6 +221,10 @@ def test_datasheet_refusals_leave_nothing(files, tmp_path, capsys, case):
     elif case == "bad_formal":
         other.write_text(json.dumps({"checks": "all fine"}))
         args += ["--formal", str(other)]
+    elif case in ("cut_command", "unknown_command"):  # a command cut short, a stray table
+        table = "verify" if case == "cut_command" else "simulate"
+        other.write_text(f'[{table}]\ncommand = "rvsm verify coin ..."\nsource = "docs"\n')
+        args += ["--commands", str(other)]
     else:
         point = tmp_path / "p.toml"
         point.write_text(files["point"].read_text().replace("lanes = 4", "lanes = 0"))
