@@ -111,13 +111,15 @@ def _scan(cols: EventColumns) -> tuple[int, int, int]:
 
 
 def columns_source(cols: EventColumns, size: tuple[int, int] | None = None,
-                   step_us: int = STEP_US, contrast: float = DEFAULT_CONTRAST) -> SpikeSource:
+                   step_us: int = STEP_US, contrast: float = DEFAULT_CONTRAST,
+                   num_steps: int | None = None) -> SpikeSource:
     """``cols`` as a source of dense events ``(T, 1, H, W) int8`` (module doc), with an
     event file's ``meta``: a plain DVS (``model = "fsm"``), the nominal ``contrast``
     the decoder assumes (the file does not say), ``source_format``, ``step_us``,
     ``t_offset`` (with ``t_shift``, the microseconds a recording clock's time stamps were
     moved back by), ``num_events`` and ``size_from`` (``"--size"``, the header's place,
-    or ``"guess"``)."""
+    or ``"guess"``). ``num_steps`` (``--steps``) sets ``T`` when the recording runs on
+    after its last event (at least the last event's step + 1)."""
     p = cols.path
     try:
         if step_us < 1:
@@ -155,6 +157,12 @@ def columns_source(cols: EventColumns, size: tuple[int, int] | None = None,
         raise
     c, ms_to_idx = cols.columns, cols.ms_to_idx
     steps = last // step_us + 1
+    if num_steps is not None:
+        if num_steps < steps:
+            cols.close()
+            raise RvsmError(f"--steps {num_steps}: {p} has events up to step {steps - 1} "
+                            f"({step_us} us a step); pass --steps {steps} or more")
+        steps = int(num_steps)
 
     def first_at(us: int) -> int:
         """Index of the first event with ``t >= us``: between ``ms_to_idx`` of the

@@ -30,17 +30,20 @@ _H5 = (".h5", ".hdf5")
 @dataclass(frozen=True)
 class ImportOptions:
     """How to read a file without our meta: ``size (H, W)`` (``--size``), microseconds
-    a step (``--step-us``), the contrast the decoder assumes (``--contrast``); ``None``
-    where not given."""
+    a step (``--step-us``), the contrast the decoder assumes (``--contrast``), the
+    number of steps (``--steps``; default: up to the last event's); ``None`` where not
+    given."""
 
     size: tuple[int, int] | None = None
     step_us: int | None = None
     contrast: float | None = None
+    steps: int | None = None
 
     def given(self) -> list[str]:
         """The options given, as the command line names them."""
         return [o for o, v in (("--size", self.size), ("--step-us", self.step_us),
-                               ("--contrast", self.contrast)) if v is not None]
+                               ("--contrast", self.contrast), ("--steps", self.steps))
+                if v is not None]
 
 
 @dataclass(frozen=True)
@@ -65,7 +68,8 @@ def _as_dense(columns: Callable[[Path], EventColumns]):
     def open_file(p: Path, o: ImportOptions) -> SpikeSource:
         return columns_source(columns(p), o.size,
                               STEP_US if o.step_us is None else o.step_us,
-                              DEFAULT_CONTRAST if o.contrast is None else o.contrast)
+                              DEFAULT_CONTRAST if o.contrast is None else o.contrast,
+                              o.steps)
     return open_file
 
 

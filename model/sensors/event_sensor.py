@@ -44,7 +44,8 @@ def evaluate_event_file(source: SpikeSource, scene: Scene, method: str = "auto",
                         match: str = "gain", stream: bool = False) -> dict:
     """Decode and score the events of ``source`` (``method`` is the one the decoder has,
     ``"auto"``; the file is always read chunk by chunk)."""
-    check_scene_fits(scene, source.shape, "events")
+    check_scene_fits(scene, source.shape, "events",
+                     imported=bool(source.meta.get("contrast_assumed")))
     reported = fixed_references if source.meta.get("design_point") is not None else None
     return evaluate_events(source, scene, match=match, reported=reported)
 

@@ -35,9 +35,11 @@ def matching_options(num_steps: int, scene: Scene) -> list[str]:
 
 
 def check_scene_fits(scene: Scene, shape: tuple[int, int, int, int],
-                     what: str = "spikes") -> None:
+                     what: str = "spikes", imported: bool = False) -> None:
     """Refuse, naming the options that fix it, a scene shaped unlike the file's
-    ``(T, S, H, W)`` ``what`` (``"spikes"`` or ``"events"``)."""
+    ``(T, S, H, W)`` ``what`` (``"spikes"`` or ``"events"``); ``imported``: the file
+    came from another tool, whose step count ends at its last event (``--steps`` of
+    ``rvsm events import`` sets it)."""
     t, _, h, w = (int(v) for v in shape)
     if scene.shape == (h, w) and scene.num_steps == t:
         return
@@ -47,6 +49,9 @@ def check_scene_fits(scene: Scene, shape: tuple[int, int, int, int],
         options = matching_options(t, scene)
         rule = "frames x steps" if scene.hold else "(frames - 1) x steps"
         fix = f"pass {' or '.join(options)} ({rule} per frame = {t} steps)"
+        if imported and scene.num_steps > t:
+            fix += (f", or import it again with --steps {scene.num_steps} if the recording "
+                    "ran on after its last event")
     raise RvsmError(f"{what} {tuple(int(v) for v in shape)} do not match scene "
                     f"{scene.name!r} ({scene.num_steps} steps of {scene.shape[0]}x"
                     f"{scene.shape[1]}: {scene.num_frames} frames, {scene.steps_per_frame} "

@@ -83,6 +83,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "x and y + 1, with a warning)")
     q.add_argument("--step-us", type=int, default=None, metavar="US",
                    help=f"microseconds a step (default {STEP_US}, 40 kHz)")
+    q.add_argument("--steps", type=int, default=None, metavar="T",
+                   help="the number of steps (default: up to the last event's step; "
+                   "more when the recording runs on without events)")
     q.add_argument("--contrast", type=float, default=None,
                    help="the sensor's contrast threshold, for rvsm evaluate "
                    f"(default {DEFAULT_CONTRAST:g}, assumed)")
@@ -169,7 +172,8 @@ def run_import(args: argparse.Namespace) -> int:
     check_outputs([Output(args.output, "-o", "spike file")], [args.events], args.force)
     if not (is_h5_path(args.output) or args.output.endswith(".npz")):
         raise RvsmError(f"-o expects a .h5 or .npz path, got {args.output!r}")
-    options = ImportOptions(parse_size_arg(args.size), args.step_us, args.contrast)
+    options = ImportOptions(parse_size_arg(args.size), args.step_us, args.contrast,
+                            args.steps)
     reader, source = open_event_file(args.events, options)
     with source:
         meta = dict(source.meta)

@@ -64,13 +64,14 @@ def test_aedat4_written_by_dv_processing(tmp_path, events):
     assert meta["shape"][2:] == (H, W) and meta["size_from"] == "its AEDAT4 header"
 
 
-def test_evt3_written_by_faery(tmp_path, events):
+@pytest.mark.parametrize("version", ["evt3", "evt2"])
+def test_evt_written_by_faery(tmp_path, events, version):
     faery = _reader("faery", "faery")
     path = tmp_path / "f.raw"
     packet = np.zeros(events["t"].size, dtype=faery.EVENTS_DTYPE)
     packet["t"], packet["x"], packet["y"] = events["t"], events["x"], events["y"]
     packet["on"] = events["p"] > 0
-    with faery.evt.Encoder(str(path), version="evt3", zero_t0=False, dimensions=(W, H),
+    with faery.evt.Encoder(str(path), version=version, zero_t0=False, dimensions=(W, H),
                            enforce_monotonic=True) as encoder:
         encoder.write({"events": packet})
     got, meta = _imported(path)
@@ -79,7 +80,7 @@ def test_evt3_written_by_faery(tmp_path, events):
     # the same events with a header that gives no size: the largest pixel + 1, said
     body = path.read_bytes().split(b"% geometry")[1].split(b"\n", 1)[1]
     bare = tmp_path / "bare.raw"
-    bare.write_bytes(b"% evt 3.0\n" + body)
+    bare.write_bytes(f"% evt {version[3]}.0\n".encode() + body)
     got, meta = _imported(bare)
     assert got == _rows(events) and meta["size_from"] == "guess"
     assert meta["shape"][2:] == (int(events["y"].max()) + 1, int(events["x"].max()) + 1)

@@ -150,11 +150,19 @@ def test_imported_events_of_another_step_count_name_the_matching_options(tmp_pat
     code, _, err = _run(capsys, "evaluate", imported, "flyball", "--steps-per-frame", 8)
     assert code == 2 and err.count("\n") == 1
     assert "pass --frames 4 " in err and "= 24 steps" in err, err
+    assert "or import it again with --steps 320" in err  # 41 frames of 8 steps
     code, _, err = _run(capsys, "evaluate", imported, "flyball", "--frames", 4)
     assert code == 2 and "pass --steps-per-frame 8" in err, err
     code, _, err = _run(capsys, "evaluate", imported, "flyball", "--frames", 4,
                         "--steps-per-frame", 8)
     assert code == 0, err
+    longer = tmp_path / "long.h5"  # the recording ran on: --steps sets T
+    code, out, err = _run(capsys, "events", "import", dsec, "-o", longer, "--size", "24x32",
+                          "--steps", 40)
+    assert code == 0 and "40 steps of 24x32" in out, err
+    code, _, err = _run(capsys, "events", "import", dsec, "-o", tmp_path / "x.h5",
+                        "--steps", 10)
+    assert code == 2 and "pass --steps 24 or more" in err and not (tmp_path / "x.h5").exists()
 
 
 def test_export_and_import_say_the_events_and_scales_written(tmp_path, capsys):
