@@ -80,6 +80,15 @@ def faery_columns(path: str | os.PathLike, fmt: str) -> EventColumns:
     the header (AEDAT4's stream info; EVT's ``% geometry`` line, where it has one)."""
     p = Path(path)
     options = {} if fmt == "AEDAT4" else {"dimensions_fallback": _NO_SIZE}
+    if fmt == "EVT":
+        try:
+            with open(p, "rb") as handle:
+                first = handle.read(1)
+        except OSError as exc:
+            raise RvsmError(f"cannot read {p}: {exc.strerror or exc}") from None
+        if first != b"%":  # faery would decode any bytes as EVT 3
+            raise RvsmError(f"{p} is not an EVT file: it has no header (lines starting "
+                            "with %, as '% evt 3.0'), which Metavision writes")
     events, dims = _decode(p, fmt, **options)
     names = {"t": "t", "x": "x", "y": "y", "p": "polarity"}
     return _columns(p, fmt, events, dims, f"its {fmt} header", names)
@@ -101,7 +110,10 @@ def _header_and_sample(path: Path) -> tuple[list[str] | None, list[str], bytes]:
     numeric = all(re.fullmatch(r"[-+0-9.eE]+", v.strip()) for v in values if v.strip())
     if numeric and not first.startswith(("#", "%")):
         return None, [v.strip() for v in values], sep
-    data = split(lines[1].decode("utf-8", "replace").strip())
+    second = lines[1].decode("utf-8", "replace").strip()
+    if not second:
+        raise RvsmError(f"{path} holds no events (a header line alone)")
+    data = split(second)
     return [v.strip() for v in values], [v.strip() for v in data], sep
 
 

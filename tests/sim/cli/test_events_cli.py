@@ -203,8 +203,16 @@ def test_bad_foreign_input_exits_2_in_one_line_and_leaves_no_file(tmp_path, caps
     (bad / "nop.csv").write_text("t,x,y\n0,1,2\n")
     _dsec(bad / "back.h5", [0, 25, 50, 75, 60], [0, 1, 2, 3, 4], [0] * 5, [1] * 5)
     (bad / "odd.xyz").write_text("0 1 2 1\n")
+    (bad / "head.csv").write_text("t,x,y,p\n")
+    (bad / "noise.raw").write_bytes(np.random.default_rng(1).bytes(3000))
+    (bad / "noise.aedat4").write_bytes(np.random.default_rng(2).bytes(3000))
+    (bad / "pol.txt").write_text("0 1 2 5\n")
     for name, words in (("nop.csv", "no column 'p' (polarity)"),
                         ("back.h5", "go back at event 4"),
+                        ("head.csv", "holds no events"),
+                        ("noise.raw", "not an EVT file: it has no header"),
+                        ("noise.aedat4", "not a readable AEDAT4 file (faery: bad magic"),
+                        ("pol.txt", "not a readable CSV or text file"),
                         ("odd.xyz", "not an event file rvsm events import reads")):
         out = tmp_path / "out" / "e.h5"
         code, _, err = _run(capsys, "events", "import", bad / name, "-o", out)
