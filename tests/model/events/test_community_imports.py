@@ -16,7 +16,7 @@ from rvsm.model.events.sensor_files import SensorFileWriter
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.spikes.files import copy_source
 from rvsm.model.spikes.source import array_source
-from tests.model.events.test_community_readers import _reader
+from tests.model.events.test_community_readers import community_reader
 
 H, W = 20, 30
 
@@ -49,7 +49,7 @@ def _rows(ev) -> list[tuple[int, int, int, int]]:
 
 
 def test_aedat4_written_by_dv_processing(tmp_path, events):
-    dv = _reader("dv_processing", "dv-processing")
+    dv = community_reader("dv_processing", "dv-processing")
     path = tmp_path / "dv.aedat4"
     writer = dv.io.MonoCameraWriter(str(path), dv.io.MonoCameraWriter.EventOnlyConfig(
         "DVXplorer_test", (W, H)))
@@ -66,7 +66,7 @@ def test_aedat4_written_by_dv_processing(tmp_path, events):
 
 @pytest.mark.parametrize("version", ["evt3", "evt2"])
 def test_evt_written_by_faery(tmp_path, events, version):
-    faery = _reader("faery", "faery")
+    faery = community_reader("faery", "faery")
     path = tmp_path / "f.raw"
     packet = np.zeros(events["t"].size, dtype=faery.EVENTS_DTYPE)
     packet["t"], packet["x"], packet["y"] = events["t"], events["x"], events["y"]
@@ -88,7 +88,7 @@ def test_evt_written_by_faery(tmp_path, events, version):
 
 @pytest.mark.parametrize("polarity", ["0/1", "-1/1", "bool"])
 def test_csv_with_any_polarity_convention(tmp_path, events, polarity):
-    _reader("faery", "faery")
+    community_reader("faery", "faery")
     p = {"0/1": events["p"].astype(int), "-1/1": np.where(events["p"] > 0, 1, -1),
          "bool": np.where(events["p"] > 0, "true", "false")}[polarity]
     lines = ["timestamp,x,y,polarity"] + [f"{t},{x},{y},{q}" for t, x, y, q in zip(
@@ -101,7 +101,7 @@ def test_csv_with_any_polarity_convention(tmp_path, events, polarity):
 
 
 def test_evlib_hdf5_written_by_evlib(tmp_path, events):
-    evlib = _reader("evlib", "evlib")
+    evlib = community_reader("evlib", "evlib")
     path = tmp_path / "evlib.h5"
     evlib.save_events_to_hdf5(events["x"].astype(np.int64), events["y"].astype(np.int64),
                               events["t"] / 1e6, np.where(events["p"] > 0, 1, -1), str(path))
@@ -113,7 +113,7 @@ def test_evlib_hdf5_written_by_evlib(tmp_path, events):
 
 
 def test_text_export_reads_in_evlib_and_faery_as_documented(tmp_path, events):
-    evlib, faery = _reader("evlib", "evlib"), _reader("faery", "faery")
+    evlib, faery = community_reader("evlib", "evlib"), community_reader("faery", "faery")
     dense = np.zeros((80, 1, H, W), np.int8)
     dense[events["t"] // 25, 0, events["y"], events["x"]] = np.where(events["p"] > 0, 1, -1)
     path = tmp_path / "e.txt"
@@ -136,7 +136,7 @@ def test_text_export_reads_in_evlib_and_faery_as_documented(tmp_path, events):
 
 
 def test_a_missing_column_is_named(tmp_path):
-    _reader("faery", "faery")
+    community_reader("faery", "faery")
     csv = tmp_path / "e.csv"
     csv.write_text("t,x,y\n0,1,2\n25,2,3\n")
     with pytest.raises(RvsmError, match=r"no column 'p' \(polarity\) in .*e\.csv"):
