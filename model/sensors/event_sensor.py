@@ -23,6 +23,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kinds.sensor_kind import DVS
 from rvsm.model.scene.scene import Scene
 from rvsm.model.sensors.capabilities import Sensor
+from rvsm.model.sensors.scene_fit import check_scene_fits
 from rvsm.model.spikes.sinks import SpikeSink
 from rvsm.model.spikes.source import SpikeSource
 
@@ -43,6 +44,8 @@ def evaluate_event_file(source: SpikeSource, scene: Scene, method: str = "auto",
                         match: str = "gain", stream: bool = False) -> dict:
     """Decode and score the events of ``source`` (``method`` is the one the decoder has,
     ``"auto"``; the file is always read chunk by chunk)."""
+    check_scene_fits(scene, source.shape, "events",
+                     imported=bool(source.meta.get("contrast_assumed")))
     reported = fixed_references if source.meta.get("design_point") is not None else None
     return evaluate_events(source, scene, match=match, reported=reported)
 

@@ -20,24 +20,11 @@ from rvsm.model.sampling.config import SamplerConfig, SpikeTrain
 from rvsm.model.sampling.twin import sample, stream_float
 from rvsm.model.scene.scene import Scene
 from rvsm.model.sensors.capabilities import Sensor
+from rvsm.model.sensors.scene_fit import check_scene_fits
 from rvsm.model.spikes.sinks import SpikeSink
 from rvsm.model.spikes.source import SpikeSource
 
-__all__ = ["SPIKE_CAMERA", "check_scene_fits", "evaluate_spike_file", "run_float_twin"]
-
-
-def check_scene_fits(scene: Scene, spikes_shape: tuple[int, int, int, int]) -> None:
-    """Refuse, naming the options that fix it, a scene shaped unlike the spikes
-    ``(T, S, H, W)``."""
-    t, _, h, w = spikes_shape
-    if scene.shape == (h, w) and scene.num_steps == t:
-        return
-    fix = (f"pass --size {h}x{w}" if scene.shape != (h, w) else
-           "pass the --frames, --steps-per-frame and --hold the spikes were made with")
-    raise RvsmError(f"spikes {tuple(spikes_shape)} do not match scene {scene.name!r} "
-                    f"({scene.num_steps} steps of {scene.shape[0]}x{scene.shape[1]}: "
-                    f"{scene.num_frames} frames, {scene.steps_per_frame} steps per frame"
-                    f"{', held' if scene.hold else ''}); {fix}")
+__all__ = ["SPIKE_CAMERA", "evaluate_spike_file", "run_float_twin"]
 
 
 def evaluate_spike_file(source: SpikeSource, scene: Scene, method: str = "auto",

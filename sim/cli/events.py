@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,8 +14,6 @@ from rvsm.model.events.event_list import (
     COMPRESSIONS,
     STEP_US,
     EventListWriter,
-    is_event_list,
-    open_event_list,
 )
 from rvsm.model.infra.atomic import write_text_atomic
 from rvsm.model.infra.errors import RvsmError
@@ -22,6 +21,7 @@ from rvsm.model.sensors.files import open_spikes
 from rvsm.model.spikes.files import copy_source
 from rvsm.model.spikes.h5 import H5SpikeWriter, is_h5_path
 from rvsm.model.spikes.npz import save_spikes
+from rvsm.model.spikes.sinks import CountSink, TeeSink
 from rvsm.sim.cli.args import (
     SceneRequest,
     add_force_argument,
@@ -48,13 +48,16 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "with the references the sensor captured at step 0 (regenerated "
                        "from the scene of the file's meta, checked by its digest; SCENE "
                        "and the scene options override it), or one scale of it as AEDAT4 "
-                       "(.aedat4), EVT 3 (.raw) or CSV (.csv), written by faery.")
+                       "(.aedat4), EVT 3 (.raw) or CSV (.csv), written by faery, or as "
+                       "evlib's text (.txt), which evlib reads without options; the output "
+                       "says which options faery and evlib need.")
     q.add_argument("events", help="event file from rvsm simulate --sensor dvs")
     add_scene_arguments(q, positional=False)
     q.add_argument("--scene", dest="scene", default=None,
                    help="the scene the events were made from (default: the file's meta)")
     q.add_argument("-o", "--output", required=True,
-                   help="output: .h5 (HDF5 event list), .aedat4, .raw (EVT 3) or .csv")
+                   help="output: .h5 (HDF5 event list), .aedat4, .raw (EVT 3), .csv "
+                   "(faery's CSV) or .txt (evlib's text: t in seconds, x, y, p -1/1)")
     q.add_argument("--scale", type=int, default=None, metavar="K",
                    help="write scale K alone (0-based): one sensor, for tools that ignore "
                    "the scale column; required for .aedat4/.raw/.csv of a multi-scale model")
@@ -64,21 +67,27 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "blosc needs the hdf5plugin package to write and to read")
     add_force_argument(q)
     q.set_defaults(func=run_export)
-    q = act.add_parser("import", help="HDF5 event list (ours or DSEC's layout) -> event "
-                       "file (.h5 streamed, or .npz)",
-                       description="Read an HDF5 event list back into an event file: one "
-                       "written by rvsm events export, or one in DSEC's layout (events/t, "
-                       "x, y, p; ms_to_idx; t_offset), read as a plain DVS with steps of "
-                       "--step-us microseconds.")
-    q.add_argument("events", help="HDF5 event list (rvsm events export, or DSEC's layout)")
+    q = act.add_parser("import", help="event file of any tool (rvsm's list, DSEC or evlib "
+                       "HDF5, AEDAT4, EVT 2/3, CSV, text) -> event file (.h5 streamed, or "
+                       ".npz)",
+                       description="Read an event file into ours: an HDF5 event list "
+                       "written by rvsm events export; or one sensor's events t, x, y, p "
+                       "read as a plain DVS with steps of --step-us microseconds: HDF5 in "
+                       "DSEC's layout (events/t, x, y, p) or evlib's (events/ts, xs, ys, "
+                       "ps), AEDAT4 (.aedat4), EVT 2/3 (.raw), CSV (.csv) or text (.txt), "
+                       "the last four read by faery (docs/events.md).")
+    q.add_argument("events", help="event file: .h5/.hdf5, .aedat4, .raw, .csv or .txt")
     q.add_argument("-o", "--output", required=True, help="output event file (.h5 or .npz)")
     q.add_argument("--size", default=None, metavar="HxW",
-                   help="DSEC layout: the sensor size (default: the file's height/width "
-                   "attributes, else the largest x and y + 1)")
-    q.add_argument("--step-us", type=int, default=STEP_US, metavar="US",
-                   help=f"DSEC layout: microseconds a step (default {STEP_US}, 40 kHz)")
+                   help="the sensor size (default: the file's header, else the largest "
+                   "x and y + 1, with a warning)")
+    q.add_argument("--step-us", type=int, default=None, metavar="US",
+                   help=f"microseconds a step (default {STEP_US}, 40 kHz)")
+    q.add_argument("--steps", type=int, default=None, metavar="T",
+                   help="the number of steps (default: up to the last event's step; "
+                   "more when the recording runs on without events)")
     q.add_argument("--contrast", type=float, default=None,
-                   help="DSEC layout: the sensor's contrast threshold, for rvsm evaluate "
+                   help="the sensor's contrast threshold, for rvsm evaluate "
                    f"(default {DEFAULT_CONTRAST:g}, assumed)")
     add_force_argument(q)
     q.set_defaults(func=run_import)
@@ -104,7 +113,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run_export(args: argparse.Namespace) -> int:
     """``rvsm events export``: an HDF5 event list, or one scale as AEDAT4, EVT 3 or CSV."""
     from rvsm.model.events.reconstruction import capture_references, config_from_meta
-    from rvsm.model.events.sensor_files import SENSOR_FORMATS, SensorFileWriter, sensor_format
+    from rvsm.model.events.sensor_files import (
+        SENSOR_FORMATS,
+        SensorFileWriter,
+        reading_hint,
+        sensor_format,
+    )
 
     one_sensor = sensor_format(args.output)
     if not (is_h5_path(args.output) or one_sensor):
@@ -132,43 +146,58 @@ def run_export(args: argparse.Namespace) -> int:
                 scene = SceneRequest.from_args(args, meta).load()
                 refs = capture_references(scene, config)
             writer.references = np.asarray(refs, dtype=np.float64)
-        copy_source(source, writer, meta)
+        counts = CountSink()
+        copy_source(source, TeeSink(writer, counts), meta)
         t, s, h, w = source.shape
-    what = (f"{one_sensor}, scale {args.scale or 0}" if one_sensor else
-            f"an event list ({args.compression}"
-            f"{'' if args.scale is None else f', scale {args.scale} alone'})")
-    print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w} as {what}")
+    model = meta.get("model", "the model")
+    if args.scale is not None:
+        n, what = int(counts.per_scale[args.scale]), (f"of scale {args.scale} alone (one "
+                                                       f"of {model}'s {s} scales)")
+    elif one_sensor:
+        n, what = counts.spikes, f"of {model}'s one scale"
+    else:
+        n, what = counts.spikes, f"of {s} scale{'s' if s > 1 else ''} ({model})"
+    form = (one_sensor if one_sensor else
+            f"an HDF5 event list ({args.compression})")
+    print(f"wrote {args.output}: {n:,} events {what}, {t} steps of {h}x{w}, as {form}")
+    if one_sensor:
+        print(f"  to read it: {reading_hint(one_sensor, w, h)}")
     return 0
 
 
 def run_import(args: argparse.Namespace) -> int:
-    """``rvsm events import``: an ``rvsm-events`` list, or a file in DSEC's layout."""
-    from rvsm.model.events.dsec import is_dsec_layout, open_dsec_events
+    """``rvsm events import``: any file :data:`EVENT_READERS` reads, into an event file."""
+    from rvsm.model.events.event_readers import ImportOptions, open_event_file
 
     check_outputs([Output(args.output, "-o", "spike file")], [args.events], args.force)
     if not (is_h5_path(args.output) or args.output.endswith(".npz")):
         raise RvsmError(f"-o expects a .h5 or .npz path, got {args.output!r}")
-    dsec = not is_event_list(args.events) and is_dsec_layout(args.events)
-    given = [o for o, v in (("--size", args.size), ("--contrast", args.contrast),
-                            ("--step-us", None if args.step_us == STEP_US else 1)) if v]
-    if given and not dsec:
-        raise RvsmError(f"{', '.join(given)} apply only to a file in DSEC's layout; "
-                        f"{args.events} is not one")
-    if dsec:
-        source = open_dsec_events(args.events, parse_size_arg(args.size), args.step_us,
-                                  DEFAULT_CONTRAST if args.contrast is None else args.contrast)
-    else:
-        source = open_event_list(args.events)
+    options = ImportOptions(parse_size_arg(args.size), args.step_us, args.contrast,
+                            args.steps)
+    reader, source = open_event_file(args.events, options)
     with source:
         meta = dict(source.meta)
-        if is_h5_path(args.output):
-            copy_source(source, H5SpikeWriter(args.output), meta)
-        else:
-            save_spikes(args.output, source.read(0, source.num_steps), meta)
         t, s, h, w = source.shape
-    how = (f" (DSEC layout, {meta['step_us']} us a step, contrast "
-           f"{meta['contrast']:g} assumed)" if dsec else "")
-    print(f"wrote {args.output}: {t} steps x {s} scale(s) x {h}x{w}{how}")
+        if meta.get("size_from") == "guess":
+            print(f"rvsm: warning: {args.events} says no sensor size: took {h}x{w}, the "
+                  "largest y and x + 1; pass --size HxW for the sensor's own",
+                  file=sys.stderr)
+        if meta.get("t_shift"):
+            print(f"rvsm: note: the time stamps start at {meta['t_shift']} us: steps count "
+                  "from there (the meta's t_offset keeps the clock)", file=sys.stderr)
+        counts = CountSink()
+        if is_h5_path(args.output):
+            copy_source(source, TeeSink(H5SpikeWriter(args.output), counts), meta)
+        else:
+            events = source.read(0, source.num_steps)
+            counts.begin(events.shape, meta)
+            counts.write(0, events)
+            save_spikes(args.output, events, meta)
+    how = "" if "contrast_assumed" not in meta else (
+        f", {meta['step_us']} us a step, contrast {meta['contrast']:g} assumed, size "
+        + ("guessed" if meta["size_from"] == "guess" else f"from {meta['size_from']}"))
+    print(f"wrote {args.output}: {counts.spikes:,} events of {s} scale{'s' if s > 1 else ''}, "
+          f"{t} steps of {h}x{w}, from {reader.name} (read by {reader.library}{how})")
     return 0
 
 

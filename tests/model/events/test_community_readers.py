@@ -22,7 +22,7 @@ from rvsm.model.spikes.files import copy_source
 from rvsm.model.spikes.source import array_source
 
 
-def _reader(module: str, package: str):
+def community_reader(module: str, package: str):
     """Import a community reader, or skip naming the package (the ``community`` extra)."""
     if importlib.util.find_spec(module) is None:
         pytest.skip(f"{package} is not installed (pip install -e '.[community]')")
@@ -68,7 +68,7 @@ def test_the_list_needs_no_filter_plugin_and_says_what_scale_means(tmp_path, dog
 
 
 def test_evlib_loads_the_list_and_one_scale(tmp_path, dog4):
-    evlib = _reader("evlib", "evlib")
+    evlib = community_reader("evlib", "evlib")
     for kw, scale in (({}, None), ({"scale": 2}, 2)):
         path = _export(tmp_path / f"list{scale}.h5", dog4, **kw)
         frame = evlib.load_events(str(path)).collect()
@@ -109,7 +109,7 @@ def test_dsec_slicing_finds_every_event_of_any_window(tmp_path, dog4):
 
 @pytest.mark.parametrize("suffix", [".aedat4", ".raw", ".csv"])
 def test_faery_reads_one_scale(tmp_path, dog4, suffix):
-    faery = _reader("faery", "faery")
+    faery = community_reader("faery", "faery")
     path = tmp_path / f"s{suffix}"
     copy_source(array_source(dog4.events, dog4.meta), SensorFileWriter(path, 3),
                 dog4.meta, 6)
@@ -127,7 +127,7 @@ def test_faery_reads_one_scale(tmp_path, dog4, suffix):
 
 
 def test_dv_processing_reads_the_aedat4_export(tmp_path, dog4):
-    dv = _reader("dv_processing", "dv-processing")
+    dv = community_reader("dv_processing", "dv-processing")
     path = tmp_path / "s.aedat4"
     copy_source(array_source(dog4.events, dog4.meta), SensorFileWriter(path, 0),
                 dog4.meta, 6)

@@ -71,7 +71,7 @@ def test_size_from_the_largest_pixel_and_refusals(tmp_path):
     with open_dsec_events(same, step_us=10) as src:  # 10 us steps separate them
         assert src.shape[0] == 5 and src.read(0, 5)[3:5, 0, 3, 7].tolist() == [-1, 1]
     bad = write_dsec(tmp_path / "c.h5", [5, 3], [0, 0], [0, 0], [1, 1])
-    with pytest.raises(RvsmError, match="non-decreasing"):
+    with pytest.raises(RvsmError, match="go back at event 1"):
         open_dsec_events(bad)
 
 
@@ -79,7 +79,8 @@ def test_rvsm_events_import_reads_the_dsec_layout(random_dsec, tmp_path, capsys)
     path, dense = random_dsec
     out = tmp_path / "e.h5"
     assert main(["events", "import", str(path), "--size", "6x10", "-o", str(out)]) == 0
-    assert "DSEC layout" in capsys.readouterr().out
+    said = f"{np.count_nonzero(dense):,} events of 1 scale, 125 steps of 6x10, from DSEC HDF5"
+    assert said in capsys.readouterr().out
     events, meta = load_any_spikes(out)
     assert np.array_equal(events, dense) and meta["source_format"] == "dsec"
     # our own list is not DSEC's: --size is refused there
@@ -88,4 +89,4 @@ def test_rvsm_events_import_reads_the_dsec_layout(random_dsec, tmp_path, capsys)
                 {"model": "fsm"})
     assert main(["events", "import", str(tmp_path / "l.h5"), "--size", "6x10",
                  "-o", str(tmp_path / "x.h5")]) == 2
-    assert "DSEC's layout" in capsys.readouterr().err
+    assert "is an rvsm event list, which says its own size" in capsys.readouterr().err

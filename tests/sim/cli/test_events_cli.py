@@ -103,3 +103,119 @@ def test_an_existing_list_is_replaced_and_another_h5_named_with_its_article(tmp_
         f["x"] = np.zeros(3)
     code, _, err = _run(capsys, "events", "export", events, "-o", tmp_path / "other.h5")
     assert code == 2 and "holds an HDF5 file, not an event list" in err
+
+
+def _dense_events(path, model: str, scales: int, steps: int = 24):
+    """An event file of ``model`` (``scales`` scales, 24x32) with random events."""
+    from rvsm.model.spikes.files import write_spikes
+
+    rng = np.random.default_rng(3)
+    dense = rng.choice([-1, 0, 1], p=[0.02, 0.96, 0.02],
+                       size=(steps, scales, 24, 32)).astype(np.int8)
+    write_spikes(path, dense, {"kind": "events", "sensor": "dvs", "model": model})
+    return dense
+
+
+def _dsec(path, t, x, y, p):
+    import h5py
+
+    with h5py.File(path, "w") as f:
+        f["events/t"], f["events/x"] = np.asarray(t), np.asarray(x, np.uint16)
+        f["events/y"], f["events/p"] = np.asarray(y, np.uint16), np.asarray(p, np.uint8)
+    return path
+
+
+def test_evaluate_of_a_foreign_file_names_the_command_that_converts_it(tmp_path, capsys):
+    dat = tmp_path / "fsm.dat"
+    dat.write_bytes(bytes(24 * 24 * 32 // 8))
+    code, _, err = _run(capsys, "evaluate", dat, "flyball")
+    assert code == 2 and err.count("\n") == 1
+    assert f"rvsm dat import {dat} --size HxW -o spikes.h5" in err
+    assert "zip directory" not in err
+    dsec = _dsec(tmp_path / "d.h5", [25, 50], [1, 2], [1, 2], [1, 0])
+    code, _, err = _run(capsys, "evaluate", dsec, "flyball")
+    assert code == 2 and f"rvsm events import {dsec} -o events.h5" in err
+
+
+def test_imported_events_of_another_step_count_name_the_matching_options(tmp_path, capsys):
+    rng = np.random.default_rng(5)
+    t = np.sort(rng.choice(np.arange(1, 24), 40)) * 25
+    t[-1] = 23 * 25  # 24 steps: 4 frames of 8 steps
+    dsec = _dsec(tmp_path / "d.h5", t, rng.integers(0, 32, 40), rng.integers(0, 24, 40),
+                 rng.integers(0, 2, 40))
+    imported = tmp_path / "e.h5"
+    code, out, err = _run(capsys, "events", "import", dsec, "-o", imported, "--size",
+                          "24x32", "--step-us", 25)
+    assert code == 0, err
+    code, _, err = _run(capsys, "evaluate", imported, "flyball", "--steps-per-frame", 8)
+    assert code == 2 and err.count("\n") == 1
+    assert "pass --frames 4 " in err and "= 24 steps" in err, err
+    assert "or import it again with --steps 320" in err  # 41 frames of 8 steps
+    code, _, err = _run(capsys, "evaluate", imported, "flyball", "--frames", 4)
+    assert code == 2 and "pass --steps-per-frame 8" in err, err
+    code, _, err = _run(capsys, "evaluate", imported, "flyball", "--frames", 4,
+                        "--steps-per-frame", 8)
+    assert code == 0, err
+    longer = tmp_path / "long.h5"  # the recording ran on: --steps sets T
+    code, out, err = _run(capsys, "events", "import", dsec, "-o", longer, "--size", "24x32",
+                          "--steps", 40)
+    assert code == 0 and "40 steps of 24x32" in out, err
+    code, _, err = _run(capsys, "events", "import", dsec, "-o", tmp_path / "x.h5",
+                        "--steps", 10)
+    assert code == 2 and "pass --steps 24 or more" in err and not (tmp_path / "x.h5").exists()
+
+
+def test_export_and_import_say_the_events_and_scales_written(tmp_path, capsys):
+    events = tmp_path / "e.h5"
+    dense = _dense_events(events, "dog4", 4)
+    aedat = tmp_path / "s.aedat4"
+    code, out, err = _run(capsys, "events", "export", events, "--scale", 2, "-o", aedat)
+    assert code == 0, err
+    n = int(np.count_nonzero(dense[:, 2]))
+    assert f"{n:,} events of scale 2 alone (one of dog4's 4 scales), 24 steps of 24x32, " \
+           "as AEDAT4" in out
+    assert "4 scale(s)" not in out and "to read it: faery and evlib" in out
+    code, out, err = _run(capsys, "events", "import", aedat, "-o", tmp_path / "b.h5")
+    assert code == 0, err
+    assert f"{n:,} events of 1 scale, " in out and "from AEDAT4 (read by faery" in out
+    text = tmp_path / "s.txt"  # evlib's text: the options faery needs are said
+    code, out, _ = _run(capsys, "events", "export", events, "--scale", 0, "-o", text)
+    assert code == 0 and "evlib reads it as it is" in out and "separator=b' '" in out
+    one = tmp_path / "one.h5"
+    dense1 = _dense_events(one, "fsm", 1)
+    code, out, _ = _run(capsys, "events", "export", one, "-o", tmp_path / "one.csv")
+    assert code == 0
+    assert f"{np.count_nonzero(dense1):,} events of fsm's one scale" in out
+    assert "dimensions_fallback=(32, 24)" in out
+
+
+def test_a_file_without_a_size_says_the_size_it_took(tmp_path, capsys):
+    dsec = _dsec(tmp_path / "d.h5", [0, 30, 40], [2, 7, 1], [0, 3, 4], [1, 0, 1])
+    code, out, err = _run(capsys, "events", "import", dsec, "-o", tmp_path / "e.h5")
+    assert code == 0, err
+    assert "warning" in err and "took 5x8, the largest y and x + 1" in err
+    assert "3 events of 1 scale" in out and "size guessed" in out
+
+
+def test_bad_foreign_input_exits_2_in_one_line_and_leaves_no_file(tmp_path, capsys):
+    bad = tmp_path / "in"
+    bad.mkdir()
+    (bad / "nop.csv").write_text("t,x,y\n0,1,2\n")
+    _dsec(bad / "back.h5", [0, 25, 50, 75, 60], [0, 1, 2, 3, 4], [0] * 5, [1] * 5)
+    (bad / "odd.xyz").write_text("0 1 2 1\n")
+    (bad / "head.csv").write_text("t,x,y,p\n")
+    (bad / "noise.raw").write_bytes(np.random.default_rng(1).bytes(3000))
+    (bad / "noise.aedat4").write_bytes(np.random.default_rng(2).bytes(3000))
+    (bad / "pol.txt").write_text("0 1 2 5\n")
+    for name, words in (("nop.csv", "no column 'p' (polarity)"),
+                        ("back.h5", "go back at event 4"),
+                        ("head.csv", "holds no events"),
+                        ("noise.raw", "not an EVT file: it has no header"),
+                        ("noise.aedat4", "not a readable AEDAT4 file (faery: bad magic"),
+                        ("pol.txt", "not a readable CSV or text file"),
+                        ("odd.xyz", "not an event file rvsm events import reads")):
+        out = tmp_path / "out" / "e.h5"
+        code, _, err = _run(capsys, "events", "import", bad / name, "-o", out)
+        assert code == 2 and err.count("\n") == 1 and words in err, (name, err)
+        assert "Traceback" not in err
+        assert not (tmp_path / "out").exists()
