@@ -1,13 +1,24 @@
 """The streaming array as AXI IP: :class:`RvsmAxisIp` (docs/ip.md).
 
-One clock domain ``sync`` (synchronous reset ``rst``)::
+One clock domain ``sync`` (synchronous reset ``rst``), joined from one component per
+concern, each with its own signature and cycle model::
 
     s_axis (video: P codes/beat, tuser = start of frame, tlast = end of line)
-      -> input gate: tready = ~busy & (drop policy | credit_r)   [framing check]
-      -> input register (the beat or a flush beat, and clear)
-      -> RvsmStreamArray (codes, clear, thr)  <- threshold writes
-      -> spikes beat (+ tuser, tlast) -> SyncFIFOBuffered(fifo_depth) -> m_axis
-    s_axil -> AxiLiteRegisters(ip_register_map) <-> control, status, counters, THR_*
+      -> InputGate: tready = ~busy & (drop | credit_r); flush beats, clear; the
+         input register                                  (input_gate.py)
+         FramingCheck beside it: tuser/tlast against the position  (framing_check.py)
+      -> RvsmStreamArray (codes, clear, thr)
+         <- ThresholdPort: THR_ADDR/THR_DATA commits, the reset walk (threshold_port.py)
+      -> OutputPacker: spike beat -> tdata + tuser + tlast, drop  (output_packer.py)
+      -> SyncFIFOBuffered(fifo_depth) (w_stream) -> m_axis
+    s_axil -> AxiLiteRegisters(ip_register_map) <-> controls, STATUS, THR_*,
+              EventCounters: IN_BEATS, OUT_BEATS, DROPPED   (event_counters.py)
+
+Submodules: ``array``, ``regs``, ``fifo``, ``gate``, ``framing``, ``threshold_port``,
+``packer``, ``counters``. A wrapper adds its own registers with ``extra_registers``
+(:meth:`~rvsm.rtl.ip.register_map.RegisterMap.extended`, offsets in
+:data:`~rvsm.rtl.ip.register_map.EXTRA_WINDOW`) and drives or reads their fields
+through :attr:`RvsmAxisIp.regs` (``value``, ``set``, ``pulse``, ``written``).
 
 **Input register.** What the gate lets through (an accepted beat, a flush beat, a
 clear) passes one register before the array's own input register: no path runs from
@@ -92,8 +103,8 @@ class RvsmAxisIp(wiring.Component):
     Members: ``s_axis`` In(:class:`AxiStreamSignature`), ``m_axis``
     Out(:class:`AxiStreamSignature`), ``s_axil`` In(:class:`AxiLiteSignature`); Verilog
     ports ``s_axis_tdata`` ... ``s_axil_rready`` plus ``clk`` and ``rst``. ``regmap`` is
-    the register map (:func:`ip_register_map`); timing in :attr:`geometry` and the
-    properties below.
+    the register map (:func:`ip_register_map`, plus ``extra_registers``); timing in
+    :attr:`geometry` and the properties below.
     """
 
     #: Registers from the input gate to the FIFO's write: the IP's input register and
