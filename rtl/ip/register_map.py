@@ -16,8 +16,9 @@ one-cycle pulse; reads as 0). Registers are 32 bits at word-aligned byte offsets
 
 from __future__ import annotations
 
+import dataclasses
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
 
 from rvsm.model.fixed.contract import ArrayContract
@@ -25,8 +26,8 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.signatures import field_bits, threshold_word_bits
 
-__all__ = ["ACCESS", "ID_MAGIC", "Field", "Register", "RegisterMap", "ip_register_map",
-           "pack_version", "regs_c_header", "regs_json", "regs_markdown"]
+__all__ = ["ACCESS", "EXTRA_WINDOW", "ID_MAGIC", "Field", "Register", "RegisterMap",
+           "ip_register_map", "pack_version", "regs_c_header", "regs_json", "regs_markdown"]
 
 #: Field access kinds and their meaning.
 ACCESS = {
@@ -46,6 +47,9 @@ RESP_OKAY, RESP_SLVERR = 0b00, 0b10
 THR_DATA_BASE = 0x100
 #: Registers of 32 bits; the address window is 4 KiB.
 ADDR_BITS = 12
+#: Byte offsets left for the registers of a wrapper (:meth:`RegisterMap.extended`):
+#: 0x080 to 0x0FC, between the IP's own (up to 0x040) and ``THR_DATA*`` (0x100 on).
+EXTRA_WINDOW = range(0x080, THR_DATA_BASE, 4)
 
 
 @dataclass(frozen=True)
@@ -151,6 +155,22 @@ class RegisterMap:
             if f.name == name:
                 return f
         raise KeyError(f"{register}.{name}")
+
+    def extended(self, registers: Sequence[Register]) -> RegisterMap:
+        """This map with ``registers`` added (a wrapper's own, e.g. a board front end's
+        link status), each inside :data:`EXTRA_WINDOW`; the offsets must be free."""
+        if not registers:
+            return self
+        for r in registers:
+            if r.offset not in EXTRA_WINDOW:
+                raise RvsmError(f"register {r.name} at 0x{r.offset:03X}: extra registers "
+                                f"go from 0x{EXTRA_WINDOW.start:03X} to "
+                                f"0x{EXTRA_WINDOW.stop - 4:03X}")
+        names = [r.name for r in (*self.registers, *registers)]
+        if len(set(names)) != len(names):
+            raise RvsmError(f"register names must be distinct, got {sorted(names)}")
+        merged = tuple(sorted((*self.registers, *registers), key=lambda r: r.offset))
+        return dataclasses.replace(self, registers=merged)
 
     def thr_data_registers(self) -> list[Register]:
         """The threshold data chunk registers, chunk 0 first (the last commits)."""

@@ -1,13 +1,24 @@
 """The streaming array as AXI IP: :class:`RvsmAxisIp` (docs/ip.md).
 
-One clock domain ``sync`` (synchronous reset ``rst``)::
+One clock domain ``sync`` (synchronous reset ``rst``), joined from one component per
+concern, each with its own signature and cycle model::
 
     s_axis (video: P codes/beat, tuser = start of frame, tlast = end of line)
-      -> input gate: tready = ~busy & (drop policy | credit_r)   [framing check]
-      -> input register (the beat or a flush beat, and clear)
-      -> RvsmStreamArray (codes, clear, thr)  <- threshold writes
-      -> spikes beat (+ tuser, tlast) -> SyncFIFOBuffered(fifo_depth) -> m_axis
-    s_axil -> AxiLiteRegisters(ip_register_map) <-> control, status, counters, THR_*
+      -> InputGate: tready = ~busy & (drop | credit_r); flush beats, clear; the
+         input register                                  (input_gate.py)
+         FramingCheck beside it: tuser/tlast against the position  (framing_check.py)
+      -> RvsmStreamArray (codes, clear, thr)
+         <- ThresholdPort: THR_ADDR/THR_DATA commits, the reset walk (threshold_port.py)
+      -> OutputPacker: spike beat -> tdata + tuser + tlast, drop  (output_packer.py)
+      -> SyncFIFOBuffered(fifo_depth) (w_stream) -> m_axis
+    s_axil -> AxiLiteRegisters(ip_register_map) <-> controls, STATUS, THR_*,
+              EventCounters: IN_BEATS, OUT_BEATS, DROPPED   (event_counters.py)
+
+Submodules: ``array``, ``regs``, ``fifo``, ``gate``, ``framing``, ``threshold_port``,
+``packer``, ``counters``. A wrapper adds its own registers with ``extra_registers``
+(:meth:`~rvsm.rtl.ip.register_map.RegisterMap.extended`, offsets in
+:data:`~rvsm.rtl.ip.register_map.EXTRA_WINDOW`) and drives or reads their fields
+through :attr:`RvsmAxisIp.regs` (``value``, ``set``, ``pulse``, ``written``).
 
 **Input register.** What the gate lets through (an accepted beat, a flush beat, a
 clear) passes one register before the array's own input register: no path runs from
@@ -51,8 +62,12 @@ sending a new frame.
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, Const, Module, Mux, Signal
+from collections.abc import Sequence
+from dataclasses import asdict
+
+from amaranth.hdl import Cat, Module, Signal
 from amaranth.lib import wiring
+from amaranth.lib.data import View
 from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.wiring import In, Out
 
@@ -62,15 +77,23 @@ from rvsm.model.infra.versions import rvsm_version
 from rvsm.rtl.flow_files import design_point_digest
 from rvsm.rtl.ip.axi_lite import AxiLiteRegisters, AxiLiteSignature
 from rvsm.rtl.ip.axis import AxiStreamSignature, spike_tdata_layout, video_lane_bits
-from rvsm.rtl.ip.register_map import ADDR_BITS, RegisterMap, ip_register_map
+from rvsm.rtl.ip.event_counters import EventCounters
+from rvsm.rtl.ip.framing_check import FramingCheck
+from rvsm.rtl.ip.input_gate import InputGate
+from rvsm.rtl.ip.output_packer import OutputPacker
+from rvsm.rtl.ip.register_map import ADDR_BITS, Register, RegisterMap, ip_register_map
+from rvsm.rtl.ip.threshold_port import ThresholdPort
 from rvsm.rtl.rtl_digest import rtl_digest
 from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.dimensions import StreamGeometry
 
-__all__ = ["IP_ARCH", "RvsmAxisIp", "ip_regmap"]
+__all__ = ["COUNTERS", "IP_ARCH", "RvsmAxisIp", "ip_options", "ip_regmap"]
 
 #: The architecture name of the IP in provenance, digests and ``ports.json``.
 IP_ARCH = "stream_axis"
+#: The beat counters, in the order of :class:`EventCounters`' events: input handshakes,
+#: output handshakes, dropped output beats (registers of the same names).
+COUNTERS = ("IN_BEATS", "OUT_BEATS", "DROPPED")
 
 
 class RvsmAxisIp(wiring.Component):
@@ -80,13 +103,13 @@ class RvsmAxisIp(wiring.Component):
     Members: ``s_axis`` In(:class:`AxiStreamSignature`), ``m_axis``
     Out(:class:`AxiStreamSignature`), ``s_axil`` In(:class:`AxiLiteSignature`); Verilog
     ports ``s_axis_tdata`` ... ``s_axil_rready`` plus ``clk`` and ``rst``. ``regmap`` is
-    the register map (:func:`ip_register_map`); timing in :attr:`geometry` and the
-    properties below.
+    the register map (:func:`ip_register_map`, plus ``extra_registers``); timing in
+    :attr:`geometry` and the properties below.
     """
 
     #: Registers from the input gate to the FIFO's write: the IP's input register and
     #: the array's input and output registers (cycles; beats in flight).
-    IN_FLIGHT = 3
+    IN_FLIGHT = InputGate.REGISTERS + 2
     #: Smallest output FIFO (beats) accepted.
     MIN_FIFO_DEPTH = 4
     #: Smallest output FIFO that takes a beat every cycle while the sink is always ready
@@ -102,7 +125,7 @@ class RvsmAxisIp(wiring.Component):
     RELEASE_CYCLES = IN_FLIGHT + 2
 
     def __init__(self, contract: ArrayContract, lanes: int = 1,
-                 fifo_depth: int = FIFO_DEPTH):
+                 fifo_depth: int = FIFO_DEPTH, extra_registers: Sequence[Register] = ()):
         if not isinstance(fifo_depth, int) or not \
                 self.MIN_FIFO_DEPTH <= fifo_depth < 1 << 16:
             raise RvsmError(f"fifo_depth must be an integer from {self.MIN_FIFO_DEPTH} to "
@@ -113,21 +136,26 @@ class RvsmAxisIp(wiring.Component):
         self.lanes = self.geometry.lanes
         self.fifo_depth = fifo_depth
         #: The options that build this IP (provenance, digest).
-        self.options = {"lanes": self.lanes, "fifo_depth": fifo_depth}
+        self.options = ip_options(self.lanes, fifo_depth, extra_registers)
         self.rtl_digest = rtl_digest(contract, IP_ARCH, self.options)
-        self.regmap: RegisterMap = ip_regmap(contract, self.lanes, fifo_depth)
-        #: The register file (:class:`AxiLiteRegisters`) and the output FIFO: submodules,
-        #: attributes so that a bench can observe them.
+        self.regmap: RegisterMap = ip_regmap(contract, self.lanes, fifo_depth,
+                                             extra_registers)
+        #: The parts (submodules; attributes so that a bench can observe them): the
+        #: register file, the input gate, the framing check, the threshold port, the
+        #: output packer, the output FIFO and the beat counters.
         self.regs = AxiLiteRegisters(self.regmap)
-        layout = spike_tdata_layout(contract.num_scales, self.lanes, contract.height,
-                                    self.geometry.groups)
-        self.fifo = SyncFIFOBuffered(width=layout.size + 2, depth=fifo_depth)
+        self.gate = InputGate(contract.adc_bits, self.lanes, self.lag, fifo_depth)
+        self.framing = FramingCheck(contract.height, self.geometry.groups)
+        self.threshold_port = ThresholdPort(self.geometry, self.regmap)
+        self.packer = OutputPacker(self.geometry)
+        self.fifo = SyncFIFOBuffered(width=self.packer.word.size, depth=fifo_depth)
+        self.counters = EventCounters(COUNTERS)
         #: Control state (threshold initialisation, flush and clear requests) and the
         #: drop strobe, for benches and diagrams.
-        self.init = Signal(init=1, name="init")
-        self.flush_req = Signal(name="flush_req")
-        self.clear_req = Signal(name="clear_req")
-        self.drop = Signal(name="drop")
+        self.init: Signal = self.threshold_port.init
+        self.flush_req: Signal = self.gate.flush_req
+        self.clear_req: Signal = self.gate.clear_req
+        self.drop: Signal = self.packer.drop
         super().__init__(self.interface(contract, self.lanes))
 
     @staticmethod
@@ -167,147 +195,80 @@ class RvsmAxisIp(wiring.Component):
         return self.contract.num_scales * self.geometry.threshold_words
 
     def elaborate(self, platform: object) -> Module:
+        """The parts (module docstring), joined: streams with ``wiring.connect``, the
+        register file's fields by name."""
         m = Module()
-        c, geo, arr = self.contract, self.geometry, self.array
-        p, n = geo.lanes, c.adc_bits
-        m.submodules.array = arr
-        m.submodules.regs = regs = self.regs
+        regs, gate, thr, fifo, arr = self.regs, self.gate, self.threshold_port, self.fifo, \
+            self.array
+        for name, part in (("array", arr), ("regs", regs), ("fifo", fifo), ("gate", gate),
+                           ("framing", self.framing), ("threshold_port", thr),
+                           ("packer", self.packer), ("counters", self.counters)):
+            m.submodules[name] = part
+        # the datapath: s_axis -> gate -> array -> packer -> FIFO -> m_axis
+        wiring.connect(m, wiring.flipped(self.s_axis), gate.s_axis)
+        wiring.connect(m, gate.codes, arr.codes)
+        wiring.connect(m, thr.thr, arr.thr)
+        wiring.connect(m, arr.spikes, self.packer.spikes)
+        wiring.connect(m, self.packer.beats, fifo.w_stream)
         wiring.connect(m, wiring.flipped(self.s_axil), regs.bus)
-        layout = spike_tdata_layout(c.num_scales, p, c.height, geo.groups)
-        m.submodules.fifo = fifo = self.fifo
-
-        init, flush_req, clear_req = self.init, self.flush_req, self.clear_req
-        flush_left = Signal(range(self.lag + 1), name="flush_left")
-        drop_policy = regs.value["CONTROL.drop"]
-        busy = init | flush_req | clear_req
-        if self.IN_FLIGHT != 3:
-            raise AssertionError("IN_FLIGHT counts the registers built here")
-        r1 = Signal(name="accepted_r1")  # the beat in the IP's input register
-        r2 = Signal(name="accepted_r2")  # the beat in the array's input register
-        # room next cycle for every beat then in flight: registered (timing), with one
-        # more beat of margin for the beat this cycle may accept
-        credit_r = Signal(init=1, name="credit_r")
-        m.d.sync += credit_r.eq(fifo.level + r1 + r2 + arr.spikes.valid + 1
-                                < self.fifo_depth)
-        credit = drop_policy | credit_r
-        s_in = self.s_axis
-        m.d.comb += s_in.tready.eq(~busy & credit)
-        fire = s_in.tvalid & s_in.tready
-        inject = ~init & flush_req & credit
-        clear_now = ~init & ~flush_req & clear_req
-        lane_bits = video_lane_bits(n)
-        codes = Cat(*(s_in.tdata[i * lane_bits:i * lane_bits + n] for i in range(p)))
-        # the input register (module docstring): r1 is its valid bit
-        in_codes = Signal(len(codes), name="in_codes_r", reset_less=True)
-        in_clear = Signal(name="in_clear_r")
-        m.d.sync += [r1.eq(fire | inject), r2.eq(r1), in_clear.eq(clear_now),
-                     in_codes.eq(Mux(inject, 0, codes))]
-        m.d.comb += [arr.codes.valid.eq(r1), arr.codes.payload.as_value().eq(in_codes),
-                     arr.clear.eq(in_clear)]
-
-        # flush and clear requests (CONTROL pulses, the cycle after the write)
-        with m.If(regs.pulse["CONTROL.flush"] & ~flush_req):
-            m.d.sync += [flush_req.eq(1), flush_left.eq(self.lag)]
-        with m.If(inject):
-            m.d.sync += flush_left.eq(flush_left - 1)
-            with m.If(flush_left == 1):
-                m.d.sync += flush_req.eq(0)
-        with m.If(regs.pulse["CONTROL.clear"]):
-            m.d.sync += clear_req.eq(1)
-        with m.If(clear_now):
-            m.d.sync += clear_req.eq(0)
-
-        # input position: framing check of tuser (start of frame) and tlast (end of line),
-        # one cycle after the beat (its handshake registered: no path from the input gate
-        # into the position counters); the counters hold the position of the beat in r1
-        in_g = Signal(range(geo.groups), name="in_group")
-        in_y = Signal(range(c.height), name="in_row")
-        fire_r = Signal(name="fire_r")
-        tuser_r, tlast_r = Signal(name="tuser_r"), Signal(name="tlast_r")
-        m.d.sync += [fire_r.eq(fire), tuser_r.eq(s_in.tuser), tlast_r.eq(s_in.tlast)]
-        g_end = in_g == geo.groups - 1
-        with m.If(clear_now):
-            m.d.sync += [in_g.eq(0), in_y.eq(0)]
-        with m.Elif(r1):
-            m.d.sync += [in_g.eq(Mux(g_end, 0, in_g + 1)),
-                         in_y.eq(Mux(g_end, Mux(in_y == c.height - 1, 0, in_y + 1), in_y))]
-        sof = (in_g == 0) & (in_y == 0)
-        m.d.comb += regs.set["STATUS.framing"].eq(
-            fire_r & ((tuser_r != sof) | (tlast_r != g_end)))
-
-        self._thresholds(m, regs, init)
-
-        # output: spikes beat -> FIFO -> m_axis
-        sp = arr.spikes.payload
-        beat = Signal(layout, name="out_beat")
-        m.d.comb += [beat.pos.eq(sp.pos), beat.neg.eq(sp.neg), beat.row.eq(sp.row),
-                     beat.group.eq(sp.group), beat.eof.eq(sp.last)]
-        out_sof = (sp.row == 0) & (sp.group == 0)
-        out_eol = sp.group == geo.groups - 1
-        drop = self.drop
-        m.d.comb += drop.eq(arr.spikes.valid & ~fifo.w_rdy)
-        m.d.comb += [fifo.w_en.eq(arr.spikes.valid),
-                     fifo.w_data.eq(Cat(beat.as_value(), out_sof, out_eol)),
-                     self.m_axis.tvalid.eq(fifo.r_rdy),
-                     self.m_axis.tdata.eq(fifo.r_data[:layout.size]),
-                     self.m_axis.tuser.eq(fifo.r_data[layout.size]),
-                     self.m_axis.tlast.eq(fifo.r_data[layout.size + 1]),
-                     fifo.r_en.eq(self.m_axis.tready),
-                     regs.set["STATUS.overflow"].eq(drop)]
-
-        # counters and status
+        out = View(self.packer.word, fifo.r_data)
         sent = self.m_axis.tvalid & self.m_axis.tready
-        for name, event in (("IN_BEATS", fire), ("OUT_BEATS", sent), ("DROPPED", drop)):
-            count = regs.value[f"{name}.count"]
-            with m.If(regs.pulse["CONTROL.counters_reset"]):
-                m.d.sync += count.eq(0)
-            with m.Elif(event):
-                m.d.sync += count.eq(count + 1)
+        m.d.comb += [arr.clear.eq(gate.clear), gate.out_valid.eq(arr.spikes.valid),
+                     gate.fifo_level.eq(fifo.level),
+                     self.m_axis.tvalid.eq(fifo.r_rdy), self.m_axis.tdata.eq(out.tdata),
+                     self.m_axis.tuser.eq(out.tuser), self.m_axis.tlast.eq(out.tlast),
+                     fifo.r_en.eq(self.m_axis.tready)]
+        # the framing check beside the gate
+        framing = self.framing
+        m.d.comb += [framing.accepted.eq(gate.accepted), framing.tuser.eq(self.s_axis.tuser),
+                     framing.tlast.eq(self.s_axis.tlast), framing.advance.eq(gate.codes.valid),
+                     framing.restart.eq(gate.restart)]
+        # the register file: controls in, status and counts out
+        thr_data = self.regmap.thr_data_registers()
+        m.d.comb += [gate.ctl.init.eq(thr.init), gate.ctl.drop.eq(regs.value["CONTROL.drop"]),
+                     gate.ctl.flush.eq(regs.pulse["CONTROL.flush"]),
+                     gate.ctl.clear.eq(regs.pulse["CONTROL.clear"]),
+                     thr.data.eq(Cat(*(regs.value[f"{r.name}.data"] for r in thr_data))),
+                     thr.commit.eq(regs.written[thr_data[-1].name]),
+                     thr.address_written.eq(regs.written["THR_ADDR"]),
+                     thr.wdata.eq(regs.wdata),
+                     regs.value["THR_ADDR.scale"].eq(thr.scale),
+                     regs.refuse["THR_ADDR"].eq(thr.init),
+                     regs.refuse[thr_data[-1].name].eq(thr.init),
+                     regs.set["STATUS.framing"].eq(framing.error),
+                     regs.set["STATUS.overflow"].eq(self.drop),
+                     self.counters.events.eq(Cat(gate.accepted, sent, self.drop)),
+                     self.counters.reset.eq(regs.pulse["CONTROL.counters_reset"])]
+        if not self.geometry.shared_thresholds:
+            m.d.comb += regs.value["THR_ADDR.word"].eq(thr.word)
+        for name in self.counters.names:
+            m.d.comb += regs.value[f"{name}.count"].eq(self.counters.count(name))
         # status as registers (one cycle behind): the register read multiplexer starts
         # at flip-flops
-        m.d.sync += [regs.value["STATUS.init"].eq(init),
-                     regs.value["STATUS.flushing"].eq(flush_req),
-                     regs.value["STATUS.busy"].eq(busy),
+        m.d.sync += [regs.value["STATUS.init"].eq(thr.init),
+                     regs.value["STATUS.flushing"].eq(gate.flushing),
+                     regs.value["STATUS.busy"].eq(gate.busy),
                      regs.value["STATUS.fifo_level"].eq(fifo.level)]
         return m
 
-    def _thresholds(self, m: Module, regs: AxiLiteRegisters, init: Signal) -> None:
-        """THR_ADDR (auto-incrementing), the commit of THR_DATA chunks, and the walk
-        that sets every threshold word to the top rail after reset."""
-        c, geo, arr, rm = self.contract, self.geometry, self.array, self.regmap
-        shared = geo.shared_thresholds  # THR_ADDR without a word: one register per scale
-        word = None if shared else regs.value["THR_ADDR.word"]
-        scale = regs.value["THR_ADDR.scale"]
-        last_word = Const(1) if shared else word == geo.threshold_words - 1
-        last_scale = scale == c.num_scales - 1
-        reset_data = Const(geo.threshold_reset_data(0), len(arr.thr.data))
-        for s in range(1, c.num_scales if shared else 1):  # what rst restores, per scale
-            reset_data = Mux(scale == s, geo.threshold_reset_data(s), reset_data)
-        chunks = [regs.value[f"{r.name}.data"] for r in rm.thr_data_registers()]
-        commit = regs.written[rm.thr_data_registers()[-1].name]
-        for name in ("THR_ADDR", rm.thr_data_registers()[-1].name):
-            m.d.comb += regs.refuse[name].eq(init)
-        step = init | commit
-        m.d.comb += [arr.thr.we.eq(step),
-                     arr.thr.addr.eq(scale if shared else Cat(word, scale)),
-                     arr.thr.data.eq(Mux(init, reset_data,
-                                         Cat(*chunks)[:len(arr.thr.data)]))]
-        with m.If(step):
-            m.d.sync += scale.eq(Mux(last_word, Mux(last_scale, 0, scale + 1), scale))
-            if not shared:
-                m.d.sync += word.eq(Mux(last_word, 0, word + 1))
-            with m.If(last_word & last_scale):
-                m.d.sync += init.eq(0)
-        with m.Elif(regs.written["THR_ADDR"]):
-            m.d.sync += scale.eq(regs.wdata[16:16 + len(scale)])
-            if not shared:
-                m.d.sync += word.eq(regs.wdata[:len(word)])
+
+def ip_options(lanes: int, fifo_depth: int,
+               extra_registers: Sequence[Register] = ()) -> dict[str, object]:
+    """The options that build the IP (JSON values; the RTL digest's): ``lanes``,
+    ``fifo_depth`` and, when there are any, the ``extra_registers`` declared."""
+    options: dict[str, object] = {"lanes": lanes, "fifo_depth": fifo_depth}
+    if extra_registers:
+        options["extra_registers"] = [asdict(r) for r in extra_registers]
+    return options
 
 
-def ip_regmap(contract: ArrayContract, lanes: int, fifo_depth: int) -> RegisterMap:
-    """The register map of the IP built with ``lanes`` and ``fifo_depth`` (its identity
-    registers hold this build's digests), without building the IP."""
-    options = {"lanes": lanes, "fifo_depth": fifo_depth}
-    return ip_register_map(contract, lanes, fifo_depth,
-                           rtl_digest(contract, IP_ARCH, options),
-                           design_point_digest(contract), rvsm_version())
+def ip_regmap(contract: ArrayContract, lanes: int, fifo_depth: int,
+              extra_registers: Sequence[Register] = ()) -> RegisterMap:
+    """The register map of the IP built with ``lanes``, ``fifo_depth`` and
+    ``extra_registers`` (its identity registers hold this build's digests), without
+    building the IP."""
+    options = ip_options(lanes, fifo_depth, extra_registers)
+    regmap = ip_register_map(contract, lanes, fifo_depth,
+                             rtl_digest(contract, IP_ARCH, options),
+                             design_point_digest(contract), rvsm_version())
+    return regmap.extended(extra_registers)

@@ -112,3 +112,24 @@ def test_c_header_compiles_and_each_define_is_the_register_maps(tmp_path: Path,
     got = {name: int(value) for name, value in (line.split() for line in out.splitlines())}
     assert got == want
     assert "RVSM_AXIS_IP_LANES 4u" in header
+
+
+def test_a_wrapper_extends_the_map_inside_its_window() -> None:
+    """:meth:`RegisterMap.extended`: a wrapper's registers join the map in offset order;
+    outside ``EXTRA_WINDOW``, on a taken offset or name, they are refused."""
+    from rvsm.rtl.ip.register_map import EXTRA_WINDOW, Field, Register
+
+    _, rm = _map()
+    link = Register("LINK_STATUS", EXTRA_WINDOW.start,
+                    (Field("locked", 0, 1, "RO", 0, "link locked", live=True),), "link")
+    ext = rm.extended([link])
+    assert ext["LINK_STATUS"] is link and rm.extended([]) is rm
+    assert [r.offset for r in ext.registers] == sorted(r.offset for r in ext.registers)
+    assert len(ext.registers) == len(rm.registers) + 1
+    for bad in (Register("X", 0x44, link.fields, "below the window"),
+                Register("X", 0x100, link.fields, "THR_DATA0's offset"),
+                Register("ID", 0x84, link.fields, "a taken name")):
+        with pytest.raises(RvsmError):
+            rm.extended([bad])
+    with pytest.raises(ValueError):  # two at one offset
+        rm.extended([link, Register("LINK_B", link.offset, link.fields, "same offset")])

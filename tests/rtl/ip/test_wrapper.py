@@ -255,3 +255,32 @@ def test_shared_thresholds_load_by_scale_and_reset_to_the_nominal_ones() -> None
     with pytest.raises(RvsmError, match="shared"):
         dut.geometry.threshold_writes(np.arange(2 * c.height * c.width).reshape(
             2, c.height, c.width) + 1)
+
+
+def test_extra_registers_of_a_wrapper_are_read_and_written_through_the_ip() -> None:
+    """A board front end adds its registers (``extra_registers``): an ``RW`` one reads
+    back what was written, a live ``RO`` one what the wrapper drives into
+    ``regs.value``; the options and the RTL digest say they are there."""
+    from rvsm.rtl.ip.register_map import Field, Register
+    from rvsm.rtl.ip.wrapper import IP_ARCH, ip_options
+    from rvsm.rtl.rtl_digest import rtl_digest
+
+    c, _, _ = _run(model="fsm", steps=1)
+    extra = (Register("LINK_STATUS", 0x80, (
+                 Field("locked", 0, 1, "RO", 0, "link locked", live=True),), "link status"),
+             Register("LINK_CTRL", 0x84, (
+                 Field("enable", 0, 1, "RW", 0, "enable the link"),), "link control"))
+    dut = RvsmAxisIp(c, LANES, extra_registers=extra)
+    assert dut.options["extra_registers"][0]["name"] == "LINK_STATUS"
+    assert dut.rtl_digest != rtl_digest(c, IP_ARCH, ip_options(LANES, dut.fifo_depth))
+    seen: dict[str, int] = {}
+
+    async def bench(cy: Cycler) -> None:
+        cy.ctx.set(dut.regs.value["LINK_STATUS.locked"], 1)  # the wrapper's live value
+        seen["write"] = await axil_write(cy, 0x84, 1)
+        seen["ctrl"] = await read_register(cy, "LINK_CTRL")
+        seen["status"] = await read_register(cy, "LINK_STATUS")
+        seen["enable"] = cy.ctx.get(dut.regs.value["LINK_CTRL.enable"])
+
+    run_bench(dut, bench)
+    assert seen == {"write": RESP_OKAY, "ctrl": 1, "status": 1, "enable": 1}
