@@ -14,9 +14,10 @@ alignment, deskew or framing; the links' ``BoardFrontEnd`` replaces :class:`Boar
   The receive bits, links in order, drive the core's ``codes.payload`` (cyclically if
   narrower); ``codes.valid`` is "every receive FIFO has a word".
 * Transmit link ``txK``: the core's output bits (``spikes`` payload and valid, in
-  signature order, zero-padded) go through an AsyncFIFO into domain ``txK`` (SCLK =
-  CLKDIVF /2 of the PLL's edge clock through an ECLKSYNCB); each word leaves in two SCLK
-  halves through one ODDRX2F per pair; the forwarded clock is an ODDRX2F sending 1010.
+  signature order, zero-padded) cross into domain ``txK`` (SCLK = CLKDIVF /2 of the PLL's
+  edge clock through an ECLKSYNCB, so related to the core clock) through a ring of
+  :data:`RING` registered words; each word leaves in two SCLK halves through one ODDRX2F
+  per pair; the forwarded clock is an ODDRX2F sending 1010.
 * Control: a write-only serial port (``spi_sck``, ``spi_mosi``, ``spi_cs_n``; bits shifted
   in on ``spi_sck`` rising, MSB first, applied when ``spi_cs_n`` rises) sets
   ``{clear, thr.we, thr.addr, thr.data}``; ``led`` shows "receive FIFOs not empty".
@@ -39,7 +40,7 @@ from amaranth.hdl import (
 )
 from amaranth.lib import wiring
 from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
-from amaranth.lib.fifo import AsyncFIFO, AsyncFIFOBuffered
+from amaranth.lib.fifo import AsyncFIFO
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.harness import component_ports
@@ -51,6 +52,8 @@ __all__ = ["BITS_PER_PAIR", "CONTROLS", "BoardTop", "board_ports"]
 BITS_PER_PAIR = 8
 #: Single-ended control pins of the board top.
 CONTROLS = ("rst_n", "spi_sck", "spi_mosi", "spi_cs_n", "led")
+#: Words in a transmitter's clock-crossing ring.
+RING = 4
 #: PLL voltage-controlled oscillator frequency (MHz): within EHXPLLL's 400-800 MHz.
 VCO_MHZ = 800.0
 
@@ -165,16 +168,23 @@ class BoardTop(Elaboratable):
                      bits: Signal) -> None:
         eclk = self._edge(m, link, tx_eclk)
         n, dom = link.data_pairs, link.name
-        fifo = AsyncFIFOBuffered(width=8 * n, depth=5, w_domain="sync", r_domain=dom)
-        m.submodules[f"{dom}_fifo"] = fifo
-        m.d.comb += [fifo.w_data.eq(bits), fifo.w_en.eq(1)]
-        half, word = Signal(name=f"{dom}_half"), Signal(8 * n, name=f"{dom}_word")
-        m.d[dom] += half.eq(~half)
-        m.d.comb += fifo.r_en.eq(~half)
-        with m.If(~half):
-            m.d[dom] += word.eq(fifo.r_data)
+        # Mesochronous ring: SCLK and the core clock come from one PLL (2 SCLK a core
+        # cycle), so a ring of RING words written every core cycle and read two SCLKs a
+        # word, RING / 2 words behind, never over- or underruns; no handshake to time.
+        ring = [Signal(8 * n, name=f"{dom}_ring{k}") for k in range(RING)]
+        wp = Signal(range(RING), name=f"{dom}_wp")
+        m.d.sync += wp.eq(wp + 1)
+        with m.Switch(wp):
+            for k in range(RING):
+                with m.Case(k):
+                    m.d.sync += ring[k].eq(bits)
+        count = Signal(range(2 * RING), name=f"{dom}_count", init=RING)
+        m.d[dom] += count.eq(count + 1)
         out = Signal(4 * n, name=f"{dom}_out")
-        m.d[dom] += out.eq(word.word_select(half, 4 * n))
+        with m.Switch(count):
+            for k in range(2 * RING):
+                with m.Case(k):
+                    m.d[dom] += out.eq(ring[k // 2].word_select(k % 2, 4 * n))
         for i in range(n):
             m.submodules[f"{dom}_oddr{i}"] = Instance(
                 "ODDRX2F", i_ECLK=eclk, i_SCLK=ClockSignal(dom), i_RST=ResetSignal(dom),
