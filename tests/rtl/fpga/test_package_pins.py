@@ -53,6 +53,23 @@ def test_cabga381_figures():
     assert all(t.bank_summary()[b]["pclk"] == 2 for b in (2, 3, 6, 7))
 
 
+@pytest.mark.parametrize("package, totals, left, right", [
+    ("CABGA381", (100, 33, 65), (16, 16, 8, 8), (17, 16, 9, 8)),
+    ("CABGA554", (129, 40, 80), (24, 16, 12, 8), (16, 24, 8, 12)),
+    ("CABGA756", (182, 56, 112), (32, 24, 16, 12), (24, 32, 12, 16)),
+])
+def test_pairs_per_package_and_side(package, totals, left, right):
+    """The figures docs/fpga.md "Board build" quotes: pairs, true-LVDS output pairs and
+    gearing pairs in all; pairs of banks 6, 7 (left) and 2, 3 (right), then their
+    true-LVDS output pairs."""
+    t = load_package(package)
+    tot, s = t.totals(), t.bank_summary()
+    assert (tot["pairs"], tot["lvds_output"], tot["gearing"]) == totals
+    for banks, want in (((6, 7), left), ((2, 3), right)):
+        got = tuple(s[b]["pairs"] for b in banks) + tuple(s[b]["lvds_output"] for b in banks)
+        assert got == want
+
+
 def test_unknown_package_is_refused():
     with pytest.raises(RvsmError, match="no pin table"):
         load_package("CSFBGA285")

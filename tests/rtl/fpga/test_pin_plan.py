@@ -9,7 +9,7 @@ from amaranth.back import verilog
 
 from rvsm.model.fixed.point_toml import load_design_point
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.fpga.board_top import BoardTop, board_ports
+from rvsm.rtl.fpga.board_top import CONTROLS, BoardTop, board_ports
 from rvsm.rtl.fpga.flow import build_component
 from rvsm.rtl.fpga.package_pins import load_package
 from rvsm.rtl.fpga.pin_plan import BoardPorts, LinkSpec, _placements, plan_pins
@@ -17,7 +17,7 @@ from rvsm.rtl.fpga.pin_plan import BoardPorts, LinkSpec, _placements, plan_pins
 POINT = "points/ecp5-85-40khz.toml"
 TINY = BoardPorts((LinkSpec("rx0", "rx", 2), LinkSpec("tx0", "tx", 2)), ("rst_n", "led"))
 #: The shipped point's links: 280 code bits = 35 pairs in, 173 + 1 spike bits = 22 out.
-FULL = BoardPorts((LinkSpec("rx0", "rx", 35), LinkSpec("tx0", "tx", 22)), ("rst_n",))
+FULL = BoardPorts((LinkSpec("rx0", "rx", 35), LinkSpec("tx0", "tx", 22)), CONTROLS)
 
 
 def _pairs_by_ball(package: str) -> dict:
@@ -56,7 +56,16 @@ def test_full_sensor_does_not_fit_cabga381_and_the_planner_chooses_cabga756():
     why381 = dict(plan.rejected)["CABGA381"]
     assert "36 receive pairs and 23 transmit" in why381
     assert "left banks 6+7: 16+16 pairs, 8+8 true-LVDS output" in why381
-    assert plan.pins_used == (36 + 23) * 2 + 2
+    assert plan.pins_used == (36 + 23) * 2 + 6 == 124 and plan.pins_available == 365
+    assert plan.link_sides == {"rx0": ("L", (6, 7)), "tx0": ("R", (2, 3))}
+    why554 = dict(plan.rejected)["CABGA554"]
+    assert "left banks 6+7: 24+16 pairs, 12+8 true-LVDS output" in why554
+    # packing the output to the payload (160 bits = 20 pairs) does not save CABGA554
+    packed = BoardPorts((FULL.links[0], LinkSpec("tx0", "tx", 20)), CONTROLS)
+    assert plan_pins(packed).package == "CABGA756"
+    # ... 18 data pairs (144 bits a cycle) would
+    assert plan_pins(BoardPorts((FULL.links[0], LinkSpec("tx0", "tx", 18)),
+                                CONTROLS)).package == "CABGA554"
     with pytest.raises(RvsmError, match="CABGA381: 2 links need 36 receive pairs"):
         plan_pins(FULL, "CABGA381")
 
@@ -71,6 +80,13 @@ def test_edge_clock_rules_of_the_placements():
         plan_pins(BoardPorts(tuple(LinkSpec(f"l{i}", "rx", 1) for i in range(5))))
     with pytest.raises(RvsmError, match="at least one data pair"):
         LinkSpec("x", "tx", 0)
+
+
+def test_the_shipped_points_links():
+    point = load_design_point(POINT)
+    core, _ = build_component(point.contract(), "stream", lanes=40)
+    core._MustUse__silence = True  # only its signature is read
+    assert board_ports(core) == FULL  # 280 code bits in, 173 + 1 spike bits out
 
 
 def test_board_top_ports_are_the_planned_ports():
