@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep bench-fpga datasheet lint diagrams clean
+.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep bench-fpga bench-board datasheet lint diagrams clean
 
 setup: $(STAMP)
 
@@ -105,6 +105,12 @@ bench-sweep: setup
 POINT ?= points/ecp5-85-40khz.toml
 bench-fpga: setup
 	$(BIN)/python scripts/bench_fpga.py $(POINT) -o build/bench-fpga \
+	  $(if $(SIZE),--size $(SIZE)) $(ARGS)
+
+# the same with real I/O: rvsm fpga --board (LVDS links on planned pins, an LPF, no
+# unconstrained port); docs/fpga.md "Board build". Over 22 minutes at full size.
+bench-board: setup
+	$(BIN)/python scripts/bench_fpga.py $(POINT) -o build/bench-board --board \
 	  $(if $(SIZE),--size $(SIZE)) $(ARGS)
 
 # the shipped point's datasheet, remade from its saved results (docs/datasheet-ecp5-85-40khz/

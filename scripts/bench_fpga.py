@@ -15,7 +15,9 @@ small wrapper and prints:
 * LUT4 sites, flip-flops and DP16KD used against the device's, from nextpnr's own
   report (yosys' counts with ``--synth-only``);
 * Fmax against the clock the camera needs at the lanes built
-  (``sensor_clock_needed_mhz``: the point's sensor at 40 kHz steps).
+  (``sensor_clock_needed_mhz``: the point's sensor at 40 kHz steps);
+* with ``--board`` (``make bench-board``): the package, pins used against it, the I/O
+  primitives and every clock against its constraint (``rvsm fpga --board``).
 
 The figures go to ``OUT/bench.json`` as well (``--bench-json`` elsewhere), with the
 command, the machine's CPU count and load average at the start, and ``rvsm fpga``'s own
@@ -161,6 +163,7 @@ def measure(point: str, out: Path, extra: list[str]) -> dict:
         "meets_camera_clock": None if fmax is None else fmax >= need,
         "settings": result.get("settings"),
         "work_dir": r["work_dir"],
+        "board": r.get("board"),
     }
 
 
@@ -193,6 +196,11 @@ def show(b: dict) -> str:
         verdict = "meets" if b["meets_camera_clock"] else "MISSES"
         lines.append(f"Fmax    {b['fmax_mhz']:.1f} MHz {verdict} the {need:.1f} MHz the "
                      f"camera needs ({cam}); place-and-route target {b['target_mhz']:g} MHz")
+    board = b.get("board")
+    if board:  # rvsm fpga --board (make bench-board)
+        from rvsm.rtl.fpga.board_flow import board_lines
+
+        lines += ["", *board_lines(board)]
     return "\n".join(lines)
 
 

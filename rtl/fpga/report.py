@@ -19,6 +19,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from rvsm.model.infra.errors import ToolError
+from rvsm.rtl.fpga.board_flow import board_lines
 from rvsm.rtl.fpga.camera import (
     CAMERA_STEP_HZ,
     StateMemory,
@@ -143,6 +144,7 @@ def parse_nextpnr_report(data: dict) -> dict[str, Any]:
     if not fmax or not util:
         raise ToolError("nextpnr report holds no Fmax or utilisation (no clocked logic?)")
     clocks = {name: float(v["achieved"]) for name, v in fmax.items()}
+    constraints = {name: float(v.get("constraint", 0.0)) for name, v in fmax.items()}
 
     def use(kind: str) -> Usage:
         u = util.get(kind, {"used": 0, "available": 0})
@@ -151,6 +153,7 @@ def parse_nextpnr_report(data: dict) -> dict[str, Any]:
     return {
         "fmax_mhz": min(clocks.values()),
         "clocks": clocks,
+        "constraints": constraints,
         "lut4": use("TRELLIS_COMB"),
         "ff": use("TRELLIS_FF"),
         "bram": use("DP16KD"),
@@ -234,6 +237,7 @@ class FpgaReport:
     seed: int | None = None
     slope: LaneSlope | None = None
     step_hz: float = CAMERA_STEP_HZ
+    board: dict[str, Any] | None = None
 
     @property
     def lut4_per_lane(self) -> float:
@@ -304,7 +308,8 @@ class FpgaReport:
         rows = [
             f"design        {self.arch} array, {self.model}, {self.height}x{self.width}, "
             f"{self.lanes} pixel(s) per clock",
-            f"device        {dev.name} ({dev.nextpnr_flag} {dev.package}, speed "
+            f"device        {dev.name} ({dev.nextpnr_flag} "
+            f"{self.board['package'] if self.board else dev.package}, speed "
             f"{self.speed}), {self.mode}",
         ]
         if self.fmax_mhz is not None:
@@ -327,9 +332,12 @@ class FpgaReport:
             f"({self.bram.percent:.1f} %), state memories "
             + ("instantiated with the output register" if self.memory == "dp16kd"
                else "inferred by yosys"),
-            f"I/O harness   {self.harness_ff:,} FF and about {self.harness_lut4:,} LUT4 of "
-            "the above (LFSR stimulus, XOR-compacted outputs)",
         ]
+        if self.board is None:
+            rows.append(f"I/O harness   {self.harness_ff:,} FF and about {self.harness_lut4:,} "
+                        "LUT4 of the above (LFSR stimulus, XOR-compacted outputs)")
+        else:
+            rows += board_lines(self.board)
         if self.slope is not None:
             sl = self.slope
             rows.append(

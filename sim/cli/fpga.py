@@ -57,6 +57,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_interface_arguments(p, "native: the bare array; axis: the AXI4-Stream / "
                             "AXI4-Lite IP around it, as rvsm verilog --interface axis "
                             "builds it (docs/ip.md)", from_point=True)
+    p.add_argument("--board", action="store_true",
+                   help="place the array as a board design: real LVDS receive and transmit "
+                   "links (IDDRX2F/ODDRX2F, ECLKSYNCB, CLKDIVF, a PLL) instead of the "
+                   "harness, every port at a planned site (top.lpf, pin_plan.json in the "
+                   "output folder), no unconstrained port (docs/fpga.md, Board build)")
+    p.add_argument("--package", choices=("CABGA381", "CABGA554", "CABGA756"),
+                   help="with --board: the ECP5-85 package (default: the smallest whose "
+                   "pins carry the links)")
     p.add_argument("--seed", type=int, default=1,
                    help="placer seed; with --seeds the first of N (default 1)")
     p.add_argument("--seeds", type=int, metavar="N",
@@ -108,6 +116,15 @@ def _fpga(args: argparse.Namespace) -> int:
                   netlist="rtlil" if args.rtlil else "verilog", memory=args.memory,
                   slope_lanes=args.slope_lanes, on_progress=progress,
                   timeout=args.timeout, build=build)
+    if args.package and not args.board:
+        raise RvsmError("--package goes with --board")
+    if args.board:
+        if args.synth_only:
+            raise RvsmError("--board places and routes: it does not go with --synth-only")
+        if args.interface == "axis":
+            raise RvsmError("--board places the streaming array; the AXI IP has no board "
+                            "top yet (use --interface native)")
+        common.update(board=True, package=args.package)
     if args.seeds is not None:
         if args.seeds < 1:
             raise RvsmError(f"--seeds must be >= 1, got {args.seeds}")

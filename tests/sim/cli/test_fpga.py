@@ -75,3 +75,18 @@ def test_interface_axis_places_the_ip(tmp_path: Path, capsys: pytest.CaptureFixt
     assert main(["fpga", point, "--size", "2x2", "--arch", "parallel", "--interface",
                  "axis", "--synth-only", "-o", str(tmp_path / "p")]) == 2
     assert "wraps the streaming array" in capsys.readouterr().err
+
+
+def test_board_options_refused_in_bad_combinations(tmp_path: Path,
+                                                   capsys: pytest.CaptureFixture,
+                                                   fsm_point) -> None:
+    save_design_point(tmp_path / "p.toml", fsm_point)
+    base = ["fpga", str(tmp_path / "p.toml"), "--size", "2x4", "--lanes", "1", "--quiet",
+            "-o", str(tmp_path / "w")]
+    assert main([*base, "--package", "CABGA554"]) == 2
+    assert "--package goes with --board" in capsys.readouterr().err
+    assert main([*base, "--board", "--synth-only"]) == 2
+    assert "does not go with --synth-only" in capsys.readouterr().err
+    assert main([*base, "--board", "--freq", "125"]) == 2  # 500 MHz edge clock: VCO 800
+    assert "integer VCO / edge clock" in capsys.readouterr().err
+    assert not (tmp_path / "w" / "report.json").exists()
