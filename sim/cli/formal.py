@@ -11,7 +11,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.sim.cli.args import parse_size_arg
 from rvsm.sim.cli.commands import summary
-from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
+from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs, removed_if_interrupted
 from rvsm.sim.cli.rtl import add_arch_arguments, add_interface_arguments, command_architecture
 
 #: The most pixels ``rvsm formal`` takes: solvers handle tiny arrays only (a 3x3
@@ -109,10 +109,11 @@ def _formal(args: argparse.Namespace) -> int:
                         f"pixels); this one is {contract.height}x{contract.width}: pass "
                         "--size, for example --size 3x4 --lanes 2")
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
-    report = run_checks(contract, arch, options, checks=args.check, mode=args.mode,
-                        depth=args.depth, workdir=args.out, timeout=args.timeout,
-                        solver=args.solver, jobs=args.jobs,
-                        progress=lambda line: print(line, file=sys.stderr, flush=True))
+    with removed_if_interrupted(args.out):
+        report = run_checks(contract, arch, options, checks=args.check, mode=args.mode,
+                            depth=args.depth, workdir=args.out, timeout=args.timeout,
+                            solver=args.solver, jobs=args.jobs,
+                            progress=lambda line: print(line, file=sys.stderr, flush=True))
     data = report.to_json()
     data["size"] = [contract.height, contract.width]
     data["model"] = point.model
