@@ -2,7 +2,7 @@
 during the simulator build and during the simulation (the simulator and the twin's
 process both running).
 
-Each interrupt (SIGINT, SIGTERM) ends in exit 130 (143 for SIGTERM) with one ``rvsm: interrupted`` line,
+Each interrupt (SIGINT, SIGTERM) ends in exit 130 (143) with one ``rvsm: interrupted`` line,
 no traceback, no process left (the cocotb job, ``vvp``, the twin's process), no
 ``.tmp`` build folder, lock or partial file, no run folder; rerunning the same command
 gives the result of an uninterrupted run. Each phase prints its first progress line at

@@ -1,6 +1,6 @@
 """``rvsm regress`` under faults: interrupts at each phase and a Dask worker killed.
 
-An interrupt (SIGINT, SIGTERM) ends in exit 130 (143 for SIGTERM) with one line and no traceback, no tool
+An interrupt (SIGINT, SIGTERM) ends in exit 130 (143) with one line and no traceback, no tool
 or worker left, no ``.tmp`` build, no half run folder, and JUnit of the runs that
 finished. Tiny Icarus plans; the full grid of phases and signals under ``-m slow``.
 """

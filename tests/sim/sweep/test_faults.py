@@ -1,7 +1,7 @@
 """``rvsm sweep`` under interrupts: while the Dask workers start, while a worker runs a
 twin, and while the results are written.
 
-Each interrupt (SIGINT, SIGTERM) ends in exit 130 (143 for SIGTERM) with one ``rvsm: interrupted`` line on
+Each interrupt (SIGINT, SIGTERM) ends in exit 130 (143) with one ``rvsm: interrupted`` line on
 stderr, no traceback and no ``leaked semaphore`` warning, no worker or tool left, no
 partial file; the rows finished stay, and rerunning the same command fills in the rest
 with rows identical to an uninterrupted run's. Tiny sweeps; the full grid under
