@@ -134,6 +134,7 @@ def _formal(args: argparse.Namespace) -> int:
 def _formal_plan(args: argparse.Namespace) -> int:
     """``rvsm formal --plan PLAN.toml``: every run of the plan (:mod:`rvsm.sim.formal.plan`)."""
     from rvsm.rtl.architectures.registry import ARCHITECTURES, NATIVE, WRAPPERS
+    from rvsm.sim.cosim.builds.build_notes import still
     from rvsm.sim.formal.plan import load_formal_plan
     from rvsm.sim.formal.plan_run import run_formal_plan
 
@@ -153,9 +154,20 @@ def _formal_plan(args: argparse.Namespace) -> int:
     check_outputs([Output(args.out, "-o", FOLDER)], [args.plan])
     print(f"formal plan {plan.name}: {len(plan.runs)} run(s), --arch {plan.arch.name}, "
           f"{args.jobs} at a time -> {args.out}", file=sys.stderr, flush=True)
-    summary = run_formal_plan(plan, args.out, jobs=args.jobs, mode=args.mode,
-                              depth=args.depth, timeout=args.timeout, solver=args.solver,
-                              progress=None if args.json else print)
+    done: list[str] = []
+
+    def finished(line: str) -> None:
+        done.append(line)
+        if not args.json:
+            print(line, flush=True)
+
+    # a run takes minutes: say how far the plan is every 8 s, on stderr (--json too)
+    with still(
+            lambda: f"formal plan {plan.name}: {len(done)}/{len(plan.runs)} run(s) done",
+            echo=lambda line: print(line, file=sys.stderr, flush=True)):
+        summary = run_formal_plan(plan, args.out, jobs=args.jobs, mode=args.mode,
+                                  depth=args.depth, timeout=args.timeout,
+                                  solver=args.solver, progress=finished)
     if args.json:
         print(json.dumps(summary.to_json(), indent=2))
     else:
