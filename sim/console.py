@@ -3,8 +3,8 @@
 Importing a command family (numpy, matplotlib, amaranth, ...) takes a second or more
 (``rvsm --help`` and ``--version`` import none: :mod:`rvsm.sim.cli.commands`);
 SIGTERM and SIGHUP are turned into interrupts before that, so a signal during start-up
-also ends with status 130 and one line instead of a traceback or a bare kill. The
-commands themselves are :func:`rvsm.sim.cli.main.main`.
+also ends with one line and status ``128 + signal`` (143 for SIGTERM) instead of a
+traceback or a bare kill. The commands themselves are :func:`rvsm.sim.cli.main.main`.
 """
 
 from __future__ import annotations
@@ -42,7 +42,8 @@ def main(argv: list[str] | None = None) -> int:
                 raise
             why = f" by {exc.args[0]}" if exc.args else ""
             print(f"rvsm: interrupted{why} while starting", file=sys.stderr)
-            return 130
+            return 128 + (signal.Signals[exc.args[0]] if exc.args and exc.args[0] in
+                          signal.Signals.__members__ else signal.SIGINT)
         return run(args)
     finally:
         for sig, handler in previous.items():

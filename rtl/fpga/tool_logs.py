@@ -13,7 +13,7 @@ import re
 from collections.abc import Callable
 from pathlib import Path
 
-from rvsm.rtl.toolchain import Progress, ProgressFollower
+from rvsm.rtl.toolchain import HEARTBEAT_SECONDS, Progress, ProgressFollower
 
 __all__ = ["DETAILS", "PHASES", "follower"]
 
@@ -55,7 +55,7 @@ def follower(
     on_progress: Callable[[Progress], None] | None,
     expected: float | None = None,
     log_file: str | None = None,
-    heartbeat: float = 30.0,
+    heartbeat: float = HEARTBEAT_SECONDS,
 ) -> ProgressFollower:
     """Follow the FPGA tool ``tool`` (its path; phases by its file name) as ``step``,
     expected to take ``expected`` s, reading ``log_file`` (the log it writes itself,

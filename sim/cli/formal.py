@@ -11,7 +11,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.kernels.receptive_fields import MODEL_NAMES
 from rvsm.sim.cli.args import parse_size_arg
 from rvsm.sim.cli.commands import summary
-from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
+from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs, removed_if_interrupted
 from rvsm.sim.cli.rtl import add_arch_arguments, add_interface_arguments, command_architecture
 
 #: The most pixels ``rvsm formal`` takes: solvers handle tiny arrays only (a 3x3
@@ -109,10 +109,11 @@ def _formal(args: argparse.Namespace) -> int:
                         f"pixels); this one is {contract.height}x{contract.width}: pass "
                         "--size, for example --size 3x4 --lanes 2")
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
-    report = run_checks(contract, arch, options, checks=args.check, mode=args.mode,
-                        depth=args.depth, workdir=args.out, timeout=args.timeout,
-                        solver=args.solver, jobs=args.jobs,
-                        progress=lambda line: print(line, file=sys.stderr, flush=True))
+    with removed_if_interrupted(args.out):
+        report = run_checks(contract, arch, options, checks=args.check, mode=args.mode,
+                            depth=args.depth, workdir=args.out, timeout=args.timeout,
+                            solver=args.solver, jobs=args.jobs,
+                            progress=lambda line: print(line, file=sys.stderr, flush=True))
     data = report.to_json()
     data["size"] = [contract.height, contract.width]
     data["model"] = point.model
@@ -133,6 +134,7 @@ def _formal(args: argparse.Namespace) -> int:
 def _formal_plan(args: argparse.Namespace) -> int:
     """``rvsm formal --plan PLAN.toml``: every run of the plan (:mod:`rvsm.sim.formal.plan`)."""
     from rvsm.rtl.architectures.registry import ARCHITECTURES, NATIVE, WRAPPERS
+    from rvsm.sim.cosim.builds.build_notes import still
     from rvsm.sim.formal.plan import load_formal_plan
     from rvsm.sim.formal.plan_run import run_formal_plan
 
@@ -152,9 +154,20 @@ def _formal_plan(args: argparse.Namespace) -> int:
     check_outputs([Output(args.out, "-o", FOLDER)], [args.plan])
     print(f"formal plan {plan.name}: {len(plan.runs)} run(s), --arch {plan.arch.name}, "
           f"{args.jobs} at a time -> {args.out}", file=sys.stderr, flush=True)
-    summary = run_formal_plan(plan, args.out, jobs=args.jobs, mode=args.mode,
-                              depth=args.depth, timeout=args.timeout, solver=args.solver,
-                              progress=None if args.json else print)
+    done: list[str] = []
+
+    def finished(line: str) -> None:
+        done.append(line)
+        if not args.json:
+            print(line, flush=True)
+
+    # a run takes minutes: say how far the plan is every 8 s, on stderr (--json too)
+    with still(
+            lambda: f"formal plan {plan.name}: {len(done)}/{len(plan.runs)} run(s) done",
+            echo=lambda line: print(line, file=sys.stderr, flush=True)):
+        summary = run_formal_plan(plan, args.out, jobs=args.jobs, mode=args.mode,
+                                  depth=args.depth, timeout=args.timeout,
+                                  solver=args.solver, progress=finished)
     if args.json:
         print(json.dumps(summary.to_json(), indent=2))
     else:

@@ -8,7 +8,7 @@ import sys
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.sim.cli.commands import summary
-from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
+from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs, removed_if_interrupted
 
 #: Today's defaults of the settings a point's [rtl] table can set (docs/fpga.md).
 DEVICE, FREQ_MHZ, MEMORY = "ecp5-85", 125.0, "dp16kd"
@@ -125,20 +125,21 @@ def _fpga(args: argparse.Namespace) -> int:
             raise RvsmError("--board places the streaming array; the AXI IP has no board "
                             "top yet (use --interface native)")
         common.update(board=True, package=args.package)
-    if args.seeds is not None:
-        if args.seeds < 1:
-            raise RvsmError(f"--seeds must be >= 1, got {args.seeds}")
-        if args.jobs is not None and args.jobs < 1:
-            raise RvsmError(f"--jobs must be >= 1, got {args.jobs}")
-        if args.synth_only:
-            raise RvsmError("--seeds places and routes: it does not go with --synth-only")
-        report = run_fpga_seeds(point, args.out, range(args.seed, args.seed + args.seeds),
-                                jobs=args.jobs, **common)
-    else:
-        if args.jobs is not None:
-            raise RvsmError("--jobs applies to --seeds only")
-        report = run_fpga(point, args.out, synth_only=args.synth_only, seed=args.seed,
-                          **common)
+    with removed_if_interrupted(args.out):  # no half-made work folder
+        if args.seeds is not None:
+            if args.seeds < 1:
+                raise RvsmError(f"--seeds must be >= 1, got {args.seeds}")
+            if args.jobs is not None and args.jobs < 1:
+                raise RvsmError(f"--jobs must be >= 1, got {args.jobs}")
+            if args.synth_only:
+                raise RvsmError("--seeds places and routes: it does not go with --synth-only")
+            report = run_fpga_seeds(point, args.out, range(args.seed, args.seed + args.seeds),
+                                    jobs=args.jobs, **common)
+        else:
+            if args.jobs is not None:
+                raise RvsmError("--jobs applies to --seeds only")
+            report = run_fpga(point, args.out, synth_only=args.synth_only, seed=args.seed,
+                              **common)
     if args.json:
         print(json.dumps({**json.loads(report.to_json()),
                           "settings": choice.record(options)}))

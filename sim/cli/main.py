@@ -21,6 +21,7 @@ from types import ModuleType
 
 from rvsm.model.infra.compile_notice import install_compile_notice
 from rvsm.model.infra.errors import RvsmError, ToolError, interrupt_behind
+from rvsm.rtl.tool_groups import INTERRUPT_SIGNALS, exit_status, interrupt_handlers, kill_all
 from rvsm.sim.cli.commands import COMMANDS, FAMILY_NAMES
 
 #: Command families (modules ``rvsm.sim.cli.<name>``), in ``rvsm --help`` order: float twin,
@@ -73,31 +74,15 @@ def _families_for(argv: Sequence[str]) -> tuple[str, ...]:
     return tuple(c.family for c in COMMANDS if c.name == word)
 
 
-def _interrupt_on_signal(signum: int, frame: object) -> None:
-    """SIGTERM/SIGHUP handler: unwind like Ctrl-C (partial files removed, tools killed);
-    later signals are ignored while that cleanup runs. A signal the caller ignores
-    (``nohup``, a background job's SIGINT) stays ignored."""
-    for sig in _INTERRUPTS:
-        signal.signal(sig, signal.SIG_IGN)
-    raise KeyboardInterrupt(signal.Signals(signum).name)
-
-
-#: Signals handled like SIGINT: the same cleanup, exit status 130.
-_INTERRUPTS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-
-
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``rvsm`` console script; returns the process exit status.
 
     Exit statuses (docs/cli.md): 0 success, 1 the RTL disagrees with the twin, 2 bad
-    input or usage, 3 a tool or the environment failed, 130 interrupted (SIGINT,
-    SIGTERM or SIGHUP). Errors are one line; ``--debug`` adds the traceback.
+    input or usage, 3 a tool or the environment failed, 128 + signal interrupted (130
+    SIGINT, 143 SIGTERM, 129 SIGHUP: every tool stopped, :mod:`rvsm.rtl.tool_groups`).
+    Errors are one line; ``--debug`` adds the traceback.
     """
-    previous = {sig: signal.getsignal(sig) for sig in _INTERRUPTS}
-    for sig in _INTERRUPTS[1:]:
-        if previous[sig] is not signal.SIG_IGN:  # `nohup rvsm ...` keeps ignoring SIGHUP
-            signal.signal(sig, _interrupt_on_signal)
-    try:
+    with interrupt_handlers():
         try:
             words = sys.argv[1:] if argv is None else list(argv)
             parser = build_parser(_families_for(words))
@@ -112,22 +97,17 @@ def main(argv: list[str] | None = None) -> int:
             parser.print_help()
             return 2
         return _run(args)
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
 
 
 def _interrupted(exc: KeyboardInterrupt) -> int:
-    """Stop every tool still running, say so on one line; exit status 130."""
-    for sig in _INTERRUPTS:
+    """Stop every tool still running, say so on one line; exit status ``128 + signal``."""
+    for sig in INTERRUPT_SIGNALS:
         signal.signal(sig, signal.SIG_IGN)
-    from rvsm.rtl.toolchain import kill_all
-
     kill_all()
     why = f" by {exc.args[0]}" if exc.args else ""
     print(f"rvsm: interrupted{why}; finished results are kept, partial files removed",
           file=sys.stderr)
-    return 130
+    return exit_status(exc)
 
 
 def _run(args: argparse.Namespace) -> int:

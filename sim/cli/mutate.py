@@ -11,7 +11,7 @@ from rvsm.rtl.architectures.registry import ARCHITECTURES
 from rvsm.rtl.capabilities import Architecture
 from rvsm.sim.cli.args import parse_size_arg
 from rvsm.sim.cli.commands import summary
-from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs
+from rvsm.sim.cli.outputs import FOLDER, Output, check_outputs, removed_if_interrupted
 
 #: ``--arch`` choices: each architecture with mutation sites, or all of them.
 ALL = "all"
@@ -107,8 +107,10 @@ def _run(point, archs: tuple[Architecture, ...], lanes: int,  # noqa: ANN001 - R
     from rvsm.sim.mutate.run import run_mutants
 
     t0 = time.perf_counter()
-    results = run_mutants(point, archs, lanes, checks, first_kill, out, timeout, names,
-                          progress=lambda line: print(line, file=sys.stderr, flush=True))
+    with removed_if_interrupted(out):
+        results = run_mutants(point, archs, lanes, checks, first_kill, out, timeout, names,
+                              progress=lambda line: print(line, file=sys.stderr,
+                                                          flush=True))
     wall = time.perf_counter() - t0
     survivors = [r.mutation.name for r in results if not r.killed]
     h, w = point.shape

@@ -22,17 +22,20 @@ probe, which is a :class:`~rvsm.model.infra.errors.ToolError` (exit status 3), a
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
+import shutil
 import tempfile
 import zipfile
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from rvsm.model.infra.errors import RvsmError, os_error
 
-__all__ = ["FOLDER", "Output", "check_outputs", "existing_kind", "kind_for_suffix", "os_error"]
+__all__ = ["FOLDER", "Output", "check_outputs", "existing_kind", "kind_for_suffix", "os_error",
+           "removed_if_interrupted"]
 
 #: The kind of a folder output.
 FOLDER = "folder"
@@ -280,3 +283,24 @@ def default_results(plan: str | os.PathLike) -> Path:
     ``build/<plan name>.sqlite`` in the current folder, never beside the plan (which may
     sit in the source tree); its coverage folder goes beside the database."""
     return Path("build") / f"{Path(plan).stem}.sqlite"
+
+
+@contextlib.contextmanager
+def removed_if_interrupted(folder: str | os.PathLike) -> Iterator[None]:
+    """A command's output folder that is complete or absent: when the block is
+    interrupted, ``folder`` is removed if the command made it, else the empty folders
+    left in it (what an interrupted step made and emptied again) are. The steps inside
+    remove their own half-made work (e.g. :func:`rvsm.sim.formal.sby.run_sby`)."""
+    root = Path(folder)
+    existed = root.exists()
+    try:
+        yield
+    except KeyboardInterrupt:
+        if not existed:
+            shutil.rmtree(root, ignore_errors=True)
+        elif root.is_dir():
+            for sub in sorted((p for p in root.rglob("*") if p.is_dir()),
+                              key=lambda p: len(p.parts), reverse=True):
+                with contextlib.suppress(OSError):
+                    sub.rmdir()  # only an empty folder goes
+        raise

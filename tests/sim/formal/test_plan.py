@@ -5,6 +5,7 @@ the matrix JSON, the worst status: 0, 1 with a counterexample)."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -89,10 +90,15 @@ def test_a_counterexample_makes_the_plan_exit_1(tiny_plan: Path, tmp_path: Path,
         return ParallelProperties(contract, mutation="parallel.threshold_off_by_one")
 
     monkeypatch.setitem(PARALLEL.formal, "properties", buggy)
+    # with --json too, stderr says how far the plan is every heartbeat (8 s; 0.2 s here)
+    monkeypatch.setattr("rvsm.sim.cosim.builds.build_notes.HEARTBEAT_SECONDS", 0.2)
     assert main(["formal", "--plan", str(tiny_plan), "--mode", "bmc", "--depth", "3",
                  "-o", str(tmp_path / "out"), "--json"]) == 1
-    runs = json.loads(capsys.readouterr().out)["runs"]
+    captured = capsys.readouterr()
+    runs = json.loads(captured.out)["runs"]
     assert [r["status"] for r in runs] == [1, 1]
+    assert re.search(r"rvsm: still formal plan tiny: [012]/2 run\(s\) done \(\d+:\d\d "
+                     r"elapsed\)", captured.err), captured.err
 
 
 def test_plan_refuses_a_point_and_its_options(tiny_plan: Path, tmp_path: Path,

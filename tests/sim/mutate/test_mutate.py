@@ -123,3 +123,28 @@ def test_a_shared_point_skips_the_threshold_memory_mutations() -> None:
     assert [r.mutation.name for r in results] == ["stream.threshold_off_by_one"]
     assert results[0].killed
     assert any("no_threshold_forwarding: skipped" in line for line in said)
+
+
+def test_mutate_says_its_mutant_and_check_every_heartbeat(tmp_path, capsys,
+                                                          monkeypatch) -> None:
+    """While it works, ``mutate`` (with ``--json`` too) says on stderr which mutant and
+    which check it is on, every heartbeat (8 s; 0.2 s here), and that it checks the
+    shipped RTL first."""
+    import re
+
+    import rvsm.sim.mutate.run as run_module
+
+    monkeypatch.setattr(run_module, "HEARTBEAT_SECONDS", 0.2)
+    monkeypatch.setattr(run_module, "COSIM_CHECKS", (CHECK["random"],))  # fast
+    assert main(["mutate", str(_point(tmp_path)), "--arch", "stream", "--checks", "cosim",
+                 "--size", "4x6", "--mutation", "stream.swapped_lanes", "--json", "-o",
+                 str(tmp_path / "m")]) == 0
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)["killed"] == 1
+    err = captured.err.splitlines()
+    assert err[0] == "mutate: stream: checking the shipped RTL first (cosim)"
+    beat = r"\(\d+:\d\d elapsed\)"
+    assert any(re.fullmatch(rf"mutate: the shipped stream RTL, check cosim:\w+ "
+                            rf"\((subtract|zero) reset\) {beat}", line) for line in err), err
+    assert any(re.fullmatch(rf"mutate: 1/1 stream.swapped_lanes, check cosim:\w+ "
+                            rf"\((subtract|zero) reset\) {beat}", line) for line in err), err
