@@ -38,8 +38,10 @@ from rvsm.rtl.board.transmitter import LinkTransmitter
 from rvsm.rtl.ip.axis import spike_tdata_layout, video_lane_bits
 from rvsm.rtl.ip.register_map import ADDR_BITS, RegisterMap
 from rvsm.rtl.ip.wrapper import RvsmAxisIp
+from rvsm.rtl.ports import verilog_ports
+from rvsm.rtl.verilog_memories import convert_verilog
 
-__all__ = ["IpBoardFrontEnd"]
+__all__ = ["IpBoardFrontEnd", "ip_front_end_verilog"]
 
 
 class IpBoardFrontEnd(wiring.Component):
@@ -119,3 +121,11 @@ class IpBoardFrontEnd(wiring.Component):
                     m.d.sync += regs.value[f"{reg.name}.{f.name}"].eq(
                         values[reg.name][f.lsb:f.lsb + f.width])
         return m
+
+
+def ip_front_end_verilog(front_end: IpBoardFrontEnd, top: str = "rvsm_board_ip") -> str:
+    """Verilog of ``front_end`` with module name ``top``: ports ``rx_clock``,
+    ``rx_pins``, ``tx_clock``, ``tx_pins``, ``tx_clock_out``, ``train_request``,
+    ``spi_sclk``, ``spi_cs_n``, ``spi_mosi``, ``spi_miso``, ``tx_overflow``, ``clk``,
+    ``rst`` (:func:`rvsm.rtl.ports.verilog_ports`)."""
+    return convert_verilog(front_end, top, verilog_ports(front_end))

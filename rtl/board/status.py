@@ -20,7 +20,7 @@ from amaranth.lib.wiring import Out
 from rvsm.rtl.ip.register_map import EXTRA_WINDOW, Field, Register
 
 __all__ = ["COUNTER_BITS", "LINK_BASE", "LinkControlSignature", "LinkStatusSignature",
-           "link_registers", "register_values"]
+           "link_registers", "link_registers_markdown", "register_values"]
 
 #: Bits of each per-pair error counter (saturating) and of the lock-loss counter.
 COUNTER_BITS = 8
@@ -106,3 +106,16 @@ def register_values(status: wiring.PureInterface, train: Value, train_request: V
         values[f"LINK_ERRORS{k}"] = Cat(status.lane_errors[j]
                                         for j in range(4 * k, min(4 * k + 4, pairs)))
     return values
+
+
+def link_registers_markdown(registers: tuple[Register, ...]) -> str:
+    """The link registers as a Markdown table (``docs/board.md``): offset, name, access,
+    reset value and each field's bits and access."""
+    lines = ["| offset | register | access | reset | fields |", "|---|---|---|---|---|"]
+    for r in registers:
+        fields = ", ".join(f"`{f.name}` [{f.lsb + f.width - 1}:{f.lsb}] {f.access}"
+                           if f.width > 1 else f"`{f.name}` [{f.lsb}] {f.access}"
+                           for f in r.fields)
+        lines.append(f"| 0x{r.offset:03X} | `{r.name}` | {r.access} | 0x{r.reset:08X} | "
+                     f"{fields}: {r.desc} |")
+    return "\n".join(lines) + "\n"

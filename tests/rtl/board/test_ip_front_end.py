@@ -14,7 +14,7 @@ from amaranth.sim import Simulator
 
 from rvsm.model.fixed.point_toml import load_design_point
 from rvsm.rtl.board.drive import capture_link, drive_link
-from rvsm.rtl.board.ip_front_end import IpBoardFrontEnd
+from rvsm.rtl.board.ip_front_end import IpBoardFrontEnd, ip_front_end_verilog
 from rvsm.rtl.board.model import (
     LinkFormat,
     beat_words,
@@ -213,3 +213,15 @@ def test_a_training_request_over_spi_retrains_and_counters_reset_clears() -> Non
     assert seen["control"] == 1
     assert seen["relocked"] & 0b111 == 0b011
     assert (seen["losses"], seen["cleared"]) == (1, 0)
+
+
+def test_the_front_end_is_verilog_with_board_ports_and_the_link_registers_in_the_map() -> None:
+    dut, _, _, _ = _setup([0, 0])
+    verilog = ip_front_end_verilog(dut)
+    header = verilog[verilog.index("module rvsm_board_ip("):].split(");")[0]
+    ports = {p.strip() for p in header.split("(", 1)[1].split(",")}
+    assert ports == {"rx_clock", "rx_pins", "tx_clock", "tx_pins", "tx_clock_out",
+                     "train_request", "spi_sclk", "spi_cs_n", "spi_mosi", "spi_miso",
+                     "tx_overflow", "clk", "rst"}
+    assert [r.offset for r in dut.link_registers] == [0x80, 0x84, 0x88, 0x8C]
+    assert dut.regmap["LINK_ERRORS0"].offset == LINK_ERRORS0
