@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from amaranth.hdl import Module
+from amaranth.lib import wiring
 from amaranth.sim import Simulator
 
 from rvsm.rtl.board.spi_bridge import MIN_PHASE_CYCLES, SpiBridge
@@ -63,7 +64,6 @@ def _run(frames: list[tuple[bytes, int | None]], half: float) -> list[bytes]:
     m.submodules.bridge = bridge = SpiBridge(REGMAP.addr_bits)
     m.submodules.regs = regs = AxiLiteRegisters(REGMAP)
     m.d.comb += regs.value["LIVE.v"].eq(LIVE)
-    from amaranth.lib import wiring
     wiring.connect(m, bridge.bus, regs.bus)
     got: list[bytes] = []
     sim = Simulator(m)
