@@ -6,7 +6,8 @@ lock losses, FIFO overflow); :class:`LinkControlSignature` what it takes (``trai
 training request held while high, ``counters_reset``: a one-cycle pulse zeroing the
 counters). :func:`link_registers` declares them as registers in the style of
 :mod:`rvsm.rtl.ip.register_map` (:class:`~rvsm.rtl.ip.register_map.Register` of
-:class:`~rvsm.rtl.ip.register_map.Field`), ready to be appended to the IP's map;
+:class:`~rvsm.rtl.ip.register_map.Field`), the IP's ``extra_registers``
+(:class:`~rvsm.rtl.board.ip_front_end.IpBoardFrontEnd`);
 :func:`register_values` gives each register's live value from the status signals.
 """
 
@@ -16,15 +17,16 @@ from amaranth.hdl import Cat, Const, Value
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import Out
 
-from rvsm.rtl.ip.register_map import Field, Register
+from rvsm.rtl.ip.register_map import EXTRA_WINDOW, Field, Register
 
 __all__ = ["COUNTER_BITS", "LINK_BASE", "LinkControlSignature", "LinkStatusSignature",
-           "link_registers", "register_values"]
+           "link_registers", "link_registers_markdown", "register_values"]
 
 #: Bits of each per-pair error counter (saturating) and of the lock-loss counter.
 COUNTER_BITS = 8
-#: Suggested byte offset of the link block in the IP's register window (free today).
-LINK_BASE = 0x60
+#: Byte offset of the link block: the start of the IP's window for a wrapper's registers
+#: (:data:`~rvsm.rtl.ip.register_map.EXTRA_WINDOW`, 0x080-0x0FC).
+LINK_BASE = EXTRA_WINDOW.start
 
 
 class LinkStatusSignature(wiring.Signature):
@@ -104,3 +106,16 @@ def register_values(status: wiring.PureInterface, train: Value, train_request: V
         values[f"LINK_ERRORS{k}"] = Cat(status.lane_errors[j]
                                         for j in range(4 * k, min(4 * k + 4, pairs)))
     return values
+
+
+def link_registers_markdown(registers: tuple[Register, ...]) -> str:
+    """The link registers as a Markdown table (``docs/board.md``): offset, name, access,
+    reset value and each field's bits and access."""
+    lines = ["| offset | register | access | reset | fields |", "|---|---|---|---|---|"]
+    for r in registers:
+        fields = ", ".join(f"`{f.name}` [{f.lsb + f.width - 1}:{f.lsb}] {f.access}"
+                           if f.width > 1 else f"`{f.name}` [{f.lsb}] {f.access}"
+                           for f in r.fields)
+        lines.append(f"| 0x{r.offset:03X} | `{r.name}` | {r.access} | 0x{r.reset:08X} | "
+                     f"{fields}: {r.desc} |")
+    return "\n".join(lines) + "\n"

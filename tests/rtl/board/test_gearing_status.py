@@ -84,7 +84,26 @@ def test_link_registers_fit_the_ip_map_style() -> None:
     assert names[:3] == ["LINK_STATUS", "LINK_CONTROL", "LINK_LOSSES"]
     assert names[3:] == [f"LINK_ERRORS{k}" for k in range(9)]
     assert regs[0].offset == LINK_BASE and regs[-1].offset == LINK_BASE + 12 + 4 * 8
-    RegisterMap(regs, 12, 1, 8, 1)  # offsets distinct and aligned, fields fit 32 bits
+    RegisterMap(regs, 12, 1, 8, 1, 1)  # offsets distinct and aligned, fields fit 32 bits
     last = regs[-1].fields
     assert [f.name for f in last] == ["pair32", "pair33", "pair34", "pair35"]
     assert "framing" in last[-1].desc
+
+
+def test_docs_board_link_register_table_is_the_rendering_of_the_shipped_point() -> None:
+    """docs/board.md's link register table is ``link_registers_markdown`` of the shipped
+    point's receive link (40 lanes of 7-bit codes: 36 pairs), at the IP's extra window."""
+    from pathlib import Path
+
+    from rvsm.model.fixed.point_toml import load_design_point
+    from rvsm.rtl.board.front_end import link_formats
+    from rvsm.rtl.board.status import link_registers_markdown
+    from rvsm.rtl.ip.register_map import EXTRA_WINDOW
+
+    rx, _ = link_formats(load_design_point("points/ecp5-85-40khz.toml").contract(), 40)
+    regs = link_registers(rx.pairs)
+    assert all(r.offset in EXTRA_WINDOW for r in regs)
+    doc = Path(__file__).resolve().parents[3] / "docs" / "board.md"
+    table = doc.read_text().split("<!-- link-registers:begin -->\n")[1] \
+        .split("<!-- link-registers:end -->")[0]
+    assert table == link_registers_markdown(regs)
