@@ -165,6 +165,13 @@ def _report(args: argparse.Namespace) -> int:
             print(f"  x {d['label']}: {_short(verdicts[d['label']])}")
     if rec and rec.get("fits"):
         print(f"every verdict's detail: {out / 'report.md'} (or --json)")
+    if constraint is not None:
+        from rvsm.sim.sweep.verdict import prime_width_note
+
+        cam = constraint.camera
+        note = prime_width_note(cam.height, cam.width, cam.rate_hz)
+        if note:
+            print(f"note: {note[2:]}")
     return 0
 
 
