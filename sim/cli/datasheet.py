@@ -236,7 +236,7 @@ def _refuse_infeasible(point, device, lanes, args) -> None:  # noqa: ANN001
     f = assess(layout, device, Camera(h, w, args.rate_hz, clock), None,
                organisation=args.organisation)
     if f.broken:
-        raise RvsmError(nothing_fits({device.name: [f]}, f"{point.model}", "the page"))
+        raise RvsmError(nothing_fits({device.name: [f]}, f"{point.model} cannot meet", "the page"))
 
 
 def _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,  # noqa: ANN001

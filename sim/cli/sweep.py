@@ -190,7 +190,10 @@ def _short(verdict: dict) -> str:
 def _figures(name: str, c: dict) -> str:
     if c["figure"] is None or not c["budget"]:
         return f"{name} ?"
-    return (f"{name} {c['figure']:,.1f} / {c['budget']:,.1f} {c['unit']} "
+    def num(v: float) -> str:
+        return f"{v:,.0f}" if abs(v) >= 100 or float(v).is_integer() else f"{v:,.1f}"
+
+    return (f"{name} {num(c['figure'])} / {num(c['budget'])} {c['unit']} "
             f"({100 * (c['figure'] / c['budget'] - 1):+.0f} %)")
 
 

@@ -44,9 +44,9 @@ def prime_width_note(height: int, width: int, rate_hz: float) -> str:
             "lanes divide it: choose a width with more divisors")
 
 
-def nothing_fits(verdicts: dict[str, list[Feasibility]], subject: str = "no design",
+def nothing_fits(verdicts: dict[str, list[Feasibility]], subject: str = "no design meets",
                  product: str = "the report") -> str:
-    """The one line: ``subject`` cannot meet the camera; per device, the nearest
+    """The one line: ``subject`` (e.g. ``"dog2 cannot meet"``) the camera; per device, the nearest
     design's broken budgets and by how much; ``--allow-infeasible`` writes ``product``."""
     parts = []
     for device, fs in verdicts.items():
@@ -59,5 +59,5 @@ def nothing_fits(verdicts: dict[str, list[Feasibility]], subject: str = "no desi
     what = "" if cam is None else f" {cam.camera.text()}"
     note = "" if cam is None else prime_width_note(cam.camera.height, cam.camera.width,
                                                    cam.camera.rate_hz)
-    return (f"{subject} cannot meet{what}: on " + " | ".join(parts) + note
+    return (f"{subject}{what}: on " + " | ".join(parts) + note
             + f" (--allow-infeasible writes {product} anyway)")
