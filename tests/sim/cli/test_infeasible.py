@@ -61,3 +61,17 @@ def test_datasheet_rate_the_clock_cannot_meet(tmp_path, capsys):
     line = _one_line_error(capsys)
     assert "fmax 1,000 / 116 MHz (+764 %)" in line and "--allow-infeasible" in line
     assert not out.exists()
+
+
+def test_verilog_warns_when_the_sdc_clock_passes_the_fmax_model(tmp_path, capsys):
+    from rvsm.sim.cli.rtl import _warn_above_fmax
+
+    point = _point(tmp_path)
+    _warn_above_fmax(point, 900.0, 40, True)
+    line = _one_line_error(capsys)
+    assert line.startswith("rvsm verilog: warning: rtl.freq_mhz = 900 is above the ecp5-85")
+    assert "the SDC asks for 900 MHz anyway" in line
+    _warn_above_fmax(point, 300.0, 40, False)
+    assert "--clock-mhz = 300" in _one_line_error(capsys)
+    _warn_above_fmax(point, 100.0, 40, True)
+    assert capsys.readouterr().err == ""
