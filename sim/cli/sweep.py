@@ -159,8 +159,7 @@ def _report(args: argparse.Namespace) -> int:
         print(f"fits {device}: {len(fit)} of {len(fit) + len(bad)} design(s)")
         verdicts = {v["label"]: v for v in rec["verdicts"][device]}
         for i, d in enumerate(fit, 1):
-            print(f"  {i}. {d['label']}: {d['worst_cost']:.3f} dB, "
-                  f"{_short(verdicts[d['label']])}")
+            print(f"  {i}. {d['label']}: {d['worst_cost']:.3f} dB, {d['summary']}")
         for d in bad:
             print(f"  x {d['label']}: {_short(verdicts[d['label']])}")
     if rec and rec.get("fits"):
@@ -176,13 +175,12 @@ def _report(args: argparse.Namespace) -> int:
 
 
 def _short(verdict: dict) -> str:
-    """A verdict of ``--json`` in one short line: lanes, clock, the failing budgets."""
+    """An infeasible verdict of ``--json`` in one short line: lanes, clock, the budgets
+    that break (or are unknown) with their figures."""
     checks = verdict["checks"]
     bad = [k for k, c in checks.items() if c["ok"] is False] or \
         [k for k, c in checks.items() if c["ok"] is None]
     head = f"P = {verdict['lanes']} at {verdict['clock_needed_mhz']:,.1f} MHz"
-    if verdict["feasible"]:
-        return f"{head}: fits"
     word = "breaks" if any(checks[k]["ok"] is False for k in bad) else "unverified"
     return f"{head}: {word} " + "; ".join(_figures(k, checks[k]) for k in bad)
 
