@@ -45,7 +45,7 @@ from rvsm.model.fixed.point_fields import (
 )
 from rvsm.model.fixed.sensor_rules import SensorRules, sensor_rules
 from rvsm.model.fixed.weights import quantise_model
-from rvsm.model.fixed.widths import signed_bits, signed_range
+from rvsm.model.fixed.widths import signed_bits, signed_range, unsigned_max
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.noise.sensor import NoiseSource
 
@@ -163,6 +163,8 @@ class DesignPoint(PointFields):
 
     def contract(self) -> ArrayContract:
         """The integer parameters the RTL is built from."""
+        if self.shared_thresholds:
+            self._check_shared_thresholds()
         return ArrayContract(
             height=self.height,
             width=self.width,
@@ -178,6 +180,28 @@ class DesignPoint(PointFields):
             shared_thresholds=(tuple(int(t) for t in self.nominal_thresholds())
                                if self.shared_thresholds else None),
         )
+
+    def _check_shared_thresholds(self) -> None:
+        """Refuse shared thresholds the accumulator cannot hold, naming the point's fields
+        and the smallest ``accumulator_bits`` (or ``shift``) that holds them."""
+        lsbs = [int(t) for t in self.nominal_thresholds()]
+        top = unsigned_max(self.accumulator_bits - 1)
+        if all(1 <= t <= top for t in lsbs):
+            return
+        field = self.rules.threshold_field(self)
+        if min(lsbs) < 1:
+            raise RvsmError(
+                f"{field} maps to thresholds of {tuple(lsbs)} LSBs at datapath.shift = "
+                f"{self.shift}: each must be at least 1; lower datapath.shift or raise "
+                f"{field}")
+        shift = next((self.shift + d for d in range(1, 33) if int(self.to_threshold_lsbs(
+            self.nominal_values / 2.0 ** d).max()) <= top), None)
+        raise RvsmError(
+            f"datapath.accumulator_bits = {self.accumulator_bits} holds shared thresholds "
+            f"up to {top} LSBs, but {field} maps to {max(lsbs)} LSBs at datapath.shift = "
+            f"{self.shift}: set datapath.accumulator_bits = {max(lsbs).bit_length() + 1} "
+            "(the smallest that holds it)"
+            + ("" if shift is None else f" or datapath.shift = {shift} (coarser sums)"))
 
     def to_threshold_lsbs(self, values: np.ndarray) -> np.ndarray:
         """Map thresholds in brightness units to integer accumulator LSBs (unclamped)."""

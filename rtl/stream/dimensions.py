@@ -65,8 +65,12 @@ class StreamGeometry:
         self.bank_words = int(bank_words)
         if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) \
                 or lanes < 1 or c.width % lanes:
+            asked = int(lanes) if isinstance(lanes, (int, np.integer)) else 1
+            near = sorted(sorted((p for p in range(1, c.width + 1) if c.width % p == 0),
+                                 key=lambda p: abs(p - asked))[:6])
             raise RvsmError(f"lanes must be a positive divisor of the width {c.width}, "
-                            f"got {lanes}")
+                            f"got {lanes}; the divisors near it: "
+                            f"{', '.join(map(str, near))}")
         self.contract = c
         self.lanes = int(lanes)
         self.groups = c.width // self.lanes

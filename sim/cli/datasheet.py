@@ -95,6 +95,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "else the fewest that fit)")
     p.add_argument("--rate-hz", type=float, default=40000.0,
                    help="camera steps per second (default %(default)g)")
+    p.add_argument("--allow-infeasible", action="store_true",
+                   help="write the page even when the device cannot meet the camera's "
+                   "rate (without it: exit 2 naming the budget that breaks)")
     p.add_argument("--organisation", default="rtl", choices=("rtl", "per-scale", "packed"),
                    help="state memory organisation (default %(default)s: what the RTL builds)")
     p.add_argument("--fpga", metavar="FILE.json", help="saved rvsm fpga POINT --json")
@@ -193,7 +196,12 @@ def _datasheet(args: argparse.Namespace) -> int:
     pf = di.load_point_file(args.point)
     lanes = args.lanes or pf.lanes
     if lanes is not None and pf.point.width % lanes:
-        raise RvsmError(f"lanes {lanes} must divide the array width {pf.point.width}")
+        from rvsm.rtl.fpga.build_budget import lanes_error
+
+        raise RvsmError(lanes_error(pf.point.width, lanes,
+                                    "--lanes" if args.lanes else "rtl.lanes"))
+    if not args.allow_infeasible:
+        _refuse_infeasible(pf.point, device, lanes, args)
     fpga = di.load_fpga_report(args.fpga) if args.fpga else None
     if fpga is not None and fpga.get("model") not in (None, pf.point.model):
         raise RvsmError(f"{args.fpga}: the fpga result is of model {fpga['model']}, the "
@@ -211,6 +219,24 @@ def _datasheet(args: argparse.Namespace) -> int:
     picture_scene = _scenes([args.picture_scene]) if args.picture_scene else None
     return _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,
                            picture_scene, settings, checks)
+
+
+def _refuse_infeasible(point, device, lanes, args) -> None:  # noqa: ANN001
+    """:class:`RvsmError` (one line) when the memory or the clock the rate needs breaks
+    on ``device`` (the logic is not known yet: it is judged on the page)."""
+    from rvsm.rtl.fpga.block_ram import StateLayout
+    from rvsm.rtl.fpga.camera import clock_needed_hz
+    from rvsm.rtl.fpga.feasibility import Camera, assess
+    from rvsm.sim.sweep.verdict import nothing_fits
+
+    h, w = point.shape
+    clock = None if lanes is None else clock_needed_hz(h, w, lanes, args.rate_hz)
+    layout = StateLayout.from_contract(point.contract(),
+                                       shared_thresholds=point.shared_thresholds)
+    f = assess(layout, device, Camera(h, w, args.rate_hz, clock), None,
+               organisation=args.organisation)
+    if f.broken:
+        raise RvsmError(nothing_fits({device.name: [f]}, f"{point.model} cannot meet", "the page"))
 
 
 def _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,  # noqa: ANN001

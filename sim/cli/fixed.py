@@ -119,11 +119,18 @@ def run_config_check(args: argparse.Namespace) -> int:
 
         check_build_settings(build, args.point)
     c = p.contract()
+    verdict = None
+    if build.device or build.lanes or build.freq_mhz:  # the build judged on its device
+        from rvsm.rtl.fpga.build_budget import judge_build
+
+        verdict = judge_build(p, build, args.point)
     print(f"{args.point}: valid design point, {p.model}{p.kind.suffix} on "
           f"{p.height}x{p.width}")
     if build.given():
         print("  built with " + ", ".join(f"{k} = {v!r}" for k, v in build.given().items())
               + " ([rtl]; flags of rvsm verilog / verify / fpga win)")
+    if verdict:
+        print(f"  {verdict}")
     print(f"  {p.rules.describe_adc(p)}")
     print(f"  weights {p.weight_bits} bits / {p.weight_frac_bits} fraction "
           f"({p.weight_rounding}); shift {p.shift}; accumulator {p.accumulator_bits} bits")

@@ -41,11 +41,21 @@ def family_module(name: str) -> ModuleType:
     return importlib.import_module(f"rvsm.sim.cli.{name}")
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An :class:`argparse.ArgumentParser` whose usage errors are one line, ``rvsm
+    COMMAND: error: ...`` (argparse's message names the valid choices) and a pointer to
+    ``--help``, exit status 2; sub-parsers are of the same class."""
+
+    def error(self, message: str):  # type: ignore[override]
+        """Print the one line and exit 2 (argparse prints the whole usage first)."""
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser(families: Sequence[str] | None = None) -> argparse.ArgumentParser:
     """The ``rvsm`` argument parser: every sub-command of :data:`FAMILIES`, or, with
     ``families``, only those families' commands in full and the others as name and help
     line (enough for ``rvsm --help``, and nothing imported for them)."""
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="rvsm",
         description="RVSM spike-camera digital twin: float model, fixed-point twin, "
         "Amaranth RTL and cocotb verification.",

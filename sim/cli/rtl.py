@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -150,11 +151,13 @@ def _verilog(args: argparse.Namespace) -> int:
     )
 
     parse_size_arg(args.size)  # a bad --size is named before the point file is read
-    choose_build(args, "verilog", args.point,
-                 {**ARCH_DEFAULTS, "freq_mhz": ("clock_mhz", DEFAULT_CLOCK_MHZ)})
+    choice = choose_build(args, "verilog", args.point,
+                          {**ARCH_DEFAULTS, "freq_mhz": ("clock_mhz", DEFAULT_CLOCK_MHZ)})
     arch, options = command_architecture(args)
     if not args.clock_mhz > 0:
         raise RvsmError(f"--clock-mhz must be > 0, got {args.clock_mhz:g}")
+    _warn_above_fmax(args.point, args.clock_mhz, options.get("lanes", 1),
+                     "freq_mhz" in choice.from_point)
     _, contract = sized_contract(args.point, args.size, arch, options)
     top = args.top or arch.default_top
     suffixes = (*OUTPUT_SUFFIXES.values(), *arch.extra_suffixes)
@@ -182,6 +185,22 @@ def _verilog(args: argparse.Namespace) -> int:
         for mem in st["memory_list"]:
             print(f"  memory {mem['name']}: {mem['words']} x {mem['width']} bits")
     return 0
+
+
+def _warn_above_fmax(point: str, clock_mhz: float, lanes: int, from_point: bool) -> None:
+    """Say on stderr (one line) when the SDC's clock passes the Fmax model of the point's
+    ``[rtl] device`` (else the ECP5-85) at ``lanes``: the template is still written."""
+    from rvsm.model.fixed.point_toml import load_point_file
+    from rvsm.rtl.fpga.build_budget import DEFAULT_DEVICE, clock_above_fmax
+
+    device = load_point_file(point)[1].device or DEFAULT_DEVICE
+    slow = clock_above_fmax(device, lanes, clock_mhz)
+    if slow:
+        if not from_point:
+            slow = slow.replace("rtl.freq_mhz", "--clock-mhz").replace("set freq_mhz",
+                                                                       "use --clock-mhz")
+        print(f"rvsm verilog: warning: {slow}; the SDC asks for {clock_mhz:g} MHz anyway",
+              file=sys.stderr)
 
 
 def _timing_text(ports_json: Path, gen: GeneratedVerilog) -> str:

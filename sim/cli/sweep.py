@@ -69,6 +69,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--io-links", default=None, choices=("bank", "side"),
                    help="report, io: what one I/O link's edge clock reaches: a bank (default) "
                    "or both banks of a side")
+    p.add_argument("--allow-infeasible", action="store_true",
+                   help="report: write the report even when no design meets the device, "
+                   "camera and rate (without it: exit 2 naming the budget that breaks)")
     p.add_argument("--json", action="store_true",
                    help="report: print one JSON object (files, recommendation, and per "
                    "device every design's verdicts with its I/O figures) instead of text; "
@@ -136,8 +139,10 @@ def _report(args: argparse.Namespace) -> int:
     out = Path(args.output) if args.output else db.with_name(db.stem + "-report")
     check_outputs([Output(out, "-o", FOLDER, (("report.md", None), ("width-cost.png", None),
                                               ("pareto.png", None)))], [db], args.force)
-    files, rec = write_report(db, out, tolerance=args.tolerance,
-                              constraint=_constraint(args, db))
+    constraint = _constraint(args, db)
+    if constraint is not None and not args.allow_infeasible:
+        _refuse_if_nothing_fits(db, constraint)
+    files, rec = write_report(db, out, tolerance=args.tolerance, constraint=constraint)
     if args.json:
         import json
 
@@ -152,11 +157,62 @@ def _report(args: argparse.Namespace) -> int:
     for device, fit in (rec or {}).get("fits", {}).items():
         bad = rec["infeasible"][device]
         print(f"fits {device}: {len(fit)} of {len(fit) + len(bad)} design(s)")
+        verdicts = {v["label"]: v for v in rec["verdicts"][device]}
         for i, d in enumerate(fit, 1):
             print(f"  {i}. {d['label']}: {d['worst_cost']:.3f} dB, {d['summary']}")
         for d in bad:
-            print(f"  x {d['label']}: {d['summary']}")
+            print(f"  x {d['label']}: {_short(verdicts[d['label']])}")
+    if rec and rec.get("fits"):
+        print(f"every verdict's detail: {out / 'report.md'} (or --json)")
+    if constraint is not None:
+        from rvsm.sim.sweep.verdict import prime_width_note
+
+        cam = constraint.camera
+        note = prime_width_note(cam.height, cam.width, cam.rate_hz)
+        if note:
+            print(f"note: {note[2:]}")
     return 0
+
+
+def _short(verdict: dict) -> str:
+    """An infeasible verdict of ``--json`` in one short line: lanes, clock, the budgets
+    that break (or are unknown) with their figures."""
+    checks = verdict["checks"]
+    bad = [k for k, c in checks.items() if c["ok"] is False] or \
+        [k for k, c in checks.items() if c["ok"] is None]
+    head = f"P = {verdict['lanes']} at {verdict['clock_needed_mhz']:,.1f} MHz"
+    word = "breaks" if any(checks[k]["ok"] is False for k in bad) else "unverified"
+    return f"{head}: {word} " + "; ".join(_figures(k, checks[k]) for k in bad)
+
+
+def _figures(name: str, c: dict) -> str:
+    if c["figure"] is None or not c["budget"]:
+        return f"{name} ?"
+    def num(v: float) -> str:
+        return f"{v:,.0f}" if abs(v) >= 100 or float(v).is_integer() else f"{v:,.1f}"
+
+    return (f"{name} {num(c['figure'])} / {num(c['budget'])} {c['unit']} "
+            f"({100 * (c['figure'] / c['budget'] - 1):+.0f} %)")
+
+
+def _refuse_if_nothing_fits(db: Path, constraint) -> None:  # noqa: ANN001 - FitConstraint
+    """:class:`RvsmError` (one line, :func:`~rvsm.sim.sweep.verdict.nothing_fits`) when no
+    design of ``db`` meets ``constraint`` on any of its devices."""
+    from rvsm.sim.sweep.fit import assess_design
+    from rvsm.sim.sweep.report import summarise
+    from rvsm.sim.sweep.store import open_existing
+    from rvsm.sim.sweep.verdict import nothing_fits
+
+    with open_existing(db) as store:
+        designs = summarise(store.results())
+    verdicts: dict[str, list] = {name: [] for name in constraint.devices}
+    for d in designs:
+        for name, f in assess_design(d.toml, d.rows[0], constraint).items():
+            if f.feasible:
+                return
+            verdicts[name].append(f)
+    if designs:
+        raise RvsmError(nothing_fits(verdicts))
 
 
 def _io(args: argparse.Namespace) -> int:
