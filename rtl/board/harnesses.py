@@ -42,9 +42,9 @@ __all__ = ["ALIGN_WORDS", "DESKEW_STROBES", "MARK_SPACING", "STREAMS", "TRAIN_WO
            "AlignerProperties", "DeskewProperties"]
 
 #: Training words the aligner harness sends before any words.
-TRAIN_WORDS = 24
+TRAIN_WORDS = 16
 #: Words (from the first) after which the aligner must be aligned, every slip.
-ALIGN_WORDS = 18
+ALIGN_WORDS = 14
 #: Least words between two MARKs the harnesses send (the protocol: 16).
 MARK_SPACING = 8
 #: Strobes after a MARK is sent (``start`` high) by which ``Deskew`` is ``done``.
