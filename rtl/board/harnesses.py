@@ -47,8 +47,8 @@ TRAIN_WORDS = 16
 ALIGN_WORDS = 14
 #: Least words between two MARKs the harnesses send (the protocol: 16).
 MARK_SPACING = 8
-#: Strobes after a MARK is sent (``start`` high) by which ``Deskew`` is ``done``.
-DESKEW_STROBES = DEPTH + 1
+#: Strobes after the one that sends a MARK (``start`` high) by which ``Deskew`` is ``done``.
+DESKEW_STROBES = DEPTH
 #: The aligner harness's streams.
 STREAMS = ("training", "no_train")
 
