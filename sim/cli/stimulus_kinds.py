@@ -89,6 +89,9 @@ class StimulusKind:
 
     name: str = ""
 
+    def __repr__(self) -> str:
+        return f"<stimulus kind {self.name}>"
+
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
         """Add the options naming this kind (none by default)."""
 
@@ -223,16 +226,13 @@ class SceneKind(StimulusKind):
         return StimulusChunks.from_scene(scene, run.point, request.steps), scene.name or "scene"
 
 
-@dataclass(frozen=True)
 class GeneratedKind(StimulusKind):
     """A stimulus generated from ``flag SEED`` at the point ``--fixed``, sized by
     ``--size``, ``--steps`` long: nothing that shapes a scene goes with it. ``dest`` is the
     option's ``argparse`` name, ``help`` its help line."""
 
-    name: str
-    flag: str
-    dest: str
-    help: str
+    def __init__(self, name: str, flag: str, dest: str, help: str) -> None:
+        self.name, self.flag, self.dest, self.help = name, flag, dest, help
 
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
         parser.add_argument(self.flag, metavar="SEED", type=int, dest=self.dest,
