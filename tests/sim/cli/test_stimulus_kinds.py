@@ -78,16 +78,19 @@ def ramp() -> Iterator[StimulusKind]:
 def test_a_toy_kind_is_one_class_and_one_registration_line(
         ramp: StimulusKind, tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     point = tmp_path / "p.toml"
-    save_design_point(point, replace(default_design_point().with_size(2, 3), model="dog1"))
+    save_design_point(point, replace(default_design_point().with_size(2, 3), model="fsm"))
     argv = ["verify", "--ramp", "3", "--fixed", str(point), "--size", "2x3", "--steps", "12",
             "--work", str(tmp_path / "work")]
     assert main([*argv, "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert out["mismatches"] == 0 and out["compared"] == 12 * 2 * 3
-    assert out["command"] is None and out["settings"]  # the one JSON printer's fields
+    scales = out["accumulators"] // (2 * 3)
+    assert out["mismatches"] == 0 and out["compared"] == 12 * scales * 2 * 3
+    assert out["expected_spikes"] > 0  # the ramp crosses the thresholds
+    # the one JSON printer's fields
+    assert out["command"].startswith("rvsm verify --ramp 3") and out["settings"]
     assert main(argv) == 0  # the shared report
     printed = capsys.readouterr().out
-    assert f"compared {12 * 2 * 3} spikes (12 steps x 6 accumulators" in printed
+    assert f"compared {out['compared']} spikes (12 steps x {scales * 6} accumulators" in printed
     assert "run folder: " in printed
     # the generated stimulus's refusals come with the kind, named by its own flag
     assert main(["verify", "--ramp", "3", "--fixed", str(point)]) == 2
