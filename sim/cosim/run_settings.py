@@ -25,7 +25,6 @@ from rvsm.sim.cosim.long_runs.long_run import DEFAULT_CHUNK_STEPS
 
 if TYPE_CHECKING:
     from rvsm.model.fixed.contract import ArrayContract
-    from rvsm.model.fixed.stimulus import Stimulus
     from rvsm.model.fixed.stimulus_chunks import StimulusChunks
 
 #: The testbenches ``rvsm verify --harness`` chooses: per cycle from Python, or the
@@ -97,13 +96,6 @@ class RunSettings:
                                  reloadable=reloadable)
         check_code_coverage(self.code_coverage, harness, self.sim)
         return harness
-
-    def check_stimulus(self, stim: Stimulus, name: str) -> dict:
-        """:func:`~.verify.check_stimulus` of ``stim`` in the per-cycle testbench."""
-        from rvsm.sim.cosim.verify import check_stimulus
-
-        return check_stimulus(stim, self.sim, waves=self.waves, work_dir=self.work_dir,
-                              name=name, arch=self.arch, **self.options)
 
     def check_chunks(self, source: StimulusChunks, name: str) -> dict:
         """:func:`~.long_runs.long_run.check_chunks` of ``source`` in the long-run

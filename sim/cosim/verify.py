@@ -108,6 +108,12 @@ def check_stimulus(
     return result
 
 
+def _per_cycle(s: RunSettings, stim: Stimulus, name: str) -> dict:
+    """:func:`check_stimulus` of ``stim`` with the settings ``s`` (per-cycle testbench)."""
+    return check_stimulus(stim, s.sim, waves=s.waves, work_dir=s.work_dir, name=name,
+                          arch=s.arch, **s.options)
+
+
 def _run_and_keep_waves(stim: Stimulus, sb: SimBuild, run_dir: Path, root: Path,
                         waves: bool) -> dict:
     """Run ``stim`` in ``run_dir``; on a mismatch without ``waves``, re-run it up to the
@@ -198,7 +204,7 @@ def replay(stimulus: str | os.PathLike, sim: str = "icarus", steps: int | None =
         result = s.check_chunks(StimulusChunks.from_stimulus(
             stim, str(Path(stimulus).resolve()), recompute=recompute_expected), name)
     else:
-        result = s.check_stimulus(stim, name)
+        result = _per_cycle(s, stim, name)
     result.update(stimulus=str(stimulus), height=c.height, width=c.width,
                   coverage=with_lane_coverage(_coverage(stim), result),
                   expectation="recomputed" if recompute_expected else "file")
@@ -245,7 +251,7 @@ def verify(scene: str | Scene, point: RunPoint | str | os.PathLike, sim: str = "
         coverage = result.get("lane_coverage")
     else:
         stim = make_stimulus(scene, run.point, num_steps=steps)
-        result = s.check_stimulus(stim, name)
+        result = _per_cycle(s, stim, name)
         coverage = _coverage(stim)
     result.update(scene=scene.source or scene.name, point=run.source, height=h, width=w,
                   coverage=coverage)
@@ -273,7 +279,7 @@ def random_verify(point: RunPoint | str | os.PathLike, seed: int, steps: int,
     if s.choose(h * w, steps) == "chunk":
         result = s.check_chunks(StimulusChunks.from_stimulus(stim), f"random{seed}")
     else:
-        result = s.check_stimulus(stim, f"random{seed}")
+        result = _per_cycle(s, stim, f"random{seed}")
     result.update(seed=seed, point=run.source, height=h, width=w,
                   coverage=with_lane_coverage(coverage(stim), result))
     return result
