@@ -8,8 +8,10 @@ failing step with waves on, so a waveform is always kept. The entry points build
 stimulus three ways: :func:`run_rtl` from a contract, codes and thresholds (the
 expectation from :meth:`ArrayContract.run`); :func:`verify` from a scene and a design
 point (a :class:`~.run_point.RunPoint`, read once by the command) via the fixed twin;
-:func:`replay` from a stimulus file (``rvsm stimulus``). The architecture is a value of
-the registry; whether it has a long-run harness is its capability
+:func:`replay` from a stimulus file (``rvsm stimulus``). The last three share one
+parameter object, :class:`~.run_settings.RunSettings` (simulator, waves, work folder,
+architecture and options, harness), given by keyword. The architecture is a value of the
+registry; whether it has a long-run harness is its capability
 (:attr:`~rvsm.rtl.capabilities.Architecture.long_run_testbench`).
 """
 
@@ -19,6 +21,7 @@ import os
 import shutil
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -28,32 +31,24 @@ from rvsm.model.fixed.stimulus_chunks import StimulusChunks
 from rvsm.model.fixed.widths import unsigned_max
 from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.scene import Scene
-from rvsm.rtl.architectures.registry import (
-    DEFAULT_ARCHITECTURE,
-    architectures_with,
-    get_architecture,
-)
+from rvsm.rtl.architectures.registry import DEFAULT_ARCHITECTURE, get_architecture
 from rvsm.rtl.capabilities import Architecture
 from rvsm.sim.cosim.builds.build_cache import SimBuild, build, new_run_dir
-from rvsm.sim.cosim.builds.cocotb_adapter import check_simulator
 from rvsm.sim.cosim.builds.testbench_run import run_testbench
-from rvsm.sim.cosim.long_runs.long_run import DEFAULT_CHUNK_STEPS, check_chunks
 from rvsm.sim.cosim.run_point import RunPoint
+from rvsm.sim.cosim.run_settings import (
+    AUTO_CHUNK_BEATS,
+    DEFAULT_WORK,
+    HARNESSES,
+    RunSettings,
+    check_code_coverage,
+    check_harness,
+    choose_harness,
+)
 
-#: The testbenches ``rvsm verify --harness`` chooses: per cycle from Python, or the
-#: long-run harness (the simulator runs the cycles; streaming array only); ``auto``
-#: picks the long-run harness for a streaming run of more than :data:`AUTO_CHUNK_BEATS`
-#: input beats, else the per-cycle testbench (:func:`choose_harness`).
-HARNESSES = ("auto", "cycle", "chunk")
-#: Beats above which ``auto`` takes the long-run harness: the per-cycle testbench runs
-#: about 600-15,000 cycles/s, so beyond this a run takes seconds to minutes in it.
-AUTO_CHUNK_BEATS = 100_000
-
-__all__ = ["AUTO_CHUNK_BEATS", "HARNESSES", "check_code_coverage", "check_harness",
-           "check_stimulus", "choose_harness", "random_verify", "replay", "run_rtl",
-           "verify"]
-
-DEFAULT_WORK = Path("build") / "verify"
+__all__ = ["AUTO_CHUNK_BEATS", "DEFAULT_WORK", "HARNESSES", "RunSettings",
+           "check_code_coverage", "check_harness", "check_stimulus", "choose_harness",
+           "random_verify", "replay", "run_rtl", "verify"]
 
 
 def _check_inputs(contract: ArrayContract, codes: np.ndarray, thresholds: np.ndarray) -> None:
@@ -65,14 +60,6 @@ def _check_inputs(contract: ArrayContract, codes: np.ndarray, thresholds: np.nda
     if thresholds.shape != (c.num_scales, c.height, c.width):
         raise RvsmError(f"thresholds must be ({c.num_scales}, {c.height}, {c.width}), "
                         f"got {thresholds.shape}")
-
-
-def _resolve(a: Architecture, options: dict[str, int | None],
-             contract: ArrayContract) -> dict[str, int]:
-    """The options of ``a`` (defaults filled in), after its size rule."""
-    resolved = a.resolve(options)
-    a.check(contract, **resolved)
-    return resolved
 
 
 def check_stimulus(
@@ -99,7 +86,7 @@ def check_stimulus(
     """
     contract = stim.contract
     a = get_architecture(arch)
-    resolved = _resolve(a, options, contract)
+    resolved = RunSettings(arch=a, options=options).resolve(contract)
     _check_inputs(contract, stim.codes, stim.thresholds)
     want = (stim.num_steps, contract.num_scales, contract.height, contract.width)
     if stim.spikes.shape != want:
@@ -119,6 +106,12 @@ def check_stimulus(
         arch=a.name, options=resolved, lanes=resolved.get("lanes"),
     )
     return result
+
+
+def _per_cycle(s: RunSettings, stim: Stimulus, name: str) -> dict:
+    """:func:`check_stimulus` of ``stim`` with the settings ``s`` (per-cycle testbench)."""
+    return check_stimulus(stim, s.sim, waves=s.waves, work_dir=s.work_dir, name=name,
+                          arch=s.arch, **s.options)
 
 
 def _run_and_keep_waves(stim: Stimulus, sb: SimBuild, run_dir: Path, root: Path,
@@ -171,43 +164,29 @@ def run_rtl(
                           build_root=build_root, arch=arch, **options)
 
 
-def replay(
-    stimulus: str | os.PathLike,
-    sim: str = "icarus",
-    steps: int | None = None,
-    waves: bool = False,
-    work_dir: str | os.PathLike = DEFAULT_WORK,
-    arch: str | Architecture = DEFAULT_ARCHITECTURE,
-    recompute_expected: bool = False,
-    harness: str = "cycle",
-    progress: bool = False,
-    chunk_steps: int = DEFAULT_CHUNK_STEPS,
-    code_coverage: bool = False,
-    **options: int | None,
-) -> dict:
+def replay(stimulus: str | os.PathLike, sim: str = "icarus", steps: int | None = None,
+           recompute_expected: bool = False, **settings: Any) -> dict:
     """Replay a stimulus file (``rvsm stimulus -o FILE``) on the RTL, spike for spike.
 
-    ``steps`` keeps the first steps. The file is checked before the RTL is blamed: when
-    its expected spikes do not follow from its own codes, thresholds and contract
-    (a hand-edited or damaged file) it is a bad stimulus (:class:`RvsmError`, exit 2,
-    naming the first inconsistent step and accumulator), unless ``recompute_expected``
-    takes the expectation from its codes instead. ``harness`` and ``progress`` as
-    :func:`verify`. Returns :func:`check_stimulus`'s result plus ``stimulus``,
-    ``height``, ``width`` and ``expectation`` (``"file"`` or ``"recomputed"``).
+    ``settings``: :class:`~.run_settings.RunSettings` by keyword (``waves``, ``work_dir``,
+    ``arch``, ``harness``...; the rest architecture options). ``steps`` keeps the first
+    steps. The file is checked before the RTL is blamed: when its expected spikes do not
+    follow from its own codes, thresholds and contract (a hand-edited or damaged file) it
+    is a bad stimulus (:class:`RvsmError`, exit 2, naming the first inconsistent step and
+    accumulator), unless ``recompute_expected`` takes the expectation from its codes
+    instead. Returns :func:`check_stimulus`'s result plus ``stimulus``, ``height``,
+    ``width`` and ``expectation`` (``"file"`` or ``"recomputed"``).
     """
-    check_simulator(sim)
-    a = get_architecture(arch)
-    check_harness(harness, a)
+    s = RunSettings.of(sim, **settings)
     stim = open_stimulus(stimulus)  # codes and spikes read a range of steps at a time
     c = stim.contract
-    _resolve(a, options, c)
+    s.resolve(c)
     if steps is not None and steps > stim.num_steps:
         raise RvsmError(f"--steps {steps}: {stimulus} holds {stim.num_steps} steps; ask for "
                         f"at most {stim.num_steps}")
     if steps is not None and steps < stim.num_steps:
         stim = stim.first_steps(steps)
-    harness = choose_harness(harness, a, c.height * c.width, stim.num_steps, options)
-    check_code_coverage(code_coverage, harness, sim)
+    harness = s.choose(c.height * c.width, stim.num_steps)
     if harness != "chunk":  # the per-cycle testbench takes the stimulus whole
         stim = stim.loaded()
     if recompute_expected:
@@ -222,41 +201,25 @@ def replay(
     name = Path(stimulus).stem or "stimulus"
     if harness == "chunk":
         # the testbench opens the file again and reads it a chunk at a time
-        source = StimulusChunks.from_stimulus(stim, str(Path(stimulus).resolve()),
-                                              recompute=recompute_expected)
-        result = check_chunks(source, sim, work_dir=work_dir, name=name, arch=a,
-                              waves=waves, progress=progress, chunk_steps=chunk_steps,
-                              code_coverage=code_coverage,
-                              **options)
+        result = s.check_chunks(StimulusChunks.from_stimulus(
+            stim, str(Path(stimulus).resolve()), recompute=recompute_expected), name)
     else:
-        result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir, name=name,
-                                arch=a, **options)
+        result = _per_cycle(s, stim, name)
     result.update(stimulus=str(stimulus), height=c.height, width=c.width,
                   coverage=with_lane_coverage(_coverage(stim), result),
                   expectation="recomputed" if recompute_expected else "file")
     return result
 
 
-def verify(
-    scene: str | Scene,
-    point: RunPoint | str | os.PathLike,
-    sim: str = "icarus",
-    steps: int | None = None,
-    waves: bool = False,
-    size: tuple[int, int] | None = None,
-    work_dir: str | os.PathLike = DEFAULT_WORK,
-    arch: str | Architecture = DEFAULT_ARCHITECTURE,
-    harness: str = "cycle",
-    progress: bool = False,
-    chunk_steps: int = DEFAULT_CHUNK_STEPS,
-    code_coverage: bool = False,
-    **options: int | None,
-) -> dict:
+def verify(scene: str | Scene, point: RunPoint | str | os.PathLike, sim: str = "icarus",
+           steps: int | None = None, size: tuple[int, int] | None = None,
+           **settings: Any) -> dict:
     """Verify the RTL of design ``point`` on ``scene``, spike for spike.
 
     ``point`` is a :class:`~.run_point.RunPoint` (a command reads its TOML once) or the
-    TOML path; ``arch`` and ``options`` as :func:`check_stimulus` (the streaming array
-    takes any array size).
+    TOML path; ``settings``: :class:`~.run_settings.RunSettings` by keyword (``arch`` and
+    its options, ``harness``, ``waves``, ``work_dir``...; the streaming array takes any
+    array size).
 
     ``size = (H, W)`` overrides the point's array size (a scene name or path is rendered
     or cropped to it; a :class:`Scene`, shaped by the caller, must have it); ``steps``
@@ -271,118 +234,55 @@ def verify(
     from rvsm.model.fixed.stimulus import make_stimulus
     from rvsm.model.scene.loaders import load_scene
 
-    check_simulator(sim)
-    a = get_architecture(arch)
-    check_harness(harness, a)
+    s = RunSettings.of(sim, **settings)
     run = RunPoint.coerce(point, size)
     h, w = run.shape
-    _resolve(a, options, run.contract)
+    s.resolve(run.contract)
     if not isinstance(scene, Scene):
         scene = load_scene(scene, size=(h, w))
-    harness = choose_harness(harness, a, h * w,
-                             scene.num_steps if steps is None else steps, options,
-                             reloadable=scene.source is not None)
-    check_code_coverage(code_coverage, harness, sim)
+    harness = s.choose(h * w, scene.num_steps if steps is None else steps,
+                       reloadable=scene.source is not None)
+    name = scene.name or "scene"
     if harness == "chunk":
         if steps is not None and steps > scene.num_steps:
             raise RvsmError(f"--steps {steps} is more than the {scene.num_steps} steps of "
                             f"scene {scene.name!r}; ask for at most {scene.num_steps}")
-        source = StimulusChunks.from_scene(scene, run.point, steps)
-        result = check_chunks(source, sim, work_dir=work_dir, name=scene.name or "scene",
-                              arch=a, waves=waves, progress=progress, chunk_steps=chunk_steps,
-                              code_coverage=code_coverage,
-                              **options)
-        result.update(scene=scene.source or scene.name, point=run.source, height=h,
-                      width=w, coverage=result.get("lane_coverage"))
-        return result
-    stim = make_stimulus(scene, run.point, num_steps=steps)
-    result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
-                            name=scene.name or "scene", arch=a, **options)
+        result = s.check_chunks(StimulusChunks.from_scene(scene, run.point, steps), name)
+        coverage = result.get("lane_coverage")
+    else:
+        stim = make_stimulus(scene, run.point, num_steps=steps)
+        result = _per_cycle(s, stim, name)
+        coverage = _coverage(stim)
     result.update(scene=scene.source or scene.name, point=run.source, height=h, width=w,
-                  coverage=_coverage(stim))
+                  coverage=coverage)
     return result
 
 
-def random_verify(
-    point: RunPoint | str | os.PathLike,
-    seed: int,
-    steps: int,
-    sim: str = "icarus",
-    waves: bool = False,
-    size: tuple[int, int] | None = None,
-    work_dir: str | os.PathLike = DEFAULT_WORK,
-    arch: str | Architecture = DEFAULT_ARCHITECTURE,
-    harness: str = "cycle",
-    progress: bool = False,
-    chunk_steps: int = DEFAULT_CHUNK_STEPS,
-    code_coverage: bool = False,
-    **options: int | None,
-) -> dict:
-    """Verify the RTL of design ``point`` (as :func:`verify`) on a seeded random and
-    corner stimulus (:func:`~rvsm.model.fixed.corner_stimulus.corner_stimulus`,
-    ``steps`` steps); ``arch`` and ``options`` as :func:`check_stimulus`.
+def random_verify(point: RunPoint | str | os.PathLike, seed: int, steps: int,
+                  sim: str = "icarus", size: tuple[int, int] | None = None,
+                  **settings: Any) -> dict:
+    """Verify the RTL of design ``point`` (as :func:`verify`, ``settings`` the same) on
+    a seeded random and corner stimulus
+    (:func:`~rvsm.model.fixed.corner_stimulus.corner_stimulus`, ``steps`` steps).
 
     Returns :func:`check_stimulus`'s result plus ``seed``, ``point``, ``height``,
     ``width`` and ``coverage`` (per scale, accumulator-steps per bin).
     """
     from rvsm.model.fixed.corner_stimulus import corner_stimulus, coverage
 
-    check_simulator(sim)
-    a = get_architecture(arch)
-    check_harness(harness, a)
+    s = RunSettings.of(sim, **settings)
     run = RunPoint.coerce(point, size)
-    _resolve(a, options, run.contract)
+    s.resolve(run.contract)
     stim = corner_stimulus(run.contract, seed, steps)
     stim.point = run.point
     h, w = run.shape
-    harness = choose_harness(harness, a, h * w, steps, options)
-    check_code_coverage(code_coverage, harness, sim)
-    if harness == "chunk":
-        result = check_chunks(StimulusChunks.from_stimulus(stim), sim, work_dir=work_dir,
-                              name=f"random{seed}", arch=a, waves=waves,
-                              progress=progress, chunk_steps=chunk_steps,
-                              code_coverage=code_coverage,
-                              **options)
+    if s.choose(h * w, steps) == "chunk":
+        result = s.check_chunks(StimulusChunks.from_stimulus(stim), f"random{seed}")
     else:
-        result = check_stimulus(stim, sim, waves=waves, work_dir=work_dir,
-                                name=f"random{seed}", arch=a, **options)
+        result = _per_cycle(s, stim, f"random{seed}")
     result.update(seed=seed, point=run.source, height=h, width=w,
                   coverage=with_lane_coverage(coverage(stim), result))
     return result
-
-
-def choose_harness(harness: str, arch: str | Architecture, pixels: int, steps: int,
-                   options: dict, reloadable: bool = True) -> str:
-    """``harness``, with ``"auto"`` resolved: ``"chunk"`` for an architecture with a
-    long-run harness (the streaming array) when ``pixels * steps / lanes`` (input beats)
-    exceeds :data:`AUTO_CHUNK_BEATS` and the stimulus can be opened again in the
-    simulator (``reloadable``), else ``"cycle"``."""
-    if harness != "auto":
-        return harness
-    long_run = get_architecture(arch).long_run_testbench is not None
-    lanes = int(options.get("lanes") or 1)
-    if long_run and reloadable and pixels * steps // lanes > AUTO_CHUNK_BEATS:
-        return "chunk"
-    return "cycle"
-
-
-def check_code_coverage(code_coverage: bool, harness: str, sim: str) -> None:
-    """Refuse code coverage outside the long-run harness on Verilator."""
-    if code_coverage and (harness != "chunk" or sim != "verilator"):
-        raise RvsmError("code coverage is built for Verilator runs in the long-run harness: "
-                        "use --sim verilator --harness chunk")
-
-
-def check_harness(harness: str, arch: str | Architecture) -> None:
-    """Refuse (:class:`RvsmError`) an unknown harness, or the long-run one for an
-    architecture it does not drive."""
-    if harness not in HARNESSES:
-        raise RvsmError(f"unknown harness {harness!r}; choose one of {', '.join(HARNESSES)}")
-    a = get_architecture(arch)
-    if harness == "chunk" and a.long_run_testbench is None:
-        names = architectures_with(lambda x: x.long_run_testbench)
-        raise RvsmError(f"--harness chunk drives the {', '.join(names)} "
-                        f"architecture only; use --harness cycle for --arch {a.name}")
 
 
 def with_lane_coverage(bins: list[dict], result: dict) -> list[dict]:
