@@ -12,7 +12,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.board_top import CONTROLS, BoardTop, board_ports
 from rvsm.rtl.fpga.flow import build_component
 from rvsm.rtl.fpga.package_pins import load_package
-from rvsm.rtl.fpga.pin_plan import BoardPorts, LinkSpec, _placements, plan_pins
+from rvsm.rtl.fpga.pin_plan import BoardPorts, LinkSpec, edge_clock_placements, plan_pins
 
 POINT = "points/ecp5-85-40khz.toml"
 TINY = BoardPorts((LinkSpec("rx0", "rx", 2), LinkSpec("tx0", "tx", 2)), ("rst_n", "led"))
@@ -70,7 +70,7 @@ def test_full_sensor_does_not_fit_cabga381_and_the_planner_chooses_cabga756():
 
 def test_edge_clock_rules_of_the_placements():
     links = [LinkSpec(f"l{i}", "rx", 1) for i in range(2)]
-    for where in _placements(links):
+    for where in edge_clock_placements(links):
         sides = [s for s, _ in where.values()]
         if sides[0] == sides[1]:  # two links on a side share one bank
             assert where["l0"][1] == where["l1"][1] and len(where["l0"][1]) == 1

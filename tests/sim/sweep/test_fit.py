@@ -50,7 +50,7 @@ def test_constraint_parsed_with_its_defaults():
     (HEAD + 'max_utilisation = 1.5\n', r"max_utilisation must be a number in \(0, 1\]"),
     (HEAD + 'memory_organisation = "diagonal"\n', r"one of rtl, per-scale, packed"),
     ('fitz = "ecp5-85"\n', r"unknown section \[fitz\]; valid: .*top-level keys: fits, camera"),
-    (HEAD + 'io_links = "chip"\n', r"io_links must be one of bank, side, got 'chip'"),
+    (HEAD + 'io_links = "chip"\n', r"io_links must be one of side, bank, got 'chip'"),
     (HEAD + 'package = "QFN9"\n', r"s.toml: package: ecp5-85 has no package 'QFN9'; choose "),
 ])
 def test_bad_constraints_are_one_line_naming_the_choices(text, msg):
