@@ -15,7 +15,8 @@ from rvsm.sim.sweep.report import write_report
 from rvsm.sim.sweep.run import run_sweep
 from rvsm.sim.sweep.spec import parse_sweep
 
-HEAD = 'fits = "ecp5-85"\ncamera = { size = "250x400", rate_hz = 40000 }\n'
+HEAD = ('fits = "ecp5-85"\ncamera = { size = "250x400", rate_hz = 40000 }\n'
+        'package = "CABGA756"\n')
 BODY = """
 [axes]
 "array.model" = ["dog1", "dog2"]
@@ -94,29 +95,31 @@ def test_report_ranks_what_fits_and_says_what_breaks(tmp_path, capsys, fake_synt
     assert "fits ecp5-25: 2 of 2 design(s)" in out
     # no Fmax model for the iCE40: unverified, not feasible
     assert "fits ice40-up5k: 0 of 2 design(s)" in out and "unverified on ice40-up5k" in out
-    # 100x400 at 100 kHz: the array's 4e9 pixel-steps/s on a state that fits; dog2's
-    # 28 + 16 Gbit/s do not place on the CABGA381's banks, dog1's 28 + 8 do
+    # 100x400 at 100 kHz: the array's 4e9 pixel-steps/s on a state that fits; on the
+    # CABGA381 dog2's transmit link (20 + 2 pairs) needs more true-LVDS pairs than a side
+    # has, dog1's 37-pair receive link more pairs than a side has
     fast = ["--fits", "ecp5-85", "--camera", "100x400", "--rate-hz", "100000"]
     assert main(["sweep", "report", str(db), "-o", str(tmp_path / "rep3"), *fast]) == 0
     out = capsys.readouterr().out
     (dog2,) = [ln for ln in out.splitlines() if ln.startswith("  x array.model=dog2")]
-    assert dog2.endswith("breaks on ecp5-85 at P = 40 at 100.0 MHz: io BREAKS: 35 / 29 "
-                         "input data pairs (+21 %); in 28.0 Gbit/s = 35 pairs x 8 bits per "
-                         "core cycle, out 16.0 Gbit/s = 20 pairs, x2 gearing at 800 Mbit/s "
-                         "per pair, +2 pairs (clock, framing) per link, links per bank, "
-                         "LFE5U-85F CABGA381; beside the outputs the banks carry 29")
-    assert "1. array.model=dog1" in out and "I/O 55 / 65 pairs" in out
-    assert "| 35 / 29 **x** |" in (tmp_path / "rep3" / "report.md").read_text()
+    assert dog2.endswith("breaks on ecp5-85 at P = 40 at 100.0 MHz: io BREAKS: 22 / 17 "
+                         "true-LVDS transmit pairs on one edge clock (+29 %); in 28.0 Gbit/s "
+                         "= 35 pairs x 8 bits per core cycle, out 16.0 Gbit/s = 20 pairs, x2 "
+                         "gearing at 800 Mbit/s per pair, one link each way +2 pairs (clock, "
+                         "framing), edge clocks per side, LFE5U-85F CABGA381; the links do "
+                         "not place")
+    assert "io BREAKS: 37 / 33 receive pairs on one edge clock" in out
+    assert "| 22 / 17 **x** |" in (tmp_path / "rep3" / "report.md").read_text()
     assert main(["sweep", "report", str(db), "-o", str(tmp_path / "rep4"), *fast,
-                 "--package", "CABGA554", "--json"]) == 0
+                 "--package", "CABGA756", "--json"]) == 0
     got = json.loads(capsys.readouterr().out)["report"]
     assert [d["label"].split(",")[0] for d in got["fits"]["ecp5-85"]] == [
         "array.model=dog1", "array.model=dog2"]
     io = {d["label"].split(",")[0]: d["io"] for d in got["verdicts"]["ecp5-85"]}
-    assert io["array.model=dog2"]["package"] == "LFE5U-85F CABGA554"
+    assert io["array.model=dog2"]["package"] == "LFE5U-85F CABGA756"
     assert (io["array.model=dog2"]["input"]["data_pairs"],
             io["array.model=dog2"]["output"]["data_pairs"]) == (35, 20)
-    assert io["array.model=dog2"]["figure"] == 65 and io["array.model=dog2"]["budget"] == 80
+    assert io["array.model=dog2"]["figure"] == 59 and io["array.model=dog2"]["budget"] == 112
 
 
 def test_cli_devices_and_bad_values_exit_2(tmp_path, capsys, fake_synthesis):
