@@ -15,8 +15,7 @@ from rvsm.sim.sweep.report import write_report
 from rvsm.sim.sweep.run import run_sweep
 from rvsm.sim.sweep.spec import parse_sweep
 
-HEAD = ('fits = "ecp5-85"\ncamera = { size = "250x400", rate_hz = 40000 }\n'
-        'package = "CABGA756"\n')
+HEAD = 'fits = "ecp5-85"\ncamera = { size = "250x400", rate_hz = 40000 }\n'
 BODY = """
 [axes]
 "array.model" = ["dog1", "dog2"]
@@ -76,14 +75,17 @@ def fake_synthesis(monkeypatch):
 def test_report_ranks_what_fits_and_says_what_breaks(tmp_path, capsys, fake_synthesis):
     db = tmp_path / "r.sqlite"
     run_sweep(parse_sweep(HEAD + BODY), db, workers=0, progress=False)
-    files, info = write_report(db, tmp_path / "rep")
+    # in the CABGA756: the package that carries the full sensor's links
+    big = parse_constraint({"fits": ["ecp5-85"], "package": "CABGA756",
+                            "camera": {"size": "250x400", "rate_hz": 40000}}, "test")
+    files, info = write_report(db, tmp_path / "rep", constraint=big)
     text = (tmp_path / "rep" / "report.md").read_text()
     # dog1, per-pixel thresholds, packed at P = 40: 100 + 95 DP16KD of 208; dog2 twice
     assert [d["label"].split(",")[0] for d in info["fits"]["ecp5-85"]] == ["array.model=dog1"]
     (bad,) = info["infeasible"]["ecp5-85"]
     assert bad["label"].startswith("array.model=dog2")
     assert "memory BREAKS: 390 / 208 DP16KD (+88 %)" in bad["summary"]
-    assert "## Fits ecp5-85 at 250x400 at 40,000 Hz" in text
+    assert "## Fits ecp5-85 in CABGA756 at 250x400 at 40,000 Hz" in text
     assert "**1 of 2 designs fit.**" in text and "195 / 208" in text
     # logic at P = 40: 100 + 40 x 400 LUT4 + the line buffer's 140 16x4 RAMs x 4
     assert "16,660 / 66,912" in text
@@ -154,7 +156,7 @@ def test_point_io_command_gives_the_figures_docs_quote(capsys, monkeypatch):
     assert main(["sweep", "io", "points/ecp5-85-40khz.toml", "--package", "CABGA381",
                  "--io-links", "bank", "--json"]) == 0
     (plan,) = json.loads(capsys.readouterr().out)
-    assert (plan["fits"], plan["figure"], plan["budget"]) == (False, 35, 29)
+    assert (plan["fits"], plan["figure"], plan["budget"]) == (False, 22, 9)
     assert main(["sweep", "io"]) == 2 and "needs a point file" in capsys.readouterr().err
     assert main(["sweep", "io", "points/ecp5-85-40khz.toml", "--package", "QFN9"]) == 2
     assert "choose one of: LFE5U-85F CABGA381" in capsys.readouterr().err
