@@ -28,7 +28,8 @@ GOOD_WORDS = 4
 class WordAligner(wiring.Component):
     """One pair's word aligner: ``gear`` (4 bits a cycle, bit 0 first), ``strobe`` (take
     a word this cycle), ``search`` (look for TRAIN while not aligned), ``restart`` in;
-    ``word`` (registered at each strobe), ``window`` (the word a strobe now would take),
+    ``word`` (registered at each strobe), ``window`` (the word a strobe now would take;
+    registered, valid at strobes: strobes are at least two cycles apart),
     ``aligned``, ``slip`` out. ``latency``: cycles from a word's last gear bits to
     ``word`` (at most one strobe period, 2)."""
 
@@ -45,17 +46,24 @@ class WordAligner(wiring.Component):
         m = Module()
         hist = Signal(4 * GEAR_BITS)
         good = Signal(range(GOOD_WORDS))
-        m.d.sync += hist.eq(Cat(hist[GEAR_BITS:], self.gear))
-        m.d.comb += self.window.eq(hist.bit_select(self.slip, WORD_BITS))
+        nxt = Cat(hist[GEAR_BITS:], self.gear)
+        m.d.sync += hist.eq(nxt)
+        # Timing: the window (and its TRAIN/MARK compares) is registered from the next
+        # history every cycle; ``slip`` changes only at a strobe and strobes are two
+        # cycles apart, so at every strobe it equals hist.bit_select(slip) exactly.
+        is_train, is_mark = Signal(), Signal()
+        window = nxt.bit_select(self.slip, WORD_BITS)
+        m.d.sync += [self.window.eq(window), is_train.eq(window == TRAIN),
+                     is_mark.eq(window == MARK)]
         with m.If(self.strobe):
             m.d.sync += self.word.eq(self.window)
         with m.If(self.restart):
             m.d.sync += [self.aligned.eq(0), good.eq(0)]
         with m.Elif(self.strobe & self.search & ~self.aligned):
-            with m.If(self.window == TRAIN):
+            with m.If(is_train):
                 m.d.sync += good.eq(good + 1)
                 with m.If(good == GOOD_WORDS - 1):
                     m.d.sync += self.aligned.eq(1)
-            with m.Elif(self.window != MARK):
+            with m.Elif(~is_mark):
                 m.d.sync += [good.eq(0), self.slip.eq(self.slip + 1)]
         return m

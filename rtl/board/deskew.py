@@ -47,14 +47,18 @@ class Deskew(wiring.Component):
         last = Signal(2)
         running = Signal()
         settled = Signal()  # delays set; ``out`` follows them from the next strobe
-        is_mark = Cat(self.words[i] == MARK for i in range(n))
+        # Timing: the MARK compares and the delays are registered every cycle; ``words``
+        # and the state change only at strobes (two cycles apart), so at every strobe
+        # they equal their combinational values exactly.
+        is_mark = Signal(n)
+        m.d.sync += is_mark.eq(Cat(self.words[i] == MARK for i in range(n)))
         newly = is_mark & ~marked
         base = Signal(2)
         m.d.comb += base.eq(Mux(running, count, 0))
         for i in range(n):
             line = [Signal(WORD_BITS, name=f"line{i}_{d}") for d in range(DEPTH - 1)]
             taps = Array([self.words[i], *line])
-            m.d.comb += self.delays[i].eq(last - arrive[i])
+            m.d.sync += self.delays[i].eq(last - arrive[i])
             with m.If(self.strobe):
                 m.d.sync += [line[0].eq(self.words[i]),
                              *(line[d].eq(line[d - 1]) for d in range(1, DEPTH - 1)),

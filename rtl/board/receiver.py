@@ -120,6 +120,21 @@ class LinkReceiver(wiring.Component):
         frame = words[f]
         payload = Cat(words[i] for i in range(fmt.data_pairs))[:fmt.payload_bits]
         beat_ok = Signal()
+        # Timing: every check on the aligned and deskewed words is registered each cycle;
+        # those words change only at strobes (two cycles apart), so at every strobe the
+        # registered checks equal their combinational values exactly.
+        def checked(value, name):
+            reg = Signal(len(value), name=name)
+            m.d.rx += reg.eq(value)
+            return reg
+        not_training = checked(Cat((a.word != TRAIN) & (a.word != MARK) for a in aligners),
+                               "not_training")
+        frame_training = checked((frame == TRAIN) | (frame == MARK), "frame_training")
+        frame_data = checked(frame[4:] == SYNC, "frame_data")
+        frame_valid = checked((frame & VALID).any(), "frame_valid")
+        parity_bad = checked(payload.xor() != (frame & PARITY).any(), "parity_bad")
+        off_frame = checked(Cat(words[i] != frame for i in range(f)), "off_frame")
+        off_train = checked(Cat(words[i] != TRAIN for i in range(f)), "off_train")
         m.submodules.fifo = fifo = AsyncFIFO(width=fmt.payload_bits + 2, depth=FIFO_DEPTH,
                                              r_domain="sync", w_domain="rx")
         overflow_rx = Signal()
@@ -128,14 +143,12 @@ class LinkReceiver(wiring.Component):
                 for a in aligners:
                     m.d.comb += [a.search.eq(1), a.restart.eq(train | drop)]
                 for i, a in enumerate(aligners):  # an aligned pair must keep training
-                    m.d.comb += err[i].eq(strobe & a.aligned
-                                          & (a.word != TRAIN) & (a.word != MARK))
+                    m.d.comb += err[i].eq(strobe & a.aligned & not_training[i])
                 with m.If(all_aligned & ~train & ~drop):
                     m.next = "DESKEW"
             with m.State("DESKEW"):
                 m.d.comb += deskew.start.eq(1)
-                for i, a in enumerate(aligners):
-                    m.d.comb += err[i].eq(strobe & (a.word != TRAIN) & (a.word != MARK))
+                m.d.comb += err.eq(Cat(strobe & not_training[i] for i in range(n)))
                 with m.If(train | drop):
                     m.d.comb += [a.restart.eq(1) for a in aligners]
                     m.next = "SEARCH"
@@ -143,18 +156,15 @@ class LinkReceiver(wiring.Component):
                     m.next = "LOCKED"
             with m.State("LOCKED"):
                 m.d.comb += [deskew.start.eq(1), locked_rx.eq(1)]
-                training = (frame == TRAIN) | (frame == MARK)
-                data_mode = frame[4:] == SYNC
                 with m.If(strobe):
-                    with m.If(training):
-                        m.d.comb += err[:f].eq(Cat(words[i] != frame for i in range(f)))
-                    with m.Elif(~data_mode):
+                    with m.If(frame_training):
+                        m.d.comb += err[:f].eq(off_frame)
+                    with m.Elif(~frame_data):
                         m.d.comb += err[f].eq(1)
-                    with m.Elif(frame & VALID):
-                        m.d.comb += [err[f].eq(payload.xor() != (frame & PARITY).any()),
-                                     beat_ok.eq(1)]
+                    with m.Elif(frame_valid):
+                        m.d.comb += [err[f].eq(parity_bad), beat_ok.eq(1)]
                     with m.Else():
-                        m.d.comb += err[:f].eq(Cat(words[i] != TRAIN for i in range(f)))
+                        m.d.comb += err[:f].eq(off_train)
                 with m.If(train | drop):
                     m.d.comb += [a.restart.eq(1) for a in aligners]
                     m.next = "SEARCH"

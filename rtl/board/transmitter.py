@@ -64,9 +64,12 @@ class LinkTransmitter(wiring.Component):
         m.d.comb += [ser.clock.eq(self.clock), self.pins.eq(ser.pins),
                      self.clock_out.eq(ser.clock_out)]
         m.submodules.tx_reset = ResetSynchronizer(ResetSignal("sync"), domain="tx")
-        m.submodules.fifo = fifo = AsyncFIFO(width=fmt.payload_bits + 2, depth=FIFO_DEPTH,
+        # the beat's parity is computed here, in the core domain, and crosses with it
+        # (timing: not a wide XOR behind the FIFO's read port at the SCLK rate)
+        m.submodules.fifo = fifo = AsyncFIFO(width=fmt.payload_bits + 3, depth=FIFO_DEPTH,
                                              r_domain="tx", w_domain="sync")
-        m.d.comb += [fifo.w_data.eq(self.beats.payload.as_value()),
+        m.d.comb += [fifo.w_data.eq(Cat(self.beats.payload.as_value(),
+                                        self.beats.payload.payload.xor())),
                      fifo.w_en.eq(self.beats.valid), self.beats.ready.eq(1)]
         with m.If(self.beats.valid & ~fifo.w_rdy):
             m.d.sync += self.overflow.eq(1)
@@ -77,11 +80,15 @@ class LinkTransmitter(wiring.Component):
         left = Signal(range(RESET_TRAINING + 1), init=RESET_TRAINING)
         period = Signal(range(TRAIN_PERIOD))
         m.d.tx += phase.eq(~phase)
-        training = (left != 0) | train
+        # Timing: registered; ``left`` changes only at ~phase cycles (two apart), so at
+        # each it is exact (``train``, a synchronised level, is one cycle later).
+        training = Signal(init=1)
+        m.d.tx += training.eq((left != 0) | train)
         payload = fifo.r_data[:fmt.payload_bits]
         sof, eol = fifo.r_data[fmt.payload_bits], fifo.r_data[fmt.payload_bits + 1]
         padded = Cat(payload, Const(0, fmt.data_pairs * WORD_BITS - fmt.payload_bits))
-        beat_frame = Cat(Const(VALID, 1), sof, eol, payload.xor(), Const(SYNC, 4))
+        parity = fifo.r_data[fmt.payload_bits + 2]
+        beat_frame = Cat(Const(VALID, 1), sof, eol, parity, Const(SYNC, 4))
         assert (SOF, EOL, PARITY) == (2, 4, 8)
         train_word = Mux(period == TRAIN_PERIOD - 1, MARK, TRAIN)
         take = ~phase & ~training & fifo.r_rdy

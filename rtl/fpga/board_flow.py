@@ -41,9 +41,13 @@ def prepare_board(core: wiring.Component, work_dir: Path, core_mhz: float,
     return top, plan
 
 
+#: The board front end's SCLK domains (net name parts) and their links.
+_LINK_NETS = (("receiver", "rx0"), ("transmitter", "tx0"))
+
+
 def _role(net: str, plan: PinPlan, core_mhz: float, constraint: float) -> str:
-    for link in plan.link_sides:
-        if link in net:
+    for part, link in _LINK_NETS:
+        if f"front_end.{part}." in net and link in plan.link_sides:
             return f"link {link} SCLK"
     return "core" if abs(constraint - core_mhz) < 1e-6 else "other"
 

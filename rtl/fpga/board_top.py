@@ -1,90 +1,76 @@
-"""A board top for place and route with real I/O: the core between LVDS links on real pins.
+"""A board top for place and route with real I/O: the board front end on real pins.
 
-Stand-in until the links' own front end (``rvsm.rtl.board``) lands: it has what the place
-and route needs (every core port reached from or driven to real differential pins through
-the ECP5 gearing primitives, real clocks) and none of the link protocol (no training,
-alignment, deskew or framing; the links' ``BoardFrontEnd`` replaces :class:`BoardTop`).
+:class:`BoardTop` places the links of :mod:`rvsm.rtl.board`: a
+:class:`~rvsm.rtl.board.front_end.BoardFrontEnd` (``LinkReceiver`` -> the streaming array ->
+``LinkTransmitter``) built with ``primitive="ecp5"`` (``IDDRX2F``/``ODDRX2F``, ``ECLKSYNCB``,
+``CLKDIVF``), so the place and route carries the real receiver (word alignment, deskew,
+the link state machine, the AsyncFIFO into the core clock) and transmitter (framing,
+training, the AsyncFIFO out of the core clock).
 
 * Clocks: the board oscillator (``clk_osc``, :attr:`BoardPorts.oscillator_mhz`) feeds an
   EHXPLLL: CLKOP = the transmit edge clock (4 x the core clock), CLKOS = the core clock
-  (domain ``sync``). Reset: ``rst_n`` low or the PLL out of lock, synchronised per domain.
-* Receive link ``rxK`` (``rxK_clk`` forwarded clock, ``rxK_d<i>`` data): ECLKSYNCB ->
-  edge clock, CLKDIVF /2 -> SCLK (domain ``rxK``); per pair an IDDRX2F gives 4 bits per
-  SCLK; two SCLK words make 8 bits per pair, written to an AsyncFIFO read in ``sync``.
-  The receive bits, links in order, drive the core's ``codes.payload`` (cyclically if
-  narrower); ``codes.valid`` is "every receive FIFO has a word".
-* Transmit link ``txK``: the core's output bits (``spikes`` payload and valid, in
-  signature order, zero-padded) cross into domain ``txK`` (SCLK = CLKDIVF /2 of the PLL's
-  edge clock through an ECLKSYNCB, so related to the core clock) through a ring of
-  :data:`RING` registered words; each word leaves in two SCLK halves through one ODDRX2F
-  per pair; the forwarded clock is an ODDRX2F sending 1010.
-* Control: a write-only serial port (``spi_sck``, ``spi_mosi``, ``spi_cs_n``; bits shifted
-  in on ``spi_sck`` rising, MSB first, applied when ``spi_cs_n`` rises) sets
-  ``{clear, thr.we, thr.addr, thr.data}``; ``led`` shows "receive FIFOs not empty".
+  (domain ``sync``). Reset: ``rst_n`` low or the PLL out of lock, synchronised.
+* Receive link ``rx0`` (``rx0_clk`` forwarded clock on a PCLK pair, ``rx0_d<i>``: the
+  receiver's pairs, the framing lane last): its SCLK is the front end's domain ``rx``.
+* Transmit link ``tx0`` (``tx0_d<i>``, the framing lane last, ``tx0_clk`` the forwarded
+  clock): its edge clock is the PLL's CLKOP, its SCLK the front end's domain ``tx``.
+* Control: a serial port (``spi_sck``, ``spi_mosi``, ``spi_cs_n``, ``spi_miso``; bits
+  shifted in on ``spi_sck`` rising, MSB first, applied when ``spi_cs_n`` rises) sets
+  ``{train, counters_reset, clear, thr.we, thr.addr, thr.data}`` (``counters_reset``,
+  ``thr.we`` and ``clear`` as one-cycle pulses); ``spi_miso`` shifts out, MSB first from
+  ``spi_cs_n`` falling, the status word (:func:`status_bits`). ``led`` is the receive
+  link's ``locked``; ``rx0_train_request`` the pin asking the sensor for training.
 
 At 100 MHz and a 400 MHz edge clock a pair carries 8 bits per core cycle (800 Mbit/s).
 """
 
 from __future__ import annotations
 
-from amaranth.hdl import (
-    Cat,
-    ClockDomain,
-    ClockSignal,
-    Const,
-    Elaboratable,
-    Instance,
-    Module,
-    ResetSignal,
-    Signal,
-)
-from amaranth.lib import wiring
+from amaranth.hdl import Cat, ClockDomain, ClockSignal, Elaboratable, Instance, Module, Signal
 from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
-from amaranth.lib.fifo import AsyncFIFO
 
 from rvsm.model.infra.errors import RvsmError
-from rvsm.rtl.fpga.harness import component_ports
+from rvsm.rtl.board.front_end import BoardFrontEnd, link_formats
 from rvsm.rtl.fpga.pin_plan import BoardPorts, LinkSpec
 
-__all__ = ["BITS_PER_PAIR", "CONTROLS", "BoardTop", "board_ports"]
+__all__ = ["BITS_PER_PAIR", "CONTROLS", "BoardTop", "board_ports", "status_bits"]
 
 #: Bits per pair per core cycle: X2 gearing (4 bits a SCLK) at SCLK = 2 x core clock.
 BITS_PER_PAIR = 8
 #: Single-ended control pins of the board top.
-CONTROLS = ("rst_n", "spi_sck", "spi_mosi", "spi_cs_n", "led")
-#: Words in a transmitter's clock-crossing ring.
-RING = 4
+CONTROLS = ("rst_n", "spi_sck", "spi_mosi", "spi_cs_n", "spi_miso", "led",
+            "rx0_train_request")
 #: PLL voltage-controlled oscillator frequency (MHz): within EHXPLLL's 400-800 MHz.
 VCO_MHZ = 800.0
 
 
-def _split(pairs: int, max_pairs: int) -> list[int]:
-    """``pairs`` as evenly as possible into links of at most ``max_pairs``."""
-    n = -(-pairs // max_pairs)
-    return [pairs // n + (i < pairs % n) for i in range(n)]
+def _array_of(core: object) -> tuple:
+    contract, lanes = getattr(core, "contract", None), getattr(core, "lanes", None)
+    if contract is None or lanes is None or not hasattr(core, "geometry"):
+        raise RvsmError("the board top needs the streaming array (rvsm fpga --arch stream)")
+    return contract, lanes
 
 
-def board_ports(core: wiring.Component, core_mhz: float = 100.0, osc_mhz: float = 100.0,
-                max_pairs_per_link: int = 64) -> BoardPorts:
-    """The links a :class:`BoardTop` around ``core`` has: receive pairs for
-    ``codes.payload``, transmit pairs for the outputs (:data:`BITS_PER_PAIR` bits per pair
-    per core cycle), links of at most ``max_pairs_per_link`` data pairs."""
-    ins, outs = _core_bits(core)
+def board_ports(core: object, core_mhz: float = 100.0, osc_mhz: float = 100.0) -> BoardPorts:
+    """The links of the board front end around ``core`` (a streaming array): ``rx0``
+    carries its codes (``P*N`` bits a beat, 8 a pair, plus the framing lane), ``tx0``
+    its spikes (``2*S*P`` bits a beat, positions implied by the framing, plus the framing
+    lane); each with a forwarded clock pair."""
+    contract, lanes = _array_of(core)
+    rx, tx = link_formats(contract, lanes)
     eclk = 4 * core_mhz
-    rx = _split(-(-ins // BITS_PER_PAIR), max_pairs_per_link)
-    tx = _split(-(-outs // BITS_PER_PAIR), max_pairs_per_link)
-    links = [LinkSpec(f"rx{i}", "rx", n, eclk) for i, n in enumerate(rx)]
-    links += [LinkSpec(f"tx{i}", "tx", n, eclk) for i, n in enumerate(tx)]
-    return BoardPorts(tuple(links), CONTROLS, "clk_osc", osc_mhz)
+    links = (LinkSpec("rx0", "rx", rx.pairs, eclk), LinkSpec("tx0", "tx", tx.pairs, eclk))
+    return BoardPorts(links, CONTROLS, "clk_osc", osc_mhz)
 
 
-def _core_bits(core: wiring.Component) -> tuple[int, int]:
-    ports = {p.name: p for p, _ in component_ports(core)}
-    if "codes.payload" not in ports or "spikes.payload" not in ports:
-        raise RvsmError("the board top needs a streaming core (codes and spikes streams)")
-    outs = sum(p.width for p in ports.values()
-               if p.direction == "out" and p.name.startswith("spikes"))
-    return ports["codes.payload"].width, outs
+def status_bits(front_end: BoardFrontEnd) -> Cat:
+    """The status word ``spi_miso`` shifts out (LSB here = last bit out): ``locked``,
+    ``aligned``, receive ``overflow``, ``tx_overflow``, ``lock_losses`` (8 bits),
+    ``framing_errors`` (16 bits), then every pair's 8-bit error counter, pair 0 first."""
+    st = front_end.status
+    return Cat(st.locked, st.aligned, st.overflow, front_end.tx_overflow, st.lock_losses,
+               front_end.framing_errors, *(st.lane_errors[i] for i in
+                                           range(len(front_end.rx_pins))))
 
 
 def _pll_divider(what: str, ratio: float) -> int:
@@ -94,17 +80,25 @@ def _pll_divider(what: str, ratio: float) -> int:
 
 
 class BoardTop(Elaboratable):
-    """``core`` between the links of ``ports`` (:func:`board_ports`); top-level ports
-    :attr:`pins` (name -> one-bit signal), named as in the pin plan. ``core_mhz``: the core
-    clock (CLKOS of the PLL)."""
+    """The board front end for ``core``'s contract and lanes (``core`` itself is the
+    front end's array: :class:`BoardFrontEnd` builds the same one) between the pins of
+    ``ports`` (:func:`board_ports`); top-level ports :attr:`pins` (name -> one-bit signal),
+    named as in the pin plan. ``core_mhz``: the core clock (CLKOS of the PLL)."""
 
     #: No test harness: the board top's I/O logic is part of the design's area.
     overhead_ff = 0
     overhead_lut = 0
 
-    def __init__(self, core: wiring.Component, ports: BoardPorts, core_mhz: float = 100.0):
+    def __init__(self, core: object, ports: BoardPorts, core_mhz: float = 100.0):
         self._MustUse__silence = True  # an __init__ that raises is not an unused design
-        self.core, self.ports, self.core_mhz = core, ports, core_mhz
+        contract, lanes = _array_of(core)
+        core._MustUse__silence = True  # replaced by the front end's own array
+        self.front_end = BoardFrontEnd(contract, lanes, primitive="ecp5")
+        self.ports, self.core_mhz = ports, core_mhz
+        links = {k.name: k for k in ports.links}
+        want = {"rx0": self.front_end.rx_format.pairs, "tx0": self.front_end.tx_format.pairs}
+        if {k: v.data_pairs for k, v in links.items()} != want:
+            raise RvsmError(f"the board top's links must be {want} pairs (board_ports)")
         self.pins: dict[str, Signal] = {}
         for link in ports.links:
             self.pins[link.clock_port] = Signal(name=link.clock_port)
@@ -112,6 +106,9 @@ class BoardTop(Elaboratable):
                 self.pins[link.data_port(i)] = Signal(name=link.data_port(i))
         for name in (ports.oscillator, *ports.controls):
             self.pins[name] = Signal(name=name)
+        missing = set(CONTROLS) - set(ports.controls)
+        if missing:
+            raise RvsmError(f"the board top needs the control pins {sorted(missing)}")
         eclks = {link.eclk_mhz for link in ports.links}
         if len(eclks) != 1:
             raise RvsmError("the board top's links share one edge clock frequency")
@@ -137,118 +134,51 @@ class BoardTop(Elaboratable):
             i_PLLWAKESYNC=0, i_ENCLKOP=0, o_CLKOP=tx_eclk, o_CLKOS=core_clk, o_LOCK=lock)
         return tx_eclk, core_clk, lock
 
-    def _edge(self, m: Module, link: LinkSpec, source: Signal) -> Signal:
-        """ECLKSYNCB + CLKDIVF /2 for ``link``: its domain (SCLK) and the edge clock."""
-        eclk, sclk = Signal(name=f"{link.name}_eclk"), Signal(name=f"{link.name}_sclk")
-        m.submodules[f"{link.name}_eclksync"] = Instance(
-            "ECLKSYNCB", i_ECLKI=source, i_STOP=0, o_ECLKO=eclk)
-        m.submodules[f"{link.name}_clkdiv"] = Instance(
-            "CLKDIVF", p_DIV="2.0", i_CLKI=eclk, i_RST=0, i_ALIGNWD=0, o_CDIVX=sclk)
-        m.domains += ClockDomain(link.name)
-        m.d.comb += ClockSignal(link.name).eq(sclk)
-        m.submodules[f"{link.name}_rst"] = ResetSynchronizer(ResetSignal("sync"),
-                                                             domain=link.name)
-        return eclk
-
-    def _receiver(self, m: Module, link: LinkSpec) -> AsyncFIFO:
-        eclk = self._edge(m, link, self.pins[link.clock_port])
-        n, dom = link.data_pairs, link.name
-        word = Signal(4 * n, name=f"{dom}_word")
-        for i in range(n):
-            m.submodules[f"{dom}_iddr{i}"] = Instance(
-                "IDDRX2F", i_D=self.pins[link.data_port(i)], i_ECLK=eclk,
-                i_SCLK=ClockSignal(dom), i_RST=ResetSignal(dom), i_ALIGNWD=0,
-                **{f"o_Q{k}": word[4 * i + k] for k in range(4)})
-        fifo = AsyncFIFO(width=8 * n, depth=4, w_domain=dom, r_domain="sync")
-        m.submodules[f"{dom}_fifo"] = fifo
-        first, half = Signal(name=f"{dom}_half"), Signal(4 * n, name=f"{dom}_first")
-        m.d[dom] += [half.eq(~half), first.eq(word)]
-        m.d.comb += [fifo.w_data.eq(Cat(first, word)), fifo.w_en.eq(half)]
-        return fifo
-
-    def _transmitter(self, m: Module, link: LinkSpec, tx_eclk: Signal,
-                     bits: Signal) -> None:
-        eclk = self._edge(m, link, tx_eclk)
-        n, dom = link.data_pairs, link.name
-        # Mesochronous ring: SCLK and the core clock come from one PLL (2 SCLK a core
-        # cycle), so a ring of RING words written every core cycle and read two SCLKs a
-        # word, RING / 2 words behind, never over- or underruns; no handshake to time.
-        ring = [Signal(8 * n, name=f"{dom}_ring{k}") for k in range(RING)]
-        wp = Signal(range(RING), name=f"{dom}_wp")
-        m.d.sync += wp.eq(wp + 1)
-        with m.Switch(wp):
-            for k in range(RING):
-                with m.Case(k):
-                    m.d.sync += ring[k].eq(bits)
-        count = Signal(range(2 * RING), name=f"{dom}_count", init=RING)
-        m.d[dom] += count.eq(count + 1)
-        out = Signal(4 * n, name=f"{dom}_out")
-        with m.Switch(count):
-            for k in range(2 * RING):
-                with m.Case(k):
-                    m.d[dom] += out.eq(ring[k // 2].word_select(k % 2, 4 * n))
-        for i in range(n):
-            m.submodules[f"{dom}_oddr{i}"] = Instance(
-                "ODDRX2F", i_ECLK=eclk, i_SCLK=ClockSignal(dom), i_RST=ResetSignal(dom),
-                **{f"i_D{k}": out[4 * i + k] for k in range(4)},
-                o_Q=self.pins[link.data_port(i)])
-        m.submodules[f"{dom}_oddr_clk"] = Instance(
-            "ODDRX2F", i_ECLK=eclk, i_SCLK=ClockSignal(dom), i_RST=ResetSignal(dom),
-            i_D0=1, i_D1=0, i_D2=1, i_D3=0, o_Q=self.pins[link.clock_port])
-
-    def _control(self, m: Module, ports: dict) -> None:
-        """The serial control port -> ``clear`` and the threshold write."""
+    def _control(self, m: Module, fe: BoardFrontEnd) -> None:
+        """The serial control port: commands in, the status word out."""
         sck, mosi, cs_n = (Signal(name=f"{n}_s") for n in ("sck", "mosi", "cs_n"))
         for pin, sig in (("spi_sck", sck), ("spi_mosi", mosi), ("spi_cs_n", cs_n)):
-            m.submodules[f"{pin}_sync"] = FFSynchronizer(self.pins[pin], sig, init=pin != "spi_sck")
-        targets = [ports[k] for k in ("thr.data", "thr.addr", "thr.we", "clear") if k in ports]
+            m.submodules[f"{pin}_sync"] = FFSynchronizer(self.pins[pin], sig,
+                                                         init=pin != "spi_sck")
+        targets = [fe.thr.data, fe.thr.addr, fe.thr.we, fe.clear, fe.control.counters_reset,
+                   fe.control.train]
+        pulses = (fe.thr.we, fe.clear, fe.control.counters_reset)
         width = sum(len(t) for t in targets)
         shift, command = Signal(width, name="spi_shift"), Signal(width, name="spi_command")
         sck_d, cs_d, apply = Signal(), Signal(init=1), Signal()
+        rising = ~cs_n & sck & ~sck_d
         m.d.sync += [sck_d.eq(sck), cs_d.eq(cs_n), apply.eq(cs_n & ~cs_d)]
-        with m.If(~cs_n & sck & ~sck_d):
+        with m.If(rising):
             m.d.sync += shift.eq(Cat(mosi, shift[:-1]))
         with m.If(cs_n & ~cs_d):
             m.d.sync += command.eq(shift)
         pos = 0
         for t in targets:
             value = command[pos:pos + len(t)]
-            is_pulse = t is ports.get("thr.we") or t is ports.get("clear")
-            m.d.comb += t.eq(value & apply if is_pulse else value)
+            m.d.comb += t.eq(value & apply if any(t is p for p in pulses) else value)
             pos += len(t)
+        status = status_bits(fe)
+        out = Signal(len(status), name="spi_status")
+        with m.If(~cs_n & cs_d):  # frame start: snapshot
+            m.d.sync += out.eq(status)
+        with m.Elif(rising):
+            m.d.sync += out.eq(Cat(0, out[:-1]))
+        m.d.comb += self.pins["spi_miso"].eq(out[-1])
 
     def elaborate(self, platform: object) -> Module:
         m = Module()
-        m.submodules.core = self.core
+        m.submodules.front_end = fe = self.front_end
         tx_eclk, core_clk, lock = self._pll(m)
         m.domains.sync = ClockDomain("sync")
         m.d.comb += ClockSignal("sync").eq(core_clk)
         m.submodules.rst_sync = ResetSynchronizer(~self.pins["rst_n"] | ~lock, domain="sync")
-        ports = {p.name: v for p, v in component_ports(self.core)}
-
-        rx = [self._receiver(m, k) for k in self.ports.links if k.direction == "rx"]
-        every = Const(1, 1)
-        for f in rx:
-            every = every & f.r_rdy
-        ready = ports.get("codes.ready", Const(1, 1))
-        rx_bits = Cat(*(f.r_data for f in rx))
-        codes = ports["codes.payload"]
-        m.d.comb += [codes.eq(Cat(*(rx_bits[i % len(rx_bits)] for i in range(len(codes))))),
-                     ports["codes.valid"].eq(every)]
-        for f in rx:
-            m.d.comb += f.r_en.eq(every & ready)
-        m.d.comb += self.pins["led"].eq(every)
-        self._control(m, ports)
-
-        out_bits = Cat(*(v for p, v in component_ports(self.core)
-                         if p.direction == "out" and p.name.startswith("spikes")))
-        tx_reg = Signal(len(out_bits), name="tx_bits")
-        m.d.sync += tx_reg.eq(out_bits)
-        pos = 0
-        for link in (k for k in self.ports.links if k.direction == "tx"):
-            width = 8 * link.data_pairs
-            chunk = Signal(width, name=f"{link.name}_bits")
-            m.d.comb += chunk.eq(tx_reg[pos:pos + width])
-            self._transmitter(m, link, tx_eclk, chunk)
-            pos += width
+        rx, tx = (next(k for k in self.ports.links if k.name == n) for n in ("rx0", "tx0"))
+        m.d.comb += [fe.rx_clock.eq(self.pins[rx.clock_port]), fe.tx_clock.eq(tx_eclk),
+                     self.pins[tx.clock_port].eq(fe.tx_clock_out),
+                     self.pins["led"].eq(fe.status.locked),
+                     self.pins["rx0_train_request"].eq(fe.train_request)]
+        m.d.comb += [fe.rx_pins[i].eq(self.pins[rx.data_port(i)]) for i in range(rx.data_pairs)]
+        m.d.comb += [self.pins[tx.data_port(i)].eq(fe.tx_pins[i])
+                     for i in range(tx.data_pairs)]
+        self._control(m, fe)
         return m

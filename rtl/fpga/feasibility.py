@@ -18,7 +18,8 @@ lane counts that divide ``W`` from the fewest up and checks at each:
   place-and-route figure of this point when one is given; no figure: unknown;
 * **io**: the ADC codes in and the spikes out at the camera's rate over the package's
   pairs (:func:`~rvsm.rtl.fpga.io_budget.io_plan`: X2 gearing, a clock and a framing
-  pair per link, output pairs on true-LVDS drivers, links placed per bank or per side);
+  pair per link, output pairs on true-LVDS drivers, links placed by the pin planner's
+  edge-clock rule, :func:`~rvsm.rtl.fpga.pin_plan.edge_clock_placements`);
   unknown on a package without per-bank figures (every family but the ECP5).
 
 The point is feasible at the fewest lanes where all of them hold; otherwise the verdicts are
@@ -242,7 +243,7 @@ def _io_check(layout: StateLayout, device: DeviceBudget, camera: Camera, core_hz
 def _checks_at(layout: StateLayout, device: DeviceBudget, camera: Camera, lanes: int,
                logic: LogicCost | None, measured: MeasuredFmax | None,
                max_utilisation: float, organisation: str, package: str | None = None,
-               io_links: str = "bank"
+               io_links: str = "side"
                ) -> tuple[dict[str, Check], StatePacking, float, IoPlan | None]:
     need = clock_needed_hz(camera.height, camera.width, lanes, camera.rate_hz)
     sp = pack_state(layout, lanes, device, organisation)
@@ -289,7 +290,7 @@ def assess(layout: StateLayout, device: DeviceBudget, camera: Camera,
            logic: LogicCost | None, *, measured: MeasuredFmax | None = None,
            max_utilisation: float = DEFAULT_MAX_UTILISATION,
            organisation: str = "packed", package: str | None = None,
-           io_links: str = "bank") -> Feasibility:
+           io_links: str = "side") -> Feasibility:
     """The :class:`Feasibility` of ``layout`` (at the camera's size) on ``device`` (module
     docstring) in ``package`` (None: the device's default), links placed per ``io_links``
     (:data:`~rvsm.rtl.fpga.io_budget.SCOPES`). ``layout`` must be the camera's size."""

@@ -13,15 +13,26 @@ A pair geared ``g`` (:class:`~rvsm.rtl.fpga.package_io.Gearing`) carries at most
 core cycle (ECP5 X2 at 100 MHz: 4 bits per 200 MHz CLKDIVF cycle from a 400 MHz edge
 clock, 8 bits per core cycle), so a direction needs ``ceil(ceil(bits_per_s / f) / b)``
 data pairs (35 in, 20 out); a core clock above the pair's rate: ``b = 0`` and
-``ceil(bits_per_s / max)`` pairs. Every **link** adds a forwarded clock pair and a framing /
-training pair (:data:`LINK_OVERHEAD_PAIRS`).
+``ceil(bits_per_s / max)`` pairs. Each direction is **one link**, as the board front end
+builds it (:mod:`rvsm.rtl.board`, :func:`rvsm.rtl.fpga.board_top.board_ports`): its data
+pairs, a framing / training lane and a forwarded clock pair (:data:`LINK_OVERHEAD_PAIRS`).
 
-**Placement** (:func:`place_links`): a link lives in one *group* of pins sharing its edge
-clock: one bank (``scope="bank"``, the bank's own ECLKSYNCB) or one side (``"side"``,
-both banks of a side on one edge clock through ECLKBRIDGECS or a PLL). Output pairs need
-a true LVDS driver (an A/B pair); input pairs take any pair left. Per group at most one
-link each way; :func:`place_links` finds the placement that carries the outputs and the
-most input pairs (an exact small dynamic programme over the groups).
+**Placement** (:func:`place_links`) follows the pin planner's edge-clock rule, one rule for
+both (:func:`rvsm.rtl.fpga.pin_plan.edge_clock_placements`): links only on the left and
+right banks (the IOLOGIC gearing), at most two links a side, and either one link alone on
+its side spanning both of its banks, or two links sharing one bank. Why this rule: it is
+what nextpnr-ecp5 places (the planner's rule was checked by placing small designs, and the
+full sensor's 37-pair receive link spans banks 6 and 7 in ``make bench-board``): an edge
+clock reaches the other bank of its side through the bank edge-clock bridge
+(``ECLKBRIDGECS``, Lattice FPGA-TN-02035 "ECP5 and ECP5-5G High-Speed I/O Interface",
+edge clock structure), while nextpnr-ecp5 0.11 gives each link the first free ECLK index
+of every bank it touches, so two links in the two banks of one side collide on that
+side's CLKDIVF 0. ``scope="side"`` is that rule (the default); ``scope="bank"`` keeps
+every link inside one bank (no bridge). Transmit pairs (data, framing and clock) need a
+true LVDS driver (an A/B pair); receive pairs take any pair. The counts per bank are
+:data:`~rvsm.rtl.fpga.package_io.ECP5_BANKS` (on the ECP5-85 derived from the planner's
+pin tables); ``tests/rtl/fpga/test_io_budget.py`` checks that the verdict equals
+:func:`~rvsm.rtl.fpga.pin_plan.plan_pins` on every ECP5-85 package.
 """
 
 from __future__ import annotations
@@ -32,14 +43,16 @@ from typing import Any
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.package_io import BankIo, PackageIo
+from rvsm.rtl.fpga.pin_plan import SIDES, LinkSpec, edge_clock_placements
 
 __all__ = ["LINK_OVERHEAD_PAIRS", "SCOPES", "Group", "GroupUse", "IoPlan", "LinkPlan",
-           "Placement", "groups_of", "io_plan", "link_plan", "place_links"]
+           "Placement", "io_plan", "link_plan", "place_links"]
 
 #: Pairs every link adds: a forwarded clock and a framing / training lane.
 LINK_OVERHEAD_PAIRS = 2
-#: What one link's edge clock reaches: one bank, or both banks of a side.
-SCOPES = ("bank", "side")
+#: What one link's edge clock reaches: both banks of its side when alone there (the
+#: planner's rule, the default), or one bank.
+SCOPES = ("side", "bank")
 
 
 @dataclass(frozen=True)
@@ -81,25 +94,9 @@ class Group:
     lvds_out_pairs: int
 
 
-def groups_of(banks: tuple[BankIo, ...], scope: str, edge_only: bool = True
-              ) -> tuple[Group, ...]:
-    """The link groups of ``banks`` (only edge-clock banks when ``edge_only``)."""
-    if scope not in SCOPES:
-        raise RvsmError(f"link scope must be one of {', '.join(SCOPES)}, got {scope!r}")
-    use = [b for b in banks if b.edge_clock or not edge_only]
-    if scope == "bank":
-        return tuple(Group(f"bank {b.bank}", b.pairs, b.lvds_out_pairs) for b in use)
-    sides: dict[str, list[BankIo]] = {}
-    for b in use:
-        sides.setdefault(b.side, []).append(b)
-    return tuple(Group(f"{s} (banks {', '.join(str(b.bank) for b in bs)})",
-                       sum(b.pairs for b in bs), sum(b.lvds_out_pairs for b in bs))
-                 for s, bs in sides.items())
-
-
 @dataclass(frozen=True)
 class GroupUse:
-    """Data pairs of each direction one group carries (a link each way where > 0)."""
+    """The data pairs of each direction one group carries (a link each way where > 0)."""
 
     group: Group
     in_data: int
@@ -115,58 +112,61 @@ class GroupUse:
 
 @dataclass(frozen=True)
 class Placement:
-    """The best placement: ``uses`` per group, ``max_in`` input data pairs the groups
-    carry beside the outputs (-1: the outputs do not place), ``max_out`` output data pairs
-    the groups carry at most."""
+    """Where the two links go (``uses``: one per group holding a link; empty when they do
+    not place) and ``reason``: the binding figure when they do not
+    ``(figure, budget, unit)``."""
 
     uses: tuple[GroupUse, ...]
-    max_in: int
-    max_out: int
+    reason: tuple[int, int, str] | None = None
 
-    def fits(self, in_data: int) -> bool:
-        """The outputs place and ``in_data`` input pairs fit beside them."""
-        return self.max_in >= in_data
+    @property
+    def placed(self) -> bool:
+        return bool(self.uses)
 
 
-def _out_options(g: Group) -> list[int]:
+def _group(banks: dict[int, BankIo], side: str, which: tuple[int, ...]) -> Group:
+    name = ("left" if side == "L" else "right") + f" (bank{'s' * (len(which) > 1)} " \
+        + "+".join(str(b) for b in which) + ")"
+    return Group(name, sum(banks[b].pairs for b in which if b in banks),
+                 sum(banks[b].lvds_out_pairs for b in which if b in banks))
+
+
+def place_links(banks: tuple[BankIo, ...], in_data: int, out_data: int,
+                scope: str = "side") -> Placement:
+    """Place one receive link of ``in_data`` data pairs and one transmit link of
+    ``out_data`` (each + :data:`LINK_OVERHEAD_PAIRS`) on ``banks`` under the planner's
+    edge-clock rule (module docstring); ``scope="bank"``: every link in one bank."""
+    if scope not in SCOPES:
+        raise RvsmError(f"link scope must be one of {', '.join(SCOPES)}, got {scope!r}")
     k = LINK_OVERHEAD_PAIRS
-    return [0] + list(range(1, max(0, min(g.lvds_out_pairs, g.pairs) - k) + 1))
-
-
-def _in_left(g: Group, out: int) -> int:
-    left = g.pairs - (out + LINK_OVERHEAD_PAIRS if out else 0)
-    return max(0, left - LINK_OVERHEAD_PAIRS)
-
-
-def place_links(groups: tuple[Group, ...], out_data: int, in_data: int) -> Placement:
-    """Place ``out_data`` output and ``in_data`` input data pairs in ``groups`` (module
-    docstring): per group the output data it takes, the rest of its pairs to inputs."""
-    max_out = sum(max(_out_options(g)) for g in groups)
-    # best[o] = (most input pairs, choices) with o = output pairs placed, capped at out_data
-    best: dict[int, tuple[int, tuple[int, ...]]] = {0: (0, ())}
-    for g in groups:
-        nxt: dict[int, tuple[int, tuple[int, ...]]] = {}
-        for o_sum, (i_sum, picks) in best.items():
-            for o in _out_options(g):
-                key = min(out_data, o_sum + o)
-                cand = (i_sum + _in_left(g, o), picks + (o,))
-                if key not in nxt or cand[0] > nxt[key][0]:
-                    nxt[key] = cand
-        best = nxt
-    if out_data not in best:
-        return Placement((), -1, max_out)
-    max_in, picks = best[out_data]
-    outs, need_o = [], out_data
-    for o in picks:
-        outs.append(min(o, need_o))
-        need_o -= outs[-1]
-    ins, need_i = [0] * len(groups), in_data  # the roomiest groups first: fewest links
-    for k in sorted(range(len(groups)), key=lambda k: -_in_left(groups[k], outs[k])):
-        ins[k] = min(_in_left(groups[k], outs[k]), need_i)
-        need_i -= ins[k]
-    return Placement(tuple(GroupUse(g, i, o) for g, i, o in zip(groups, ins, outs,
-                                                                 strict=True)),
-                     max_in, max_out)
+    by_bank = {b.bank: b for b in banks if b.edge_clock}
+    links = [LinkSpec("rx0", "rx", in_data + k - 1), LinkSpec("tx0", "tx", out_data + k - 1)]
+    need = {"rx0": in_data + k, "tx0": out_data + k}
+    for where in edge_clock_placements(links):
+        if scope == "bank" and any(len(b) > 1 for _, b in where.values()):
+            continue
+        groups = {n: _group(by_bank, side, b) for n, (side, b) in where.items()}
+        if where["rx0"] == where["tx0"]:  # two links in one bank
+            g = groups["rx0"]
+            ok = need["tx0"] <= g.lvds_out_pairs and need["rx0"] + need["tx0"] <= g.pairs
+            uses = (GroupUse(g, in_data, out_data),)
+        else:
+            ok = (need["tx0"] <= groups["tx0"].lvds_out_pairs
+                  and need["rx0"] <= groups["rx0"].pairs)
+            uses = (GroupUse(groups["rx0"], in_data, 0), GroupUse(groups["tx0"], 0, out_data))
+        if ok:
+            return Placement(uses)
+    spans = [(s, b) for s, pair in SIDES.items()
+             for b in ((pair,) if scope == "side" else ()) + ((pair[0],), (pair[1],))]
+    best = [_group(by_bank, s, b) for s, b in spans]
+    most_lvds = max((g.lvds_out_pairs for g in best), default=0)
+    most_pairs = max((g.pairs for g in best), default=0)
+    if need["tx0"] > most_lvds:
+        return Placement((), (need["tx0"], most_lvds, "true-LVDS transmit pairs on one "
+                                                      "edge clock"))
+    if need["rx0"] > most_pairs:
+        return Placement((), (need["rx0"], most_pairs, "receive pairs on one edge clock"))
+    return Placement((), (need["rx0"] + need["tx0"], most_pairs, "pairs on one side"))
 
 
 @dataclass(frozen=True)
@@ -184,8 +184,8 @@ class IoPlan:
 
     @property
     def fits(self) -> bool:
-        """Every output and input pair placed, with its links' clock and framing pairs."""
-        return self.placement.fits(self.input.data_pairs)
+        """Both links placed, with their clock and framing pairs."""
+        return self.placement.placed
 
     @property
     def links(self) -> tuple[int, int]:
@@ -193,27 +193,28 @@ class IoPlan:
         return (sum(1 for u in self.placement.uses if u.in_data),
                 sum(1 for u in self.placement.uses if u.out_data))
 
+    @property
+    def pairs_needed(self) -> int:
+        """Pairs of both links: data, framing and forwarded clock."""
+        return self.input.data_pairs + self.output.data_pairs + 2 * LINK_OVERHEAD_PAIRS
+
     def verdict(self) -> tuple[float, float, str, str]:
         """``(figure, budget, unit, detail)``: the binding budget, as the checks say it."""
         i, o, p = self.input, self.output, self.placement
         rates = (f"in {i.bits_per_s / 1e9:.1f} Gbit/s = {i.data_pairs} pairs x "
                  f"{i.bits_per_pair_per_cycle} bits per core cycle, out "
                  f"{o.bits_per_s / 1e9:.1f} Gbit/s = {o.data_pairs} pairs, {i.gearing} "
-                 f"gearing at {i.rate_per_pair_bps / 1e6:g} Mbit/s per pair, +"
-                 f"{LINK_OVERHEAD_PAIRS} pairs (clock, framing) per link, links per "
+                 f"gearing at {i.rate_per_pair_bps / 1e6:g} Mbit/s per pair, one link each "
+                 f"way +{LINK_OVERHEAD_PAIRS} pairs (clock, framing), edge clocks per "
                  f"{self.scope}, {self.package}")
-        if p.max_in < 0:
-            return (o.data_pairs, p.max_out, "true-LVDS output data pairs",
-                    f"{rates}; the outputs do not place")
-        li, lo = self.links
-        if not self.fits:
-            return (i.data_pairs, p.max_in, "input data pairs",
-                    f"{rates}; beside the outputs the banks carry {p.max_in}")
-        used = sum(u.pairs_used for u in p.uses)
-        return (used, self.edge_pairs, "pairs",
-                f"{rates}; {li} input and {lo} output links; "
-                f"{o.data_pairs + LINK_OVERHEAD_PAIRS * lo} of "
-                f"{self.edge_lvds_out_pairs} true-LVDS pairs")
+        if not p.placed:
+            figure, budget, unit = p.reason
+            return (figure, budget, unit, f"{rates}; the links do not place")
+        where = "; ".join(f"{u.group.name}: " + " + ".join(
+            f"{d} {n + LINK_OVERHEAD_PAIRS}" for d, n in (("rx", u.in_data),
+                                                          ("tx", u.out_data)) if n)
+            for u in p.uses)
+        return (self.pairs_needed, self.edge_pairs, "pairs", f"{rates}; {where}")
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready figures."""
@@ -223,10 +224,9 @@ class IoPlan:
                 "detail": detail,
                 "input": vars(self.input), "output": vars(self.output),
                 "links": {"in": self.links[0], "out": self.links[1]},
+                "pairs_needed": self.pairs_needed,
                 "edge_pairs": self.edge_pairs,
                 "edge_lvds_out_pairs": self.edge_lvds_out_pairs,
-                "max_input_data_pairs": self.placement.max_in,
-                "max_output_data_pairs": self.placement.max_out,
                 "groups": [{"group": u.group.name, "pairs": u.group.pairs,
                             "lvds_out_pairs": u.group.lvds_out_pairs, "in_data": u.in_data,
                             "out_data": u.out_data, "pairs_used": u.pairs_used}
@@ -234,7 +234,7 @@ class IoPlan:
 
 
 def io_plan(layout: Any, rate_hz: float, package: PackageIo, core_hz: float,
-            gearing: str = "x2", scope: str = "bank") -> IoPlan:
+            gearing: str = "x2", scope: str = "side") -> IoPlan:
     """The :class:`IoPlan` of ``layout`` (an ArrayContract or a StateLayout: height,
     width, ADC bits and scales) at ``rate_hz`` steps/s on ``package`` at ``core_hz``."""
     if package.estimate_only:
@@ -243,12 +243,14 @@ def io_plan(layout: Any, rate_hz: float, package: PackageIo, core_hz: float,
     if g.max_mbps_per_pair is None:
         raise RvsmError(f"{package.name}: the {gearing} gearing's rate per pair is "
                         f"unconfirmed; use one with a rate ({g.source})")
+    if scope not in SCOPES:
+        raise RvsmError(f"link scope must be one of {', '.join(SCOPES)}, got {scope!r}")
     scales = getattr(layout, "num_scales", None) or len(layout.scales)
     pixels_per_s = layout.height * layout.width * rate_hz
     max_bps = g.max_mbps_per_pair * 1e6
     inp = link_plan("in", pixels_per_s * layout.adc_bits, core_hz, gearing, max_bps)
     out = link_plan("out", pixels_per_s * scales * 2, core_hz, gearing, max_bps)
-    groups = groups_of(package.banks, scope, edge_only=g.edge_banks)
+    edge = [b for b in package.banks if b.edge_clock or not g.edge_banks]
     return IoPlan(package.name, core_hz, scope, inp, out,
-                  place_links(groups, out.data_pairs, inp.data_pairs),
-                  sum(gr.pairs for gr in groups), sum(gr.lvds_out_pairs for gr in groups))
+                  place_links(package.banks, inp.data_pairs, out.data_pairs, scope),
+                  sum(b.pairs for b in edge), sum(b.lvds_out_pairs for b in edge))

@@ -9,7 +9,10 @@ bank). Counted from Project Trellis' database (``prjtrellis-db``, commit
 bank); the totals are the data sheet's user I/O (205 on the LFE5U-85F CABGA381, 259 on
 the CABGA554, 365 on the CABGA756). Banks 2, 3 (right) and 6, 7 (left) have edge clocks,
 so the X2 and 7:1 gearing; 0, 1 (top), 4 and 8 (bottom) serve X1 and single-ended I/O.
-A later pin planner checks these counts against its own pin table (one dict, below).
+On the LFE5U-85F the counts are derived from the pin planner's own tables
+(:mod:`rvsm.rtl.fpga.package_pins`, the same prjtrellis-db commit), so the budget and the
+planner count the same pins; the 25k and 45k dies have no pin table here and keep the
+counts read from the same database.
 
 **Other families**: their packages' user I/O where known, no per-bank table and no gearing
 model: :attr:`PackageIo.estimate_only`, so the I/O budget is unknown there, not a verdict.
@@ -20,12 +23,12 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 from rvsm.model.infra.errors import RvsmError
+from rvsm.rtl.fpga.package_pins import PACKAGES as PIN_TABLE_PACKAGES
+from rvsm.rtl.fpga.package_pins import TRELLIS_DB_COMMIT, load_package
 
 __all__ = ["ECP5_BANKS", "ECP5_GEARINGS", "TRELLIS_DB_COMMIT", "BankIo", "Gearing",
            "PackageIo", "ecp5_packages", "estimate_only"]
 
-#: The prjtrellis-db commit the ECP5 bank counts were read from.
-TRELLIS_DB_COMMIT = "4dda149b9e4f1753ebc8b011ece2fe794be1281a"
 TRELLIS_SOURCE = (f"counted from Project Trellis prjtrellis-db {TRELLIS_DB_COMMIT[:7]} "
                   "ECP5/{die}/iodb.json (pins per package, bank per PIO; A/B and C/D "
                   "pairs with both pins bonded; true LVDS on A/B pairs of banks 2, 3, 6, 7)")
@@ -97,16 +100,19 @@ ECP5_BANKS: dict[tuple[str, str], dict[int, tuple[int, int, int]]] = {
     ("LFE5U-45F", "CABGA554"): {0: (32, 16, 0), 1: (40, 20, 0), 2: (32, 16, 8),
                                 3: (48, 24, 12), 6: (48, 24, 12), 7: (32, 16, 8),
                                 8: (13, 6, 0)},
-    ("LFE5U-85F", "CABGA381"): {0: (27, 13, 0), 1: (33, 16, 0), 2: (34, 17, 9),
-                                3: (33, 16, 8), 6: (33, 16, 8), 7: (32, 16, 8),
-                                8: (13, 6, 0)},
-    ("LFE5U-85F", "CABGA554"): {0: (32, 16, 0), 1: (40, 20, 0), 2: (32, 16, 8),
-                                3: (48, 24, 12), 4: (14, 7, 0), 6: (48, 24, 12),
-                                7: (32, 16, 8), 8: (13, 6, 0)},
-    ("LFE5U-85F", "CABGA756"): {0: (56, 28, 0), 1: (48, 24, 0), 2: (48, 24, 12),
-                                3: (64, 32, 16), 4: (24, 12, 0), 6: (64, 32, 16),
-                                7: (48, 24, 12), 8: (13, 6, 0)},
 }
+
+
+def _from_pin_table(package: str) -> dict[int, tuple[int, int, int]]:
+    """Per bank ``(pins, pairs, true-LVDS output pairs)`` of the LFE5U-85F in ``package``,
+    counted from the pin planner's table (:mod:`rvsm.rtl.fpga.package_pins`)."""
+    return {b: (r["pins"], r["pairs"], r["lvds_output"])
+            for b, r in load_package(package).bank_summary().items()}
+
+
+#: The ECP5-85 packages: derived from the pin tables the pin planner places with, so the
+#: I/O budget and the planner count the same pins.
+ECP5_BANKS.update({("LFE5U-85F", pk): _from_pin_table(pk) for pk in PIN_TABLE_PACKAGES})
 #: The LFE5UM5G-85F (ECP5-5G) has the LFE5U-85F's pins in each package (the same
 #: iodb.json counts) and two DCUs of two SerDes channels at up to 5 Gbit/s.
 ECP5_5G_SERDES = (4, 5.0, "Lattice FPGA-DS-02012 ECP5 and ECP5-5G Family Data Sheet, "

@@ -34,7 +34,8 @@ from itertools import product
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.package_pins import PACKAGES, DiffPair, PackagePins, load_package
 
-__all__ = ["BoardPorts", "LinkSpec", "PinPlan", "PinSite", "plan_pins", "plan_pins_in"]
+__all__ = ["SIDES", "BoardPorts", "LinkSpec", "PinPlan", "PinSite", "edge_clock_placements",
+           "plan_pins", "plan_pins_in"]
 
 #: Banks of each gearing side.
 SIDES = {"L": (6, 7), "R": (2, 3)}
@@ -136,7 +137,8 @@ class PinPlan:
                 "sites": [s.__dict__ for s in self.sites]}
 
 
-def _placements(links: Sequence[LinkSpec]) -> Iterator[dict[str, tuple[str, tuple[int, ...]]]]:
+def edge_clock_placements(links: Sequence[LinkSpec]
+                          ) -> Iterator[dict[str, tuple[str, tuple[int, ...]]]]:
     """Every (side, banks) choice per link that the edge-clock rules allow, links alone
     on a side spanning both banks tried first."""
     choices = [(side, banks) for side, pair in SIDES.items()
@@ -212,7 +214,7 @@ def plan_pins_in(ports: BoardPorts, package: str) -> PinPlan:
         raise RvsmError(f"{len(links)} links need {len(links)} edge clocks with a CLKDIVF "
                         "each; the ECP5 has 4 CLKDIVF (2 a side): merge links")
     assigned = where = None
-    for where in _placements(links):
+    for where in edge_clock_placements(links):
         assigned = _assign(table, links, where)
         if assigned is not None:
             break

@@ -7,7 +7,7 @@ A sweep file may say, before its tables::
     memory_organisation = "packed"                    # rtl | per-scale | packed (default)
     max_utilisation = 0.8                             # LUT4 / FF share allowed (default)
     package = "CABGA554"                              # default: the device's first
-    io_links = "bank"                                 # bank (default) | side
+    io_links = "side"                                 # side (default) | bank
 
 :func:`assess_design` checks one design of a results database against each device
 (:func:`rvsm.rtl.fpga.feasibility.assess`: its state at the camera's size packed into
@@ -58,7 +58,7 @@ class FitConstraint:
     max_utilisation: float = DEFAULT_MAX_UTILISATION
     #: The package (None: each device's default) and what one link's clock reaches.
     package: str | None = None
-    io_links: str = "bank"
+    io_links: str = "side"
 
     def text(self) -> str:
         """``"ecp5-85 at 250x400 at 40,000 Hz (packed state, 80 % of the logic)"``."""
@@ -107,7 +107,7 @@ def parse_constraint(data: dict[str, Any], source: str) -> FitConstraint | None:
                 get_budget(n).package_io(package)
             except RvsmError as exc:
                 raise RvsmError(f"{source}: package: {exc}") from None
-    links = data.get("io_links", "bank")
+    links = data.get("io_links", "side")
     if links not in SCOPES:
         raise RvsmError(f"{source}: io_links must be one of {', '.join(SCOPES)}, got "
                         f"{links!r}")

@@ -21,7 +21,7 @@ def _dog2_a17_shared() -> StateLayout:
 
 
 def test_dog2_a17_shared_thresholds_fits_the_ecp5_85_at_40_lanes() -> None:
-    f = assess(_dog2_a17_shared(), ECP5, CAMERA, DEFAULT_LOGIC, package="CABGA554")
+    f = assess(_dog2_a17_shared(), ECP5, CAMERA, DEFAULT_LOGIC, package="CABGA756")
     assert f.feasible and f.lanes == 40 and f.clock_needed_hz == 100e6
     c = f.checks
     assert (c["memory"].figure, c["memory"].budget) == (190, 208)
@@ -33,27 +33,29 @@ def test_dog2_a17_shared_thresholds_fits_the_ecp5_85_at_40_lanes() -> None:
     # P = 40, the full sensor placed and routed)
     assert c["fmax"].budget == 115.7 and "measured at P = 40" in c["fmax"].detail
     assert "feasible on ecp5-85 at P = 40" in f.summary()
-    # I/O on the CABGA554, links per bank: 35 + 20 data pairs, 3 in + 2 out links
-    assert (c["io"].figure, c["io"].budget, c["io"].unit) == (35 + 20 + 2 * 5, 80, "pairs")
+    # I/O on the CABGA756: one link each way, 35 + 20 data pairs + 2 x (clock, framing)
+    assert (c["io"].figure, c["io"].budget, c["io"].unit) == (35 + 20 + 2 * 2, 112, "pairs")
 
 
-def test_only_the_io_breaks_on_the_cabga381_with_a_link_per_bank() -> None:
+def test_only_the_io_breaks_on_the_cabga381() -> None:
     f = assess(_dog2_a17_shared(), ECP5, CAMERA, DEFAULT_LOGIC)  # CABGA381 by default
     assert [c.name for c in f.broken] == ["io"] and f.lanes == 40
     io = f.checks["io"]
-    # 28 Gbit/s in = 35 pairs of 8 bits a 100 MHz cycle; beside 20 output pairs on true
-    # LVDS drivers, banks 2, 3, 6, 7 (65 pairs) carry 29 input data pairs
-    assert (io.figure, io.budget, io.unit) == (35, 29, "input data pairs")
-    assert "io BREAKS: 35 / 29 input data pairs (+21 %)" in f.summary()
+    # 28 Gbit/s in = 35 pairs of 8 bits a 100 MHz cycle, 16 Gbit/s out = 20 pairs; the
+    # transmit link (+ framing + clock) needs 22 true-LVDS pairs on one edge clock, the
+    # right side (banks 2+3) has 17
+    assert (io.figure, io.budget, io.unit) == (22, 17,
+                                               "true-LVDS transmit pairs on one edge clock")
+    assert "io BREAKS: 22 / 17 true-LVDS transmit pairs on one edge clock (+29 %)" in \
+        f.summary()
     assert f.io is not None and f.io.input.bits_per_pair_per_cycle == 8
-    assert f.to_dict()["io"]["links"] == {"in": 4, "out": 4}
-    # one link per side (an edge clock across both banks): 63 of 65 pairs
-    side = assess(_dog2_a17_shared(), ECP5, CAMERA, DEFAULT_LOGIC, io_links="side")
-    assert side.feasible and (side.checks["io"].figure, side.checks["io"].budget) == (63, 65)
+    assert f.to_dict()["io"]["links"] == {"in": 0, "out": 0}
+    bank = assess(_dog2_a17_shared(), ECP5, CAMERA, DEFAULT_LOGIC, io_links="bank")
+    assert (bank.checks["io"].figure, bank.checks["io"].budget) == (22, 9)
     with pytest.raises(RvsmError, match="no package 'QFN9'; choose one of: LFE5U-85F "
                                         "CABGA381"):
         assess(_dog2_a17_shared(), ECP5, CAMERA, DEFAULT_LOGIC, package="QFN9")
-    with pytest.raises(RvsmError, match="io_links must be one of bank, side"):
+    with pytest.raises(RvsmError, match="io_links must be one of side, bank"):
         assess(_dog2_a17_shared(), ECP5, CAMERA, DEFAULT_LOGIC, io_links="chip")
 
 
@@ -61,9 +63,10 @@ def test_default_point_breaks_memory_with_its_figures() -> None:
     lay = StateLayout.from_contract(default_design_point().contract())
     f = assess(lay, ECP5, CAMERA, DEFAULT_LOGIC)
     assert not f.feasible and f.lanes == 40  # the fewest lanes meeting the clock
-    broken, io = f.broken  # and 40 output pairs for dog4, over the 33 true-LVDS pairs
+    broken, io = f.broken  # and 40 + 2 transmit pairs for dog4, over a side's 17
     assert broken.name == "memory" and (broken.figure, broken.budget) == (779, 208)
-    assert io.name == "io" and (io.figure, io.unit) == (40, "true-LVDS output data pairs")
+    assert io.name == "io" and (io.figure, io.unit) == (
+        42, "true-LVDS transmit pairs on one edge clock")
     assert broken.over_by == pytest.approx(779 / 208 - 1)
     assert "memory BREAKS: 779 / 208 DP16KD (+275 %)" in f.summary()
     # today's RTL organisation: per scale 3 banks (2 full, one of 452 words) of 40 + 38
@@ -73,12 +76,12 @@ def test_default_point_breaks_memory_with_its_figures() -> None:
 
 def test_logic_budget_breaks_with_headroom() -> None:
     heavy = LogicCost(2000, 0, 100, 0)
-    f = assess(_dog2_a17_shared(), ECP5, CAMERA, heavy, package="CABGA554")
+    f = assess(_dog2_a17_shared(), ECP5, CAMERA, heavy, package="CABGA756")
     assert [c.name for c in f.broken] == ["lut4"]
     assert f.checks["lut4"].figure == 40 * 2000 + 560 > 0.8 * 83640
     # the same logic fits with no headroom asked: 80,560 <= 83,640
     assert assess(_dog2_a17_shared(), ECP5, CAMERA, heavy, max_utilisation=1.0,
-                  package="CABGA554").feasible
+                  package="CABGA756").feasible
     with pytest.raises(RvsmError, match="max_utilisation"):
         assess(_dog2_a17_shared(), ECP5, CAMERA, heavy, max_utilisation=0)
 
@@ -86,7 +89,7 @@ def test_logic_budget_breaks_with_headroom() -> None:
 def test_a_measured_fmax_below_the_model_decides() -> None:
     slow = MeasuredFmax(90.0, 1, "a test")
     light = LogicCost(1000, 131, 800, 300)
-    f = assess(_dog2_a17_shared(), ECP5, CAMERA, light, measured=slow, package="CABGA554")
+    f = assess(_dog2_a17_shared(), ECP5, CAMERA, light, measured=slow, package="CABGA756")
     # 90 MHz: P = 40 needs 100 MHz, so the fewest lanes are 50 (80 MHz)
     assert f.feasible and f.lanes == 50 and f.checks["fmax"].budget == 90.0
     assert "measured: 90.0 MHz at P = 1 (a test), taken for P = 50" in f.checks["fmax"].detail

@@ -12,12 +12,13 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.board_top import CONTROLS, BoardTop, board_ports
 from rvsm.rtl.fpga.flow import build_component
 from rvsm.rtl.fpga.package_pins import load_package
-from rvsm.rtl.fpga.pin_plan import BoardPorts, LinkSpec, _placements, plan_pins
+from rvsm.rtl.fpga.pin_plan import BoardPorts, LinkSpec, edge_clock_placements, plan_pins
 
 POINT = "points/ecp5-85-40khz.toml"
 TINY = BoardPorts((LinkSpec("rx0", "rx", 2), LinkSpec("tx0", "tx", 2)), ("rst_n", "led"))
-#: The shipped point's links: 280 code bits = 35 pairs in, 173 + 1 spike bits = 22 out.
-FULL = BoardPorts((LinkSpec("rx0", "rx", 35), LinkSpec("tx0", "tx", 22)), CONTROLS)
+#: The shipped point's links (the board front end's): 280 code bits = 35 pairs in, 160
+#: spike bits = 20 pairs out, each with its framing lane (LinkSpec counts it as data).
+FULL = BoardPorts((LinkSpec("rx0", "rx", 36), LinkSpec("tx0", "tx", 21)), CONTROLS)
 
 
 def _pairs_by_ball(package: str) -> dict:
@@ -54,25 +55,22 @@ def test_full_sensor_does_not_fit_cabga381_and_the_planner_chooses_cabga756():
     assert plan.package == "CABGA756"
     assert [p for p, _ in plan.rejected] == ["CABGA381", "CABGA554"]
     why381 = dict(plan.rejected)["CABGA381"]
-    assert "36 receive pairs and 23 transmit" in why381
+    assert "37 receive pairs and 22 transmit" in why381
     assert "left banks 6+7: 16+16 pairs, 8+8 true-LVDS output" in why381
-    assert plan.pins_used == (36 + 23) * 2 + 6 == 124 and plan.pins_available == 365
+    assert plan.pins_used == (37 + 22) * 2 + 8 == 126 and plan.pins_available == 365
     assert plan.link_sides == {"rx0": ("L", (6, 7)), "tx0": ("R", (2, 3))}
     why554 = dict(plan.rejected)["CABGA554"]
     assert "left banks 6+7: 24+16 pairs, 12+8 true-LVDS output" in why554
-    # packing the output to the payload (160 bits = 20 pairs) does not save CABGA554
-    packed = BoardPorts((FULL.links[0], LinkSpec("tx0", "tx", 20)), CONTROLS)
-    assert plan_pins(packed).package == "CABGA756"
-    # ... 18 data pairs (144 bits a cycle) would
+    # 18 transmit pairs with the framing lane (136 bits a cycle) would fit CABGA554
     assert plan_pins(BoardPorts((FULL.links[0], LinkSpec("tx0", "tx", 18)),
                                 CONTROLS)).package == "CABGA554"
-    with pytest.raises(RvsmError, match="CABGA381: 2 links need 36 receive pairs"):
+    with pytest.raises(RvsmError, match="CABGA381: 2 links need 37 receive pairs"):
         plan_pins(FULL, "CABGA381")
 
 
 def test_edge_clock_rules_of_the_placements():
     links = [LinkSpec(f"l{i}", "rx", 1) for i in range(2)]
-    for where in _placements(links):
+    for where in edge_clock_placements(links):
         sides = [s for s, _ in where.values()]
         if sides[0] == sides[1]:  # two links on a side share one bank
             assert where["l0"][1] == where["l1"][1] and len(where["l0"][1]) == 1
@@ -86,7 +84,7 @@ def test_the_shipped_points_links():
     point = load_design_point(POINT)
     core, _ = build_component(point.contract(), "stream", lanes=40)
     core._MustUse__silence = True  # only its signature is read
-    assert board_ports(core) == FULL  # 280 code bits in, 173 + 1 spike bits out
+    assert board_ports(core) == FULL  # 280 code bits in, 2 x 2 x 40 spike bits out
 
 
 def test_board_top_ports_are_the_planned_ports():
@@ -94,7 +92,7 @@ def test_board_top_ports_are_the_planned_ports():
     core, _ = build_component(point.with_size(4, 8).contract(), "stream", lanes=2)
     ports = board_ports(core)
     assert [(k.name, k.direction, k.data_pairs) for k in ports.links] == [
-        ("rx0", "rx", 2), ("tx0", "tx", 2)]  # 14 code bits in, 13 + 1 spike bits out
+        ("rx0", "rx", 3), ("tx0", "tx", 2)]  # 14 code bits in, 8 spike bits out, + framing
     top = BoardTop(core, ports)
     text = verilog.convert(top, name="top", ports=top.port_list, emit_src=False)
     header = re.search(r"module top\((.*?)\);", text, re.S)[1]

@@ -50,7 +50,7 @@ def test_constraint_parsed_with_its_defaults():
     (HEAD + 'max_utilisation = 1.5\n', r"max_utilisation must be a number in \(0, 1\]"),
     (HEAD + 'memory_organisation = "diagonal"\n', r"one of rtl, per-scale, packed"),
     ('fitz = "ecp5-85"\n', r"unknown section \[fitz\]; valid: .*top-level keys: fits, camera"),
-    (HEAD + 'io_links = "chip"\n', r"io_links must be one of bank, side, got 'chip'"),
+    (HEAD + 'io_links = "chip"\n', r"io_links must be one of side, bank, got 'chip'"),
     (HEAD + 'package = "QFN9"\n', r"s.toml: package: ecp5-85 has no package 'QFN9'; choose "),
 ])
 def test_bad_constraints_are_one_line_naming_the_choices(text, msg):
@@ -75,14 +75,17 @@ def fake_synthesis(monkeypatch):
 def test_report_ranks_what_fits_and_says_what_breaks(tmp_path, capsys, fake_synthesis):
     db = tmp_path / "r.sqlite"
     run_sweep(parse_sweep(HEAD + BODY), db, workers=0, progress=False)
-    files, info = write_report(db, tmp_path / "rep")
+    # in the CABGA756: the package that carries the full sensor's links
+    big = parse_constraint({"fits": ["ecp5-85"], "package": "CABGA756",
+                            "camera": {"size": "250x400", "rate_hz": 40000}}, "test")
+    files, info = write_report(db, tmp_path / "rep", constraint=big)
     text = (tmp_path / "rep" / "report.md").read_text()
     # dog1, per-pixel thresholds, packed at P = 40: 100 + 95 DP16KD of 208; dog2 twice
     assert [d["label"].split(",")[0] for d in info["fits"]["ecp5-85"]] == ["array.model=dog1"]
     (bad,) = info["infeasible"]["ecp5-85"]
     assert bad["label"].startswith("array.model=dog2")
     assert "memory BREAKS: 390 / 208 DP16KD (+88 %)" in bad["summary"]
-    assert "## Fits ecp5-85 at 250x400 at 40,000 Hz" in text
+    assert "## Fits ecp5-85 in CABGA756 at 250x400 at 40,000 Hz" in text
     assert "**1 of 2 designs fit.**" in text and "195 / 208" in text
     # logic at P = 40: 100 + 40 x 400 LUT4 + the line buffer's 140 16x4 RAMs x 4
     assert "16,660 / 66,912" in text
@@ -94,26 +97,33 @@ def test_report_ranks_what_fits_and_says_what_breaks(tmp_path, capsys, fake_synt
     assert "fits ecp5-25: 2 of 2 design(s)" in out
     # no Fmax model for the iCE40: unverified, not feasible
     assert "fits ice40-up5k: 0 of 2 design(s)" in out and ": unverified fmax ?" in out
-    # 100x400 at 100 kHz: the array's 4e9 pixel-steps/s on a state that fits; dog2's
-    # 28 + 16 Gbit/s do not place on the CABGA381's banks, dog1's 28 + 8 do
+    # 100x400 at 100 kHz: the array's 4e9 pixel-steps/s on a state that fits; on the
+    # CABGA381 dog2's transmit link (20 + 2 pairs) needs more true-LVDS pairs than a side
+    # has, dog1's 37-pair receive link more pairs than a side has: nothing fits, exit 2
     fast = ["--fits", "ecp5-85", "--camera", "100x400", "--rate-hz", "100000"]
-    assert main(["sweep", "report", str(db), "-o", str(tmp_path / "rep3"), *fast]) == 0
+    assert main(["sweep", "report", str(db), "-o", str(tmp_path / "rep3"), *fast]) == 2
+    err = capsys.readouterr().err
+    assert "io" in err and len(err.strip().splitlines()) == 1
+    assert main(["sweep", "report", str(db), "-o", str(tmp_path / "rep3"), *fast,
+                 "--allow-infeasible"]) == 0
     out = capsys.readouterr().out
     (dog2,) = [ln for ln in out.splitlines() if ln.startswith("  x array.model=dog2")]
     # the line short, the detail in report.md and --json
-    assert dog2.endswith(": P = 40 at 100.0 MHz: breaks io 35 / 29 input data pairs (+21 %)")
-    assert "1. array.model=dog1" in out and "I/O 55 / 65 pairs" in out
-    assert "| 35 / 29 **x** |" in (tmp_path / "rep3" / "report.md").read_text()
+    assert dog2.endswith(": P = 40 at 100.0 MHz: breaks io 22 / 17 true-LVDS transmit "
+                         "pairs on one edge clock (+29 %)")
+    (dog1,) = [ln for ln in out.splitlines() if ln.startswith("  x array.model=dog1")]
+    assert "breaks io 37 / 33 receive pairs on one edge clock" in dog1
+    assert "| 22 / 17 **x** |" in (tmp_path / "rep3" / "report.md").read_text()
     assert main(["sweep", "report", str(db), "-o", str(tmp_path / "rep4"), *fast,
-                 "--package", "CABGA554", "--json"]) == 0
+                 "--package", "CABGA756", "--json"]) == 0
     got = json.loads(capsys.readouterr().out)["report"]
     assert [d["label"].split(",")[0] for d in got["fits"]["ecp5-85"]] == [
         "array.model=dog1", "array.model=dog2"]
     io = {d["label"].split(",")[0]: d["io"] for d in got["verdicts"]["ecp5-85"]}
-    assert io["array.model=dog2"]["package"] == "LFE5U-85F CABGA554"
+    assert io["array.model=dog2"]["package"] == "LFE5U-85F CABGA756"
     assert (io["array.model=dog2"]["input"]["data_pairs"],
             io["array.model=dog2"]["output"]["data_pairs"]) == (35, 20)
-    assert io["array.model=dog2"]["figure"] == 65 and io["array.model=dog2"]["budget"] == 80
+    assert io["array.model=dog2"]["figure"] == 59 and io["array.model=dog2"]["budget"] == 112
 
 
 def test_cli_devices_and_bad_values_exit_2(tmp_path, capsys, fake_synthesis):
@@ -148,7 +158,7 @@ def test_point_io_command_gives_the_figures_docs_quote(capsys, monkeypatch):
     assert main(["sweep", "io", "points/ecp5-85-40khz.toml", "--package", "CABGA381",
                  "--io-links", "bank", "--json"]) == 0
     (plan,) = json.loads(capsys.readouterr().out)
-    assert (plan["fits"], plan["figure"], plan["budget"]) == (False, 35, 29)
+    assert (plan["fits"], plan["figure"], plan["budget"]) == (False, 22, 9)
     assert main(["sweep", "io"]) == 2 and "needs a point file" in capsys.readouterr().err
     assert main(["sweep", "io", "points/ecp5-85-40khz.toml", "--package", "QFN9"]) == 2
     assert "choose one of: LFE5U-85F CABGA381" in capsys.readouterr().err
