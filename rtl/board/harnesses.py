@@ -31,7 +31,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from amaranth.asserts import AnyConst, AnySeq
-from amaranth.hdl import Array, Cat, Const, Module, Mux, Signal, Value
+from amaranth.hdl import Array, Cat, Module, Mux, Signal, Value
 
 from rvsm.rtl.board.aligner import WordAligner
 from rvsm.rtl.board.deskew import DEPTH, Deskew
@@ -163,16 +163,31 @@ class DeskewProperties(FormalHarness):
         self.pairs = pairs
         self.free_strobe = free_strobe
         self.deskew = deskew
-        #: Steps checked: two MARK periods and the deskew after them.
-        self.depth = 2 * MARK_SPACING + DESKEW_STROBES + 4
+        #: Steps checked: two MARK periods and the deskew after them, at a strobe every
+        #: other cycle (the receiver's word rate: the deskew registers its MARK compares
+        #: and delays between strobes).
+        self.depth = 2 * (2 * MARK_SPACING + DESKEW_STROBES + 4)
         self.cover_depth = self.depth
 
     def elaborate(self, platform: object) -> Module:
         m = Module()
         n = self.pairs
         m.submodules.dut = dut = self.deskew(n)
-        strobe = AnySeq(1) if self.free_strobe else Const(1)
-        start, mark = AnySeq(1), AnySeq(1)
+        # strobes at most every other cycle, as the receiver gives them
+        phase = Signal()
+        m.d.sync += phase.eq(~phase)
+        strobe = Signal()
+        if self.free_strobe:
+            was = Signal()
+            m.d.comb += strobe.eq(AnySeq(1))
+            m.d.sync += was.eq(strobe)
+            self.check(m, "assume.strobe_spacing", ~(strobe & was),
+                       "no two strobes in consecutive cycles")
+        else:
+            m.d.comb += strobe.eq(phase)
+        start, mark = Signal(), AnySeq(1)
+        with m.If(strobe):  # start changes at strobes, as the receiver's link FSM's
+            m.d.sync += start.eq(AnySeq(1))
         m.d.comb += [dut.strobe.eq(strobe), dut.start.eq(start)]
         lags = [AnyConst(2) for _ in range(n)]
         most: Value = lags[0]
@@ -188,8 +203,11 @@ class DeskewProperties(FormalHarness):
         outs = []
         for i in range(n):
             # one free bit a word picks TRAIN or 0: any sequence, no stray MARK
+            # the word of this strobe period, held between strobes as the receiver's
+            # words are (drawn at the strobe before)
             sent = Signal(WORD_BITS, name=f"sent{i}")
-            m.d.comb += sent.eq(Mux(mark, MARK, Mux(AnySeq(1), TRAIN, 0)))
+            with m.If(strobe):
+                m.d.sync += sent.eq(Mux(mark, MARK, Mux(AnySeq(1), TRAIN, 0)))
             past = [Signal(WORD_BITS, name=f"sent{i}_{k}") for k in range(1, DEPTH)]
             with m.If(strobe):
                 m.d.sync += [past[0].eq(sent),
@@ -201,15 +219,22 @@ class DeskewProperties(FormalHarness):
                 m.d.sync += expected.eq(taps[latest])
             outs.append((dut.out[i], expected, dut.delays[i], lags[i]))
         for out, expected, delay, lag in outs:
-            self.check(m, "deskew.delays", ~dut.done | (delay == latest - lag),
-                       "once done each lane waits max(lag) - its lag words")
-            self.check(m, "deskew.same_cycle", ~dut.done | (out == expected),
-                       "once done every lane gives the word sent max(lag) strobes before")
-        # strobes since a MARK sent while start has stayed high (0: none)
+            # the delays and MARK compares are registered between strobes: the lane
+            # words are checked where the receiver takes them, at its strobes
+            self.check(m, "deskew.delays", ~strobe | ~dut.done | (delay == latest - lag),
+                       "once done each lane waits max(lag) - its lag words (at strobes)")
+            self.check(m, "deskew.same_cycle", ~strobe | ~dut.done | (out == expected),
+                       "once done every lane gives the word sent max(lag) strobes before "
+                       "(at strobes)")
+        # strobes since a MARK shown to the deskew while start has stayed high (0: none);
+        # a MARK drawn at a strobe is shown from that strobe to the next
+        shown = Signal()
+        with m.If(strobe):
+            m.d.sync += shown.eq(mark)
         after = Signal(range(DESKEW_STROBES + 2), name="after_mark")
         with m.If(~start):
             m.d.sync += after.eq(0)
-        with m.Elif(strobe & (after == 0) & mark):
+        with m.Elif(strobe & (after == 0) & shown):
             m.d.sync += after.eq(1)
         with m.Elif(strobe & (after != 0) & (after != DESKEW_STROBES + 1)):
             m.d.sync += after.eq(after + 1)
