@@ -12,13 +12,14 @@ every clock against its constraint.
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from amaranth.lib import wiring
 
 from rvsm.model.infra.atomic import write_text_atomic
-from rvsm.rtl.fpga.board_top import BoardTop, board_ports
+from rvsm.rtl.fpga.board_top import BoardTop, board_ports, front_end_name
 from rvsm.rtl.fpga.pin_plan import PinPlan, plan_pins
 
 __all__ = ["IO_PRIMITIVES", "board_report", "prepare_board"]
@@ -30,10 +31,11 @@ IO_PRIMITIVES = ("TRELLIS_IO", "IOLOGIC", "SIOLOGIC", "ECLKSYNCB", "CLKDIVF",
 
 def prepare_board(core: wiring.Component, work_dir: Path, core_mhz: float,
                   package: str | None = None) -> tuple[BoardTop, PinPlan]:
-    """The board top around ``core`` and its pin plan; writes ``top.lpf`` and
+    """The board top around ``core`` (the streaming array, or the AXI IP: then its
+    registers on the SPI pins) and its pin plan; writes ``top.lpf`` and
     ``pin_plan.json`` into ``work_dir``."""
     ports = board_ports(core, core_mhz=core_mhz)
-    plan = plan_pins(ports, package)
+    plan = replace(plan_pins(ports, package), front_end=front_end_name(core))
     top = BoardTop(core, ports, core_mhz)
     work_dir.mkdir(parents=True, exist_ok=True)
     write_text_atomic(work_dir / "top.lpf", plan.lpf())
@@ -54,8 +56,9 @@ def _role(net: str, plan: PinPlan, core_mhz: float, constraint: float) -> str:
 
 def board_report(plan: PinPlan, pnr: dict[str, Any], core_mhz: float) -> dict[str, Any]:
     """Pins used / available (the plan's package), nextpnr's I/O primitives
-    (:data:`IO_PRIMITIVES`, used / available on the die) and every clock:
-    ``{net: {role, achieved_mhz, constraint_mhz, met}}``."""
+    (:data:`IO_PRIMITIVES`, used / available on the die), every clock:
+    ``{net: {role, achieved_mhz, constraint_mhz, met}}``, the plan's ``front_end`` and
+    ``sites`` (every port: ball, PIO site, bank, I/O type, pair; as ``pin_plan.json``)."""
     util = pnr.get("utilization", {})
     clocks = {}
     for net, mhz in pnr.get("clocks", {}).items():
@@ -64,6 +67,7 @@ def board_report(plan: PinPlan, pnr: dict[str, Any], core_mhz: float) -> dict[st
                        "constraint_mhz": want, "met": mhz >= want}
     return {
         "package": plan.package,
+        "front_end": plan.front_end,
         "pins_used": plan.pins_used,
         "pins_available": plan.pins_available,
         "ports": len(plan.sites),
@@ -72,6 +76,7 @@ def board_report(plan: PinPlan, pnr: dict[str, Any], core_mhz: float) -> dict[st
         "primitives": {k: util[k] for k in IO_PRIMITIVES if k in util},
         "clocks": clocks,
         "all_clocks_met": all(c["met"] for c in clocks.values()),
+        "sites": [dict(s.__dict__) for s in plan.sites],
         "edge_clock_note": "edge clocks (ECLK) drive only IOLOGIC; nextpnr times the "
                            "SCLK and core domains, not the gearing itself",
     }

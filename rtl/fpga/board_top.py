@@ -20,6 +20,13 @@ training, the AsyncFIFO out of the core clock).
   ``thr.we`` and ``clear`` as one-cycle pulses); ``spi_miso`` shifts out, MSB first from
   ``spi_cs_n`` falling, the status word (:func:`status_bits`). ``led`` is the receive
   link's ``locked``; ``rx0_train_request`` the pin asking the sensor for training.
+* Around the AXI IP (``core`` an :class:`~rvsm.rtl.ip.wrapper.RvsmAxisIp`, ``rvsm fpga
+  --interface axis --board``) the front end is
+  :class:`~rvsm.rtl.board.ip_front_end.IpBoardFrontEnd` instead: the same links and
+  clocks, and the four SPI pins are its :class:`~rvsm.rtl.board.spi_bridge.SpiBridge`'s
+  (SPI mode 0 frames onto the IP's AXI4-Lite registers, the link registers among them:
+  docs/board.md); ``tx0_overflow`` (:data:`IP_CONTROLS`) is the transmit FIFO's
+  overflow, which has no register there.
 
 At 100 MHz and a 400 MHz edge clock a pair carries 8 bits per core cycle (800 Mbit/s).
 """
@@ -31,15 +38,20 @@ from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
 
 from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.board.front_end import BoardFrontEnd, link_formats
+from rvsm.rtl.board.ip_front_end import IpBoardFrontEnd
 from rvsm.rtl.fpga.pin_plan import BoardPorts, LinkSpec
 
-__all__ = ["BITS_PER_PAIR", "CONTROLS", "BoardTop", "board_ports", "status_bits"]
+__all__ = ["BITS_PER_PAIR", "CONTROLS", "IP_CONTROLS", "BoardTop", "board_ports",
+           "front_end_name", "status_bits"]
 
 #: Bits per pair per core cycle: X2 gearing (4 bits a SCLK) at SCLK = 2 x core clock.
 BITS_PER_PAIR = 8
 #: Single-ended control pins of the board top.
 CONTROLS = ("rst_n", "spi_sck", "spi_mosi", "spi_cs_n", "spi_miso", "led",
             "rx0_train_request")
+#: Single-ended control pins of the board top around the AXI IP: the SPI pins reach
+#: the IP's registers, plus the transmit FIFO's overflow.
+IP_CONTROLS = (*CONTROLS, "tx0_overflow")
 #: PLL voltage-controlled oscillator frequency (MHz): within EHXPLLL's 400-800 MHz.
 VCO_MHZ = 800.0
 
@@ -51,16 +63,30 @@ def _array_of(core: object) -> tuple:
     return contract, lanes
 
 
+def _is_ip(core: object) -> bool:
+    from rvsm.rtl.ip.wrapper import RvsmAxisIp
+
+    return isinstance(core, RvsmAxisIp)
+
+
+def front_end_name(core: object) -> str:
+    """The front end a board top puts around ``core``: ``"IpBoardFrontEnd"`` (the AXI
+    IP, registers over SPI) or ``"BoardFrontEnd"`` (the streaming array)."""
+    _array_of(core)
+    return "IpBoardFrontEnd" if _is_ip(core) else "BoardFrontEnd"
+
+
 def board_ports(core: object, core_mhz: float = 100.0, osc_mhz: float = 100.0) -> BoardPorts:
-    """The links of the board front end around ``core`` (a streaming array): ``rx0``
-    carries its codes (``P*N`` bits a beat, 8 a pair, plus the framing lane), ``tx0``
-    its spikes (``2*S*P`` bits a beat, positions implied by the framing, plus the framing
-    lane); each with a forwarded clock pair."""
+    """The links of the board front end around ``core`` (the streaming array or the AXI
+    IP): ``rx0`` carries its codes (``P*N`` bits a beat, 8 a pair, plus the framing
+    lane), ``tx0`` its spikes (``2*S*P`` bits a beat, positions implied by the framing,
+    plus the framing lane); each with a forwarded clock pair. Control pins
+    :data:`CONTROLS`, around the IP :data:`IP_CONTROLS`."""
     contract, lanes = _array_of(core)
     rx, tx = link_formats(contract, lanes)
     eclk = 4 * core_mhz
     links = (LinkSpec("rx0", "rx", rx.pairs, eclk), LinkSpec("tx0", "tx", tx.pairs, eclk))
-    return BoardPorts(links, CONTROLS, "clk_osc", osc_mhz)
+    return BoardPorts(links, IP_CONTROLS if _is_ip(core) else CONTROLS, "clk_osc", osc_mhz)
 
 
 def status_bits(front_end: BoardFrontEnd) -> Cat:
@@ -79,11 +105,20 @@ def _pll_divider(what: str, ratio: float) -> int:
     return int(round(ratio))
 
 
+def _silence(core: object) -> None:
+    """``core`` and its parts are not elaborated (the front end builds its own)."""
+    core._MustUse__silence = True
+    for part in vars(core).values():
+        if isinstance(part, Elaboratable):
+            part._MustUse__silence = True
+
+
 class BoardTop(Elaboratable):
-    """The board front end for ``core``'s contract and lanes (``core`` itself is the
-    front end's array: :class:`BoardFrontEnd` builds the same one) between the pins of
-    ``ports`` (:func:`board_ports`); top-level ports :attr:`pins` (name -> one-bit signal),
-    named as in the pin plan. ``core_mhz``: the core clock (CLKOS of the PLL)."""
+    """The board front end for ``core``'s contract and lanes (``core`` stands for the
+    front end's own array or IP: :class:`BoardFrontEnd` or :class:`IpBoardFrontEnd`
+    builds the same one) between the pins of ``ports`` (:func:`board_ports`); top-level
+    ports :attr:`pins` (name -> one-bit signal), named as in the pin plan. ``core_mhz``:
+    the core clock (CLKOS of the PLL)."""
 
     #: No test harness: the board top's I/O logic is part of the design's area.
     overhead_ff = 0
@@ -92,8 +127,12 @@ class BoardTop(Elaboratable):
     def __init__(self, core: object, ports: BoardPorts, core_mhz: float = 100.0):
         self._MustUse__silence = True  # an __init__ that raises is not an unused design
         contract, lanes = _array_of(core)
-        core._MustUse__silence = True  # replaced by the front end's own array
-        self.front_end = BoardFrontEnd(contract, lanes, primitive="ecp5")
+        _silence(core)  # replaced by the front end's own array or IP
+        self.ip = _is_ip(core)
+        self.front_end: BoardFrontEnd | IpBoardFrontEnd = (
+            IpBoardFrontEnd(contract, lanes, core.fifo_depth, primitive="ecp5") if self.ip
+            else BoardFrontEnd(contract, lanes, primitive="ecp5"))
+        self.controls = IP_CONTROLS if self.ip else CONTROLS
         self.ports, self.core_mhz = ports, core_mhz
         links = {k.name: k for k in ports.links}
         want = {"rx0": self.front_end.rx_format.pairs, "tx0": self.front_end.tx_format.pairs}
@@ -106,7 +145,7 @@ class BoardTop(Elaboratable):
                 self.pins[link.data_port(i)] = Signal(name=link.data_port(i))
         for name in (ports.oscillator, *ports.controls):
             self.pins[name] = Signal(name=name)
-        missing = set(CONTROLS) - set(ports.controls)
+        missing = set(self.controls) - set(ports.controls)
         if missing:
             raise RvsmError(f"the board top needs the control pins {sorted(missing)}")
         eclks = {link.eclk_mhz for link in ports.links}
@@ -165,6 +204,13 @@ class BoardTop(Elaboratable):
             m.d.sync += out.eq(Cat(0, out[:-1]))
         m.d.comb += self.pins["spi_miso"].eq(out[-1])
 
+    def _spi(self, m: Module, fe: IpBoardFrontEnd) -> None:
+        """The IP's SPI bridge on the four SPI pins (it synchronises them itself)."""
+        m.d.comb += [fe.spi.sclk.eq(self.pins["spi_sck"]), fe.spi.cs_n.eq(self.pins["spi_cs_n"]),
+                     fe.spi.mosi.eq(self.pins["spi_mosi"]),
+                     self.pins["spi_miso"].eq(fe.spi.miso),
+                     self.pins["tx0_overflow"].eq(fe.tx_overflow)]
+
     def elaborate(self, platform: object) -> Module:
         m = Module()
         m.submodules.front_end = fe = self.front_end
@@ -175,10 +221,14 @@ class BoardTop(Elaboratable):
         rx, tx = (next(k for k in self.ports.links if k.name == n) for n in ("rx0", "tx0"))
         m.d.comb += [fe.rx_clock.eq(self.pins[rx.clock_port]), fe.tx_clock.eq(tx_eclk),
                      self.pins[tx.clock_port].eq(fe.tx_clock_out),
-                     self.pins["led"].eq(fe.status.locked),
+                     self.pins["led"].eq(fe.receiver.status.locked if self.ip
+                                         else fe.status.locked),
                      self.pins["rx0_train_request"].eq(fe.train_request)]
         m.d.comb += [fe.rx_pins[i].eq(self.pins[rx.data_port(i)]) for i in range(rx.data_pairs)]
         m.d.comb += [self.pins[tx.data_port(i)].eq(fe.tx_pins[i])
                      for i in range(tx.data_pairs)]
-        self._control(m, fe)
+        if self.ip:
+            self._spi(m, fe)
+        else:
+            self._control(m, fe)
         return m

@@ -99,13 +99,15 @@ class PinSite:
 @dataclass(frozen=True)
 class PinPlan:
     """The sites of every port in ``package``; ``link_sides`` maps a link to its side
-    and banks; ``rejected`` lists smaller packages tried first, with the reason."""
+    and banks; ``rejected`` lists smaller packages tried first, with the reason;
+    ``front_end``: the design the pins belong to (the board top's front end class)."""
 
     package: str
     sites: tuple[PinSite, ...]
     link_sides: dict[str, tuple[str, tuple[int, ...]]]
     frequencies: dict[str, float]
     rejected: tuple[tuple[str, str], ...] = field(default=())
+    front_end: str = ""
 
     @property
     def pins_used(self) -> int:
@@ -129,7 +131,8 @@ class PinPlan:
         return "\n".join(lines) + "\n"
 
     def to_dict(self) -> dict:
-        return {"package": self.package, "pins_used": self.pins_used,
+        return {"package": self.package, "front_end": self.front_end,
+                "pins_used": self.pins_used,
                 "pins_available": self.pins_available,
                 "links": {k: {"side": s, "banks": list(b)} for k, (s, b) in
                           self.link_sides.items()},

@@ -61,7 +61,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="place the array as a board design: real LVDS receive and transmit "
                    "links (IDDRX2F/ODDRX2F, ECLKSYNCB, CLKDIVF, a PLL) instead of the "
                    "harness, every port at a planned site (top.lpf, pin_plan.json in the "
-                   "output folder), no unconstrained port (docs/fpga.md, Board build)")
+                   "output folder), no unconstrained port; with --interface axis the AXI IP "
+                   "between the links, its registers on SPI pins (docs/fpga.md, Board build)")
     p.add_argument("--package", choices=("CABGA381", "CABGA554", "CABGA756"),
                    help="with --board: the ECP5-85 package (default: the smallest whose "
                    "pins carry the links)")
@@ -121,9 +122,6 @@ def _fpga(args: argparse.Namespace) -> int:
     if args.board:
         if args.synth_only:
             raise RvsmError("--board places and routes: it does not go with --synth-only")
-        if args.interface == "axis":
-            raise RvsmError("--board places the streaming array; the AXI IP has no board "
-                            "top yet (use --interface native)")
         common.update(board=True, package=args.package)
     with removed_if_interrupted(args.out):  # no half-made work folder
         if args.seeds is not None:
