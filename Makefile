@@ -116,7 +116,9 @@ bench-board: setup
 # the shipped point's datasheet, remade from its saved results (docs/datasheet-ecp5-85-40khz/
 # results: rvsm fpga from make bench-fpga, rvsm quality, the 40,000-step rvsm verify, rvsm
 # formal, rvsm mutate and the JUnit of regressions/ecp5-85-40khz.toml, each named in the page;
-# commands.toml: the command lines the results do not record); tests/sim/studies/
+# commands.toml: the command lines the results do not record; fpga-board.json, when it is
+# there, the full-size rvsm fpga --board --json of make bench-board for the Board section,
+# with its pin_plan.json if the report has no board.sites); tests/sim/studies/
 # test_shipped_datasheet.py checks the page against them
 SHEET = docs/datasheet-ecp5-85-40khz
 datasheet: setup
@@ -124,7 +126,9 @@ datasheet: setup
 	  --fpga $(SHEET)/results/fpga.json --quality $(SHEET)/results/quality.json \
 	  --verify $(SHEET)/results/verify.json --formal $(SHEET)/results/formal.json \
 	  --mutate $(SHEET)/results/mutate.json --regress $(SHEET)/results/regress.xml \
-	  --commands $(SHEET)/results/commands.toml
+	  --commands $(SHEET)/results/commands.toml \
+	  $(if $(wildcard $(SHEET)/results/fpga-board.json),--board-fpga $(SHEET)/results/fpga-board.json) \
+	  $(if $(and $(wildcard $(SHEET)/results/fpga-board.json),$(wildcard $(SHEET)/results/pin_plan.json)),--board-pin-plan $(SHEET)/results/pin_plan.json)
 
 # the guides' timing diagrams, recorded from amaranth.sim (docs/integration.md, docs/ip.md)
 diagrams: setup

@@ -19,7 +19,8 @@ DEFAULT_FRAMES = 41
 DEFAULT_STEPS_PER_FRAME = 10
 #: Files ``rvsm datasheet`` writes into its folder.
 DATASHEET_FILES = (("datasheet.md", PLAIN), ("resources.png", None), ("clock.png", None),
-                   ("quality_costs.png", None), ("reconstructions.png", None))
+                   ("quality_costs.png", None), ("reconstructions.png", None),
+                   ("pin_plan.csv", PLAIN))
 
 
 def _noise_settings(text: str) -> list[bool]:
@@ -101,6 +102,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--organisation", default="rtl", choices=("rtl", "per-scale", "packed"),
                    help="state memory organisation (default %(default)s: what the RTL builds)")
     p.add_argument("--fpga", metavar="FILE.json", help="saved rvsm fpga POINT --json")
+    p.add_argument("--board-fpga", metavar="FILE.json", help="saved rvsm fpga POINT --board "
+                   "--json: the Board section (pin plan, links, clocks; pin_plan.csv beside "
+                   "the page); without it the section names the command")
+    p.add_argument("--board-pin-plan", metavar="FILE.json", help="with --board-fpga: the "
+                   "build's pin_plan.json, for a report without board.sites (older rvsm fpga)")
     p.add_argument("--quality", metavar="FILE.json", help="saved rvsm quality POINT --json "
                    "(default: run the study)")
     p.add_argument("--verify", metavar="FILE.json", help="saved rvsm verify ... --json")
@@ -191,7 +197,7 @@ def _datasheet(args: argparse.Namespace) -> int:
         raise RvsmError(f"--rate-hz must be > 0, got {args.rate_hz:g}")
     device = get_budget(args.device)
     inputs = [args.point, args.fpga, args.quality, args.verify, args.regress, args.formal,
-              args.mutate, args.commands]
+              args.mutate, args.commands, args.board_fpga, args.board_pin_plan]
     check_outputs([Output(args.output, "-o", FOLDER, DATASHEET_FILES)], inputs, args.force)
     pf = di.load_point_file(args.point)
     lanes = args.lanes or pf.lanes
@@ -206,6 +212,16 @@ def _datasheet(args: argparse.Namespace) -> int:
     if fpga is not None and fpga.get("model") not in (None, pf.point.model):
         raise RvsmError(f"{args.fpga}: the fpga result is of model {fpga['model']}, the "
                         f"point's is {pf.point.model}")
+    if args.board_pin_plan and not args.board_fpga:
+        raise RvsmError("--board-pin-plan goes with --board-fpga")
+    board = None
+    if args.board_fpga:
+        from rvsm.sim.studies.datasheet_board import load_board_report
+
+        board = load_board_report(args.board_fpga, args.board_pin_plan)
+        if board.get("model") not in (None, pf.point.model):
+            raise RvsmError(f"{args.board_fpga}: the board report is of model "
+                            f"{board['model']}, the point's is {pf.point.model}")
     quality = None
     if args.quality:
         quality = PointQuality.from_json(di.read_result_text(args.quality, "rvsm quality result"),
@@ -215,7 +231,8 @@ def _datasheet(args: argparse.Namespace) -> int:
     regress = di.load_regress(args.regress) if args.regress else None
     checks = {"formal": di.load_formal_report(args.formal) if args.formal else None,
               "mutate": di.load_mutate_report(args.mutate) if args.mutate else None,
-              "commands": di.load_commands(args.commands) if args.commands else {}}
+              "commands": di.load_commands(args.commands) if args.commands else {},
+              "board": board}
     picture_scene = _scenes([args.picture_scene]) if args.picture_scene else None
     return _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,
                            picture_scene, settings, checks)
@@ -246,6 +263,7 @@ def _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,  # 
     from rvsm.model.infra.atomic import atomic_path, write_text_atomic
     from rvsm.model.scene.loaders import load_scene
     from rvsm.sim.studies.datasheet import DatasheetInputs, build_datasheet
+    from rvsm.sim.studies.datasheet_board import CSV_NAME, REPORT_NAME
     from rvsm.sim.studies.point_quality import reconstructions, run_point_quality
 
     command = getattr(args, "command_line", "rvsm datasheet")
@@ -281,11 +299,16 @@ def _make_datasheet(args, device, pf, lanes, fpga, quality, verify, regress,  # 
         verify_path=args.verify, regress=regress, regress_path=args.regress,
         formal=checks["formal"], formal_path=args.formal, mutate=checks["mutate"],
         mutate_path=args.mutate, command=command, quality_path=args.quality,
-        commands=checks["commands"], docs=_docs_from(out)))
+        commands=checks["commands"], docs=_docs_from(out), board=checks["board"],
+        board_path=args.board_fpga or (out / REPORT_NAME).as_posix()))
     for name, fig in sheet.figures.items():
         with atomic_path(out / name) as tmp:
             fig.savefig(tmp, format="png")
         fig.clear()
+    for name, text in sheet.files.items():
+        write_text_atomic(out / name, text)
+    if CSV_NAME not in sheet.files:
+        (out / CSV_NAME).unlink(missing_ok=True)  # no board report: no stale pin plan
     write_text_atomic(out / "datasheet.md", sheet.markdown)
     print(f"wrote {out / 'datasheet.md'} and {len(sheet.figures)} figure(s)")
     return 0

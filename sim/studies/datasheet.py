@@ -16,9 +16,13 @@ figures, section by section, after a **Summary** table (:mod:`.datasheet_summary
    register map of the IP with every bit field, the ports of the bare array and of the
    IP with every payload's bit ranges, the reset, initialisation and flush sequence
    (:mod:`.datasheet_interfaces`);
-5. **Image quality** -- the study of :mod:`rvsm.sim.studies.point_quality` and a picture of
+5. **Board** -- the chip on a board, from a saved ``rvsm fpga --board --json`` report:
+   package, links and their rates against the published limit, the pin plan (also
+   ``pin_plan.csv``), the timing of every clock, the training and reset sequence and
+   the link registers (:mod:`.datasheet_board`); without it, the command that makes it;
+6. **Image quality** -- the study of :mod:`rvsm.sim.studies.point_quality` and a picture of
    the reconstructions;
-6. **Verification** -- saved ``rvsm verify --json`` and ``rvsm regress --junit`` results,
+7. **Verification** -- saved ``rvsm verify --json`` and ``rvsm regress --junit`` results,
    "not run" for what is not given.
 
 Every section ends with a "Sources" line naming the code behind its figures and pointing
@@ -35,6 +39,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.rtl.fpga.block_ram import StateLayout
 from rvsm.rtl.fpga.camera import clock_needed_hz, state_memory
 from rvsm.rtl.fpga.feasibility import Camera, Feasibility, LogicCost, MeasuredFmax, assess
+from rvsm.sim.studies import datasheet_board as board
 from rvsm.sim.studies import datasheet_figures as figs
 from rvsm.sim.studies.datasheet_inputs import DatasheetInputs
 from rvsm.sim.studies.datasheet_interfaces import Interfaces, interfaces_lines, interfaces_of
@@ -51,17 +56,19 @@ __all__ = ["Datasheet", "DatasheetInputs", "build_datasheet", "logic_of"]
 #: The page's file name and its section titles, in order.
 PAGE = "datasheet.md"
 SECTIONS = ("Design point", "Resources", "Clock", "Memory map and interfaces",
-            "Image quality", "Verification")
+            board.TITLE, "Image quality", "Verification")
 #: Before and after them.
 FIRST, LAST = "Summary", "Reproduce"
 
 
 @dataclass
 class Datasheet:
-    """The page's Markdown and its figures by file name (matplotlib figures)."""
+    """The page's Markdown, its figures by file name (matplotlib figures) and other
+    files beside it by name (text: the board's ``pin_plan.csv``)."""
 
     markdown: str
     figures: dict[str, Any] = field(default_factory=dict)
+    files: dict[str, str] = field(default_factory=dict)
 
 
 def logic_of(inputs: DatasheetInputs) -> LogicCost | None:
@@ -276,7 +283,7 @@ def _quality_section(inputs: DatasheetInputs) -> tuple[list[str], dict[str, Any]
     q = inputs.quality
     h, w = q.size
     out: dict[str, Any] = {"quality_costs.png": figs.costs_figure(q)}
-    lines = [f"## {SECTIONS[4]}", "",
+    lines = [f"## {SECTIONS[5]}", "",
              f"PSNR (dB) and SSIM against the ground truth on {len({r.scene for r in q.rows})}"
              f" built-in scene(s) at {h}x{w}, {q.steps_text()}, seed "
              f"{q.point.get('seed')}, {q.method} reconstruction, {q.match} brightness "
@@ -302,6 +309,15 @@ def _quality_section(inputs: DatasheetInputs) -> tuple[list[str], dict[str, Any]
     return lines, out
 
 
+def _board_section(inputs: DatasheetInputs) -> list[str]:
+    """The Board section (:mod:`.datasheet_board`) of the saved board report, at the
+    report's own size."""
+    rep, point = inputs.board, inputs.point_file.point
+    contract = None if rep is None else point.with_size(rep["height"], rep["width"]).contract()
+    return board.board_lines(rep, contract, inputs.point_file.path,
+                             inputs.board_path or "FILE.json", REPRODUCE, inputs.docs)
+
+
 def _anchor(title: str) -> str:
     """The Markdown anchor of a section title (GitHub's rule for plain words)."""
     return "-".join(title.lower().split())
@@ -320,8 +336,9 @@ def build_datasheet(inputs: DatasheetInputs) -> Datasheet:
     lines += summary_lines(inputs, feas, io) + _point_section(inputs, logic, feas)
     res, res_fig = _resources_section(inputs, feas)
     clk, clk_fig = _clock_section(inputs, feas)
-    lines += res + clk + _interfaces_section(inputs, feas, io)
+    lines += res + clk + _interfaces_section(inputs, feas, io) + _board_section(inputs)
     qual, qual_figs = _quality_section(inputs)
-    lines += qual + verification_lines(inputs, SECTIONS[5]) + reproduce_lines(inputs, feas.lanes)
+    lines += qual + verification_lines(inputs, SECTIONS[6]) + reproduce_lines(inputs, feas.lanes)
+    files = {board.CSV_NAME: board.pin_plan_csv(inputs.board)} if inputs.board else {}
     return Datasheet("\n".join(lines), {"resources.png": res_fig, "clock.png": clk_fig,
-                                        **qual_figs})
+                                        **qual_figs}, files)

@@ -167,7 +167,9 @@ class DatasheetInputs:
     (``fpga``, ``quality``, ``verify``, ``formal``, ``mutate``, ``regress``) the
     command that made it and where that command comes from, for results that do not
     record theirs (``--commands FILE.toml``); ``docs``: the path from the page to the
-    project's ``docs/`` folder (for links)."""
+    project's ``docs/`` folder (for links); ``board``: a saved ``rvsm fpga --board
+    --json`` report (:func:`~rvsm.sim.studies.datasheet_board.load_board_report`) and
+    ``board_path`` its file."""
 
     point_file: PointFile
     device: DeviceBudget
@@ -193,6 +195,8 @@ class DatasheetInputs:
     quality_path: str | None = None
     commands: dict[str, tuple[str, str]] = field(default_factory=dict)
     docs: str = "../docs"
+    board: dict[str, Any] | None = None
+    board_path: str | None = None
 
 
 def load_formal_report(path: str | os.PathLike) -> dict[str, Any]:
@@ -275,7 +279,7 @@ def load_regress_junit(path: str | os.PathLike) -> RegressSummary:
 
 
 #: The saved results a ``--commands`` file may give the command of.
-COMMAND_KEYS = ("fpga", "quality", "verify", "formal", "mutate", "regress")
+COMMAND_KEYS = ("fpga", "board", "quality", "verify", "formal", "mutate", "regress")
 
 
 def load_commands(path: str | os.PathLike) -> dict[str, tuple[str, str]]:

@@ -179,6 +179,15 @@ def reproduce_steps(inputs: DatasheetInputs, lanes: int) -> list[ReproduceStep]:
             f"{fp.get('work_dir', 'build/fpga')} > {inputs.fpga_path}",
             "reconstructed from the result's settings: its point and work folder")
         steps.append(ReproduceStep(f"place and route (`{inputs.fpga_path}`)", *got))
+    if inputs.board is not None:
+        from rvsm.sim.studies.datasheet_board import board_command
+
+        got = _recorded(inputs.board, "board", inputs, inputs.board_path) or (
+            board_command(pf.path, inputs.board, inputs.board_path),
+            "reconstructed from the result's settings: its point, size, front end and "
+            "work folder")
+        steps.append(ReproduceStep(f"place and route on the board's pins "
+                                   f"(`{inputs.board_path}`)", *got))
     if inputs.quality_path is not None:
         got = _recorded({"command": inputs.quality.command}, "quality", inputs,
                         inputs.quality_path)
