@@ -233,3 +233,38 @@ def test_datasheet_refusals_leave_nothing(files, tmp_path, capsys, case):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("rvsm: error: ")
     assert not out.exists()
+
+
+def test_datasheet_board_section_and_csv_follow_board_fpga(files, tmp_path, capsys):
+    """``--board-fpga``: the Board section and ``pin_plan.csv`` beside the page, the
+    board build's command in Reproduce; a report of another model is refused with
+    nothing written; remade without it, the section names the command and the CSV goes.
+    The report is the tiny board build's (tests/data/board-tiny/, the FSM point; its
+    tables are checked in tests/sim/studies/test_datasheet_board.py) relabelled as this
+    dog4 point's, whose links at 2x4 and one lane have the same pairs."""
+    from rvsm.sim.studies.datasheet_board import load_board_report, pin_plan_csv
+
+    saved = Path(__file__).resolve().parents[2] / "data" / "board-tiny" / "fpga-board.json"
+    out = tmp_path / "sheet"
+    base = ["datasheet", str(files["point"]), "-o", str(out), "--quality",
+            str(files["quality"]), "--fpga", str(files["fpga"]), "--quiet"]
+    assert main([*base, "--board-fpga", str(saved)]) == 2
+    assert "the board report is of model fsm" in capsys.readouterr().err
+    assert not out.exists()
+    board = json.loads(saved.read_text())
+    board["model"] = "dog4"
+    mine = tmp_path / "fpga-board.json"
+    mine.write_text(json.dumps(board))
+    assert main([*base, "--board-fpga", str(mine)]) == 0
+    md = (out / "datasheet.md").read_text()
+    assert _sections(md) == [FIRST, *SECTIONS, LAST]
+    section = md.split("\n## Board\n")[1].split("\n## ")[0]
+    assert "**CABGA381**: 21 of 205 pins" in section and "](pin_plan.csv)" in section
+    assert (out / "pin_plan.csv").read_text() == pin_plan_csv(load_board_report(mine))
+    assert "place and route on the board's pins" in md and "--interface axis --board" in md
+    assert main([*base, "--force"]) == 0
+    md = (out / "datasheet.md").read_text()
+    section = md.split("\n## Board\n")[1].split("\n## ")[0]
+    assert f"--board --json -o build/bench-board > {out.as_posix()}/results/fpga-board.json" \
+        in section
+    assert not (out / "pin_plan.csv").exists()

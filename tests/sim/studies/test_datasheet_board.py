@@ -8,7 +8,6 @@ import csv
 import io
 import json
 import re
-import shutil
 from pathlib import Path
 
 import pytest
@@ -156,26 +155,3 @@ def test_the_reconstructed_command_parses_and_names_the_build():
     assert re.search(r"--size 2x4\b", cmd) is None  # the point is 2x4 itself
     assert args.point == "tests/data/board-tiny.toml"
 
-
-def test_rvsm_datasheet_writes_the_board_section_and_its_csv(tmp_path: Path, monkeypatch):
-    """The command end to end on the tiny point (no synthesis, the smallest study)."""
-    from rvsm.sim.cli.main import main
-
-    out = tmp_path / "sheet"
-    shutil.copy(REPORT, tmp_path / "fpga-board.json")
-    code = main(["datasheet", str(POINT), "-o", str(out), "--no-synthesis",
-                 "--allow-infeasible", "--lanes", "1", "--frames", "2",
-                 "--steps-per-frame", "2", "--scenes", "coin", "--noise", "off", "--quiet",
-                 "--board-fpga", str(tmp_path / "fpga-board.json")])
-    assert code == 0
-    page = (out / "datasheet.md").read_text()
-    assert "\n## Board\n" in page and "](pin_plan.csv)" in page
-    assert (out / "pin_plan.csv").read_text() == pin_plan_csv(load_board_report(REPORT))
-    assert "place and route on the board's pins" in page
-    # remade without the report: the section names the command, the CSV is gone
-    assert main(["datasheet", str(POINT), "-o", str(out), "--no-synthesis", "--force",
-                 "--allow-infeasible", "--lanes", "1", "--frames", "2",
-                 "--steps-per-frame", "2", "--scenes", "coin", "--noise", "off",
-                 "--quiet"]) == 0
-    page = (out / "datasheet.md").read_text()
-    assert "--board --json -o build/bench-board >" in page and not (out / "pin_plan.csv").exists()

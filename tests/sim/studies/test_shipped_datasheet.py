@@ -20,6 +20,9 @@ ROOT = Path(__file__).resolve().parents[3]
 POINT = ROOT / "points" / "ecp5-85-40khz.toml"
 SHEET = ROOT / "docs" / "datasheet-ecp5-85-40khz"
 RESULTS = SHEET / "results"
+#: The full-size board report (make bench-board), when saved; its pin plan if the
+#: report predates board.sites.
+BOARD, BOARD_PLAN = RESULTS / "fpga-board.json", RESULTS / "pin_plan.json"
 
 
 @pytest.fixture(scope="module")
@@ -69,8 +72,9 @@ def test_reproduce_has_every_command_whole_and_each_parses(page):
     from rvsm.sim.cli.main import build_parser
 
     commands = _reproduce_commands(page)
-    # the page, fpga, quality, verify, formal, mutate, regress, the two Verilog builds
-    assert len(commands) == 9
+    # the page, fpga, (the board report when saved), quality, verify, formal, mutate,
+    # regress, the two Verilog builds
+    assert len(commands) == 9 + BOARD.is_file()
     parser = build_parser()
     parsed = {}
     for cmd in commands:
@@ -204,3 +208,30 @@ def test_formal_mutation_and_regression_results_are_the_saved_ones(page):
     m = _json("mutate.json")
     assert f"{m['killed']} of {m['mutations']} mutations killed" in page
     assert "regression ecp5-85-40khz" in page
+
+
+def test_board_section_is_the_saved_board_report_or_names_its_command(page):
+    """With results/fpga-board.json: the section's pin plan, links and clocks are the
+    report's and pin_plan.csv beside the page is its pin plan; without it: one line
+    naming the command that makes it, and no CSV."""
+    from rvsm.sim.studies.datasheet_board import load_board_report, pin_plan_csv
+
+    text = _section(page, "Board")
+    if not BOARD.is_file():
+        assert ("`rvsm fpga points/ecp5-85-40khz.toml --board --json -o build/bench-board "
+                "> docs/datasheet-ecp5-85-40khz/results/fpga-board.json`") in text
+        assert not (SHEET / "pin_plan.csv").exists()
+        return
+    report = load_board_report(BOARD, BOARD_PLAN if BOARD_PLAN.is_file() else None)
+    b = report["board"]
+    assert f"**{b['package']}**: {b['pins_used']} of {b['pins_available']} pins" in text
+    for s in report.sites:
+        assert "| " + " | ".join(str(s[k]) if s[k] != "" else "-" for k in
+                                 ("port", "ball", "bank", "pio", "pair", "io_type")) + " |" \
+            in text, s["port"]
+    for net, c in b["clocks"].items():
+        assert (f"| {c['role']} | `{net}` | {c['achieved_mhz']:.1f} | "
+                f"{c['constraint_mhz']:g} | {'met' if c['met'] else 'MISSED'} |") in text
+    assert (SHEET / "pin_plan.csv").read_text(encoding="utf-8") == pin_plan_csv(report)
+    point, build = load_point_file(POINT)
+    assert (report["model"], report["lanes"]) == (point.model, build.lanes)
