@@ -2,8 +2,8 @@
 "Reproduce" section with every command whole.
 
 :func:`summary_lines` -- one table: device and package, clock and Fmax with its margin,
-lanes, throughput, latency, state memory, utilisation, PSNR against the float models and
-what was verified (each row from the figures the page's sections show).
+lanes, throughput, latency, state memory, utilisation, the board build, PSNR against the
+float models and what was verified (each row from the figures the page's sections show).
 
 :func:`reproduce_steps` -- for the page and each saved result, the command that makes it
 again and where that command comes from: recorded in the result (``command``), given in
@@ -78,6 +78,18 @@ def _verified(inputs: DatasheetInputs) -> str:
     return ("; ".join(parts) if parts else "nothing given") + f" ({_see('Verification')})"
 
 
+def _board(report: dict[str, Any] | None) -> str:
+    """The board row: package, pins and clocks of a saved ``rvsm fpga --board`` report."""
+    if report is None:
+        return f"not placed with its links ({_see('Board')})"
+    b = report["board"]
+    missed = [c["role"] for c in b["clocks"].values() if not c["met"]]
+    return (f"{b['package']}: {b['pins_used']} of {b['pins_available']} pins, every port at "
+            f"a named site, at {report['height']}x{report['width']}; "
+            + ("every clock met" if not missed else f"MISSED: {', '.join(missed)}")
+            + f" ({_see('Board')})")
+
+
 def _see(section: str) -> str:
     """A link to ``section`` of the page."""
     return f"[{section}](#{'-'.join(section.lower().split())})"
@@ -133,6 +145,7 @@ def summary_lines(inputs: DatasheetInputs, feas: Feasibility, io: Interfaces) ->
                      f"measured (place and route): {used} ({_see('Resources')})"))
     else:
         rows.append(("utilisation", f"estimate only: {feas.summary()} ({_see('Resources')})"))
+    rows.append(("board", _board(inputs.board)))
     q = inputs.quality.rows_with(False) or inputs.quality.rows
     if q:
         n = len(q)
