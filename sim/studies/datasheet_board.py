@@ -65,6 +65,7 @@ class BoardReport(dict):
 
     path: str
     sites: list[dict[str, Any]]
+    sites_from: str
 
 
 def _sites(sites: Any, where: str) -> list[dict[str, Any]]:
@@ -107,6 +108,7 @@ def load_board_report(path: str | os.PathLike, pin_plan: str | os.PathLike | Non
         raise RvsmError(f"{path}: {len(sites)} sites for {b['ports']} ports")
     out = BoardReport(d)
     out.path, out.sites = str(path), sites
+    out.sites_from = "its board.sites" if own is not None else f"`{pin_plan}`"
     return out
 
 
@@ -203,7 +205,8 @@ def _timing_lines(b: dict[str, Any]) -> list[str]:
                "NOT every clock meets its constraint: "
                + ", ".join(c["role"] for c in b["clocks"].values() if not c["met"])
                + " MISSED")
-    out += ["", f"{verdict}. {b.get('edge_clock_note', '')}".rstrip() + ".", "",
+    note = b.get("edge_clock_note", "")
+    out += ["", f"{verdict}. {note[:1].upper()}{note[1:]}".rstrip(". ") + ".", "",
             "| primitive | used | available on the die |", "|---|---|---|"]
     out += [f"| {k} | {v['used']} | {v['available']} |" for k, v in b["primitives"].items()]
     return out
@@ -213,7 +216,7 @@ def _sequence_lines(front_end: str | None) -> list[str]:
     regs = front_end == "IpBoardFrontEnd"
     poll = ("poll `LINK_STATUS` over SPI until `locked` and `aligned` are 1 and "
             "`train_request` 0, then `STATUS.busy` 0" if regs else
-            "read the status word on `spi_miso` until `locked` and `aligned` are 1")
+            "reads the status word on `spi_miso` until `locked` and `aligned` are 1")
     return [
         f"1. Release reset (`rst_n`) with the oscillator running; the core and transmit "
         "clocks come from the PLL and wait for its lock. The receive SCLK domain stays in "
@@ -263,7 +266,8 @@ def board_lines(report: BoardReport | None, contract: ArrayContract | None,
             ", the smallest ECP5-85 package that carries the links; smaller ones "
             "rejected by the pin planner:" if b["rejected_packages"] else
             ": the first package tried carries the links."), ""]
-    lines += [f"- {p['package']}: {p['reason']}" for p in b["rejected_packages"]]
+    lines += [f"- {p['package']}: {p['reason'].removeprefix(p['package'] + ': ')}"
+              for p in b["rejected_packages"]]
     lines += ["", "**Links** (source-synchronous LVDS, a forwarded clock pair each; the "
               "framing lane carries `sof`, `eol`, parity and the training marks):", ""]
     lines += _links_table(report, rows)
@@ -284,7 +288,8 @@ def board_lines(report: BoardReport | None, contract: ArrayContract | None,
               + "):", ""]
     lines += [link_registers_markdown(link_registers(rx_pairs)).rstrip("\n"), "",
               f"Sources: `rvsm fpga --board` saved as `{report.path}` (its `board` object: "
-              "package, sites, clocks, primitives); payload from rtl/board/front_end.py, "
-              "limit from rtl/fpga/package_io.py, registers from rtl/board/status.py; "
+              f"package, clocks, primitives; the sites from {report.sites_from}); payload "
+              "from rtl/board/front_end.py, limit from rtl/fpga/package_io.py, registers "
+              "from rtl/board/status.py; "
               f"commands: {reproduce}.", ""]
     return lines

@@ -89,7 +89,7 @@ def test_the_section_tables_are_the_report_and_its_pin_plan():
     assert "FPGA-TN-02035" in text
     # rejected packages with the planner's reason; the registers as status.py renders them
     for p in b["rejected_packages"]:
-        assert f"- {p['package']}: {p['reason']}" in text
+        assert f"- {p['package']}: {p['reason'].removeprefix(p['package'] + ': ')}" in text
     assert link_registers_markdown(link_registers(rx.pairs)).strip() in text
     assert "LINK_CONTROL.train" in text and "Training and reset sequence" in text
     # the CSV beside the page: the same rows
@@ -110,7 +110,7 @@ def test_link_rates_come_from_the_sclk_constraint():
     other = dict(report)
     other["lanes"] = 8
     copy = type(report)(other)
-    copy.path, copy.sites = report.path, report.sites
+    copy.path, copy.sites, copy.sites_from = report.path, report.sites, report.sites_from
     with pytest.raises(RvsmError, match="pairs placed"):
         link_rows(copy, wide)
 
