@@ -199,6 +199,10 @@ def reproduce_steps(inputs: DatasheetInputs, lanes: int) -> list[ReproduceStep]:
             board_command(pf.path, inputs.board, inputs.board_path),
             "reconstructed from the result's settings: its point, size, front end and "
             "work folder")
+        sites = getattr(inputs.board, "sites_from", "its board.sites")
+        if sites != "its board.sites":
+            got = (got[0], f"{got[1]}; the pin plan {sites} is pin_plan.json of the work "
+                           "folder")
         steps.append(ReproduceStep(f"place and route on the board's pins "
                                    f"(`{inputs.board_path}`)", *got))
     if inputs.quality_path is not None:
