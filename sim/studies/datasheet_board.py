@@ -249,9 +249,10 @@ def board_lines(report: BoardReport | None, contract: ArrayContract | None,
     Reproduce section; ``docs``: the path from the page to ``docs/``."""
     head = [f"## {TITLE}", ""]
     if report is None or contract is None:
-        return head + [f"Not placed with its links: `{board_command(point_path, None, path_hint)}`"
-                       f" makes the report, `--board-fpga` gives it to this page "
-                       f"({docs}/fpga.md, Board build); commands: {reproduce}.", ""]
+        return head + [f"Not placed with its links. Sources: not run: "
+                       f"`{board_command(point_path, None, path_hint)}` makes the report, "
+                       f"`--board-fpga` gives it to this page ({docs}/fpga.md, Board "
+                       f"build); commands: {reproduce}.", ""]
     b = report["board"]
     fe = b.get("front_end") or "BoardFrontEnd"
     rows = link_rows(report, contract)
