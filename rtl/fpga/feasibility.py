@@ -39,7 +39,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.loaders import parse_size
 from rvsm.rtl.fpga.block_ram import StateLayout, StatePacking, pack_state
 from rvsm.rtl.fpga.camera import clock_needed_hz, lanes_needed
-from rvsm.rtl.fpga.devices import DeviceBudget
+from rvsm.rtl.fpga.devices import BUDGETS, ESTIMATE_ONLY, DeviceBudget
 from rvsm.rtl.fpga.io_budget import SCOPES, IoPlan, io_plan
 
 __all__ = ["DEFAULT_MAX_UTILISATION", "Camera", "Check", "Feasibility", "LogicCost",
@@ -194,17 +194,19 @@ class Feasibility:
     def summary(self) -> str:
         """``"feasible at P = 40"`` or what breaks, with figures."""
         head = f"P = {self.lanes} at {self.clock_needed_hz / 1e6:.1f} MHz"
+        dev = self.device + ("" if BUDGETS[self.device].placed else f" ({ESTIMATE_ONLY})")
         if self.feasible:
             io = self.checks.get("io")
-            return f"feasible on {self.device} at {head}" + (
+            return f"feasible on {dev} at {head}" + (
                 f"; I/O {io.figure:,.0f} / {io.budget:,.0f} {io.unit}" if io else "")
         bad = self.broken or self.unknown
         word = "breaks" if self.broken else "unverified"
-        return f"{word} on {self.device} at {head}: " + "; ".join(c.text() for c in bad)
+        return f"{word} on {dev} at {head}: " + "; ".join(c.text() for c in bad)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready verdicts."""
-        return {"device": self.device, "camera": self.camera.text(), "lanes": self.lanes,
+        return {"device": self.device, "status": BUDGETS[self.device].status,
+                "camera": self.camera.text(), "lanes": self.lanes,
                 "clock_needed_mhz": self.clock_needed_hz / 1e6,
                 "organisation": self.organisation, "feasible": self.feasible,
                 "checks": {k: {"ok": c.ok, "figure": c.figure, "budget": c.budget,

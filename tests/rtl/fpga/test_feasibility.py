@@ -111,7 +111,8 @@ def test_no_timing_model_or_logic_is_unknown_not_feasible() -> None:
     f = assess(small, get_budget("gw2a-18"), cam, DEFAULT_LOGIC)
     assert not f.feasible and not f.broken
     assert [c.name for c in f.unknown] == ["fmax", "io"]  # no per-bank I/O off the ECP5
-    assert f.summary().startswith("unverified on gw2a-18")
+    assert f.summary().startswith("unverified on gw2a-18 (estimate only)")
+    assert f.to_dict()["status"] == "estimate only"
     assert "ECP5 figures as a proxy on gowin" in f.checks["lut4"].detail
     g = assess(small, ECP5, cam, None)
     assert {c.name for c in g.unknown} == {"lut4", "ff"}
