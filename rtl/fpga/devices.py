@@ -314,7 +314,8 @@ class DeviceBudget:
         lut = f", {self.lutram.available} {self.lutram.name}" if self.lutram else ""
         timing = (f"Fmax model {self.timing.family} speed {self.timing.speed}"
                   if self.timing else "no Fmax model")
-        return (f"{self.name} ({self.status}): {self.part} ({self.tool}): {self.lut4:,} LUT4, {self.ff:,} FF, "
+        return (f"{self.name} ({self.status}): {self.part} ({self.tool}): {self.lut4:,} LUT4, "
+                f"{self.ff:,} FF, "
                 f"{self.bram} {self.bram_kind.name} ({self.bram_bits / 1e6:.2f} Mbit; "
                 f"{', '.join(a.text() for a in self.bram_kind.aspects)}){extra}{lut}, "
                 f"{self.multipliers} multipliers; {timing}")

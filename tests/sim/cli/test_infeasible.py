@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pytest
-
 from rvsm.sim.cli import main
 
 POINT = (Path(__file__).parents[3] / "points" / "ecp5-85-40khz.toml").read_text()

@@ -129,8 +129,11 @@ def test_report_ranks_what_fits_and_says_what_breaks(tmp_path, capsys, fake_synt
 def test_cli_devices_and_bad_values_exit_2(tmp_path, capsys, fake_synthesis):
     assert main(["sweep", "devices"]) == 0
     out = capsys.readouterr().out
-    assert "ecp5-85: LFE5U-85F speed 6" in out and "208 DP16KD" in out
-    assert "512x36 (pseudo-dual)" in out and "ice40-up5k" in out
+    assert "ecp5-85 (placed and routed): LFE5U-85F speed 6" in out and "208 DP16KD" in out
+    assert "512x36 (pseudo-dual)" in out and "ice40-up5k (estimate only): " in out
+    rows = [r for r in out.splitlines() if not r.startswith("  ")]
+    assert len(rows) == 13 and all(("(placed and routed)" in r) != ("(estimate only)" in r)
+                                   for r in rows)
     f = tmp_path / "s.toml"
     f.write_text(HEAD.replace("ecp5-85", "nosuch") + BODY)
     assert main(["sweep", str(f), "-o", str(tmp_path / "x.sqlite")]) == 2
