@@ -19,8 +19,10 @@ built) and the full sensor's own place and route (:data:`FULL_SENSOR`) say why:
 3. **nextpnr packs into more sites than yosys counts.** The same run's yosys netlist has
    7,788 LUT4 + 2 x 5,692 CCU2C = 19,172 sites; nextpnr reports 23,546 ``TRELLIS_COMB``
    of which 560 are the 140 ``TRELLIS_DPR16X4`` (4 each): :data:`PNR_LUT4_FACTOR` =
-   (23,546 - 560) / 19,172 = 1.199. (The 64x64, P = 8 run of docs/fpga.md, earlier RTL,
-   gave 14,982 / 12,332 = 1.215: the factor is the fabric's, not this design's.)
+   (23,546 - 560) / 19,172 = 1.199. A small place and route of today's RTL,
+   :data:`SMALL_PLACED` (128x40, P = 2), gives 1.206, and the 64x64, P = 8 run of
+   docs/fpga.md (earlier RTL) 14,982 / 12,332 = 1.215: the factor is the fabric's and
+   nextpnr's packing, not this design's size.
 
 So the placed LUT4 of a point at ``P`` lanes is ``PNR_LUT4_FACTOR x (base + P x per_lane +
 bank multiplexers) + 4 x TRELLIS_DPR16X4``. Flip-flops need no refit: nextpnr's
@@ -38,7 +40,7 @@ from dataclasses import dataclass
 from rvsm.rtl.fpga.block_ram import RTL_BANK_WORDS, StateLayout, state_memories
 
 __all__ = ["BANK_LUT4", "CALIBRATION_RUNS", "FULL_SENSOR", "PNR_LUT4_FACTOR",
-           "SHIPPED_LANE_COST", "CalibrationRun", "PlacedRun", "bank_mux_lut4",
+           "SHIPPED_LANE_COST", "SMALL_PLACED", "CalibrationRun", "PlacedRun", "bank_mux_lut4",
            "fit_bank_lut4", "placed_lut4"]
 
 
@@ -96,6 +98,11 @@ class PlacedRun:
 #: (``lut4.used`` and ``synth_cells``).
 FULL_SENSOR = PlacedRun("docs/datasheet-ecp5-85-40khz/results/fpga.json", 23546, 7788, 5692,
                         140)
+#: A small place and route of the same point on today's RTL (the check of the factor):
+#: ``rvsm fpga points/ecp5-85-40khz.toml --size 128x40 --lanes 2 --json`` (commit
+#: 37927a9; 201.8 MHz, 12 DP16KD).
+SMALL_PLACED = PlacedRun("rvsm fpga points/ecp5-85-40khz.toml --size 128x40 --lanes 2",
+                         1475, 533, 322, 14)
 #: nextpnr ``TRELLIS_COMB`` per yosys ``LUT4 + 2 x CCU2C`` (module docstring, 3).
 PNR_LUT4_FACTOR = round(FULL_SENSOR.factor, 3)
 

@@ -64,6 +64,8 @@ def test_the_packing_factor_is_the_saved_place_and_routes():
         r["lut4"]["used"], cells["LUT4"], cells["CCU2C"], cells["TRELLIS_DPR16X4"])
     assert pl.PNR_LUT4_FACTOR == pytest.approx(run.factor, abs=5e-4)
     assert 1.15 < pl.PNR_LUT4_FACTOR < 1.25  # 1.215 on the 64x64, P = 8 run (docs/fpga.md)
+    # a small array of today's RTL packs alike: the factor is not the full sensor's alone
+    assert pl.SMALL_PLACED.factor == pytest.approx(pl.PNR_LUT4_FACTOR, abs=0.02)
 
 
 def test_the_bank_term_is_the_fit_of_the_calibration_runs():
