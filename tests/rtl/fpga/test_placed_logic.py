@@ -49,6 +49,17 @@ def test_shipped_point_estimate_is_within_10_percent_of_nextpnr():
     assert f.packing.lutram == r["synth_cells"]["TRELLIS_DPR16X4"]
 
 
+def test_the_shipped_page_shows_the_models_estimate_beside_nextpnrs():
+    f = _shipped_estimate()
+    r = json.loads(FPGA_JSON.read_text(encoding="utf-8"))
+    page = (FPGA_JSON.parents[1] / "datasheet.md").read_text(encoding="utf-8")
+    resources = page.split("\n## Resources\n", 1)[1].split("\n## ", 1)[0]
+    for row, key, check in (("LUT4", "lut4", "lut4"), ("FF", "ff", "ff"),
+                            ("DP16KD", "bram", "memory")):
+        assert f"| {row} | {r[key]['used']:,} (" in resources, row
+        assert f") | {f.checks[check].figure:,.0f} (" in resources, row
+
+
 def test_the_old_small_array_fit_alone_is_over_10_percent_under():
     # the fit of 16x16 at P = 1 and 2 without the refit: 97 + 40 x 436 + 560 = 18,097
     r = json.loads(FPGA_JSON.read_text(encoding="utf-8"))
