@@ -20,7 +20,8 @@ built) and the full sensor's own place and route (:data:`FULL_SENSOR`) say why:
    7,788 LUT4 + 2 x 5,692 CCU2C = 19,172 sites; nextpnr reports 23,546 ``TRELLIS_COMB``
    of which 560 are the 140 ``TRELLIS_DPR16X4`` (4 each): :data:`PNR_LUT4_FACTOR` =
    (23,546 - 560) / 19,172 = 1.199. A small place and route of today's RTL,
-   :data:`SMALL_PLACED` (128x40, P = 2), gives 1.206, and the 64x64, P = 8 run of
+   :data:`SMALL_PLACED` (128x40, P = 2), gives 1.206, nextpnr's packing of 16x80, P = 40
+   (:data:`WIDE_PACKED`) 1.228, and the 64x64, P = 8 run of
    docs/fpga.md (earlier RTL) 14,982 / 12,332 = 1.215: the factor is the fabric's and
    nextpnr's packing, not this design's size.
 
@@ -40,8 +41,8 @@ from dataclasses import dataclass
 from rvsm.rtl.fpga.block_ram import RTL_BANK_WORDS, StateLayout, state_memories
 
 __all__ = ["BANK_LUT4", "CALIBRATION_RUNS", "FULL_SENSOR", "PNR_LUT4_FACTOR",
-           "SHIPPED_LANE_COST", "SMALL_PLACED", "CalibrationRun", "PlacedRun", "bank_mux_lut4",
-           "fit_bank_lut4", "placed_lut4"]
+           "SHIPPED_LANE_COST", "SMALL_PLACED", "WIDE_PACKED", "CalibrationRun", "PlacedRun",
+           "bank_mux_lut4", "fit_bank_lut4", "placed_lut4"]
 
 
 @dataclass(frozen=True)
@@ -103,6 +104,11 @@ FULL_SENSOR = PlacedRun("docs/datasheet-ecp5-85-40khz/results/fpga.json", 23546,
 #: 37927a9; 201.8 MHz, 12 DP16KD).
 SMALL_PLACED = PlacedRun("rvsm fpga points/ecp5-85-40khz.toml --size 128x40 --lanes 2",
                          1475, 533, 322, 14)
+#: nextpnr's packing of 16x80, P = 40 (40 lanes, one bank): the utilisation it reports after
+#: packing (``rvsm fpga points/ecp5-85-40khz.toml --size 16x80 --lanes 40``, stopped in
+#: placement; same commit): 21,029 ``TRELLIS_COMB``, factor 1.228.
+WIDE_PACKED = PlacedRun("rvsm fpga points/ecp5-85-40khz.toml --size 16x80 --lanes 40 "
+                        "(packing only)", 21029, 5321, 5673, 140)
 #: nextpnr ``TRELLIS_COMB`` per yosys ``LUT4 + 2 x CCU2C`` (module docstring, 3).
 PNR_LUT4_FACTOR = round(FULL_SENSOR.factor, 3)
 

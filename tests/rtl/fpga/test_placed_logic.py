@@ -77,6 +77,7 @@ def test_the_packing_factor_is_the_saved_place_and_routes():
     assert 1.15 < pl.PNR_LUT4_FACTOR < 1.25  # 1.215 on the 64x64, P = 8 run (docs/fpga.md)
     # a small array of today's RTL packs alike: the factor is not the full sensor's alone
     assert pl.SMALL_PLACED.factor == pytest.approx(pl.PNR_LUT4_FACTOR, abs=0.02)
+    assert pl.WIDE_PACKED.factor == pytest.approx(pl.PNR_LUT4_FACTOR, abs=0.04)
 
 
 def test_the_bank_term_is_the_fit_of_the_calibration_runs():
