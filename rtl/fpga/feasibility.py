@@ -9,8 +9,10 @@ lane counts that divide ``W`` from the fewest up and checks at each:
   wide words (:func:`~rvsm.rtl.fpga.block_ram.pack_state`), and the line buffer into its
   distributed RAM (or block RAM);
 * **lut4** and **ff**: the logic at ``P`` lanes, ``base + P * per_lane`` from the lane
-  cost model (:mod:`rvsm.rtl.fpga.lane_cost`: ECP5 LUT4 and flip-flops from yosys) plus
-  the line buffer's distributed RAM (4 LUT4 per 16x4), fits ``max_utilisation`` (80 % by
+  cost model (:mod:`rvsm.rtl.fpga.lane_cost`: ECP5 LUT4 and flip-flops from yosys), the
+  LUT4 with the bank read multiplexers and nextpnr's packing factor refit on the full
+  sensor's place and route (:func:`~rvsm.rtl.fpga.placed_logic.placed_lut4`) plus the
+  line buffer's distributed RAM (4 LUT4 per 16x4), fits ``max_utilisation`` (80 % by
   default: routing headroom) of the device; on other families the ECP5 figures stand in
   for their LUT4 (a proxy, said in the verdict);
 * **fmax**: the Fmax at ``P`` reaches the clock the camera needs: the smaller of the
@@ -39,8 +41,9 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.loaders import parse_size
 from rvsm.rtl.fpga.block_ram import StateLayout, StatePacking, pack_state
 from rvsm.rtl.fpga.camera import clock_needed_hz, lanes_needed
-from rvsm.rtl.fpga.devices import DeviceBudget
+from rvsm.rtl.fpga.devices import BUDGETS, ESTIMATE_ONLY, DeviceBudget
 from rvsm.rtl.fpga.io_budget import SCOPES, IoPlan, io_plan
+from rvsm.rtl.fpga.placed_logic import placed_lut4
 
 __all__ = ["DEFAULT_MAX_UTILISATION", "Camera", "Check", "Feasibility", "LogicCost",
            "MeasuredFmax", "assess"]
@@ -194,17 +197,19 @@ class Feasibility:
     def summary(self) -> str:
         """``"feasible at P = 40"`` or what breaks, with figures."""
         head = f"P = {self.lanes} at {self.clock_needed_hz / 1e6:.1f} MHz"
+        dev = self.device + ("" if BUDGETS[self.device].placed else f" ({ESTIMATE_ONLY})")
         if self.feasible:
             io = self.checks.get("io")
-            return f"feasible on {self.device} at {head}" + (
+            return f"feasible on {dev} at {head}" + (
                 f"; I/O {io.figure:,.0f} / {io.budget:,.0f} {io.unit}" if io else "")
         bad = self.broken or self.unknown
         word = "breaks" if self.broken else "unverified"
-        return f"{word} on {self.device} at {head}: " + "; ".join(c.text() for c in bad)
+        return f"{word} on {dev} at {head}: " + "; ".join(c.text() for c in bad)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready verdicts."""
-        return {"device": self.device, "camera": self.camera.text(), "lanes": self.lanes,
+        return {"device": self.device, "status": BUDGETS[self.device].status,
+                "camera": self.camera.text(), "lanes": self.lanes,
                 "clock_needed_mhz": self.clock_needed_hz / 1e6,
                 "organisation": self.organisation, "feasible": self.feasible,
                 "checks": {k: {"ok": c.ok, "figure": c.figure, "budget": c.budget,
@@ -265,15 +270,15 @@ def _checks_at(layout: StateLayout, device: DeviceBudget, camera: Camera, lanes:
         checks["ff"] = Check("ff", None, None, device.ff * max_utilisation, "FF", "")
     else:
         proxy = "" if device.family == "ecp5" else f"; ECP5 figures as a proxy on {device.family}"
-        lut = logic.lut4_base + lanes * logic.lut4_per_lane + sp.lutram_lut4
+        lut, how = placed_lut4(logic.lut4_base, logic.lut4_per_lane, layout, lanes,
+                               sp.lutram_lut4)
         lut_budget = device.lut4 * max_utilisation
         ff = logic.ff_base + lanes * logic.ff_per_lane
         ff_budget = device.ff * max_utilisation
         checks["lut4"] = Check(
             "lut4", lut <= lut_budget, lut, lut_budget, "LUT4",
-            f"{logic.lut4_base:.0f} + {lanes} x {logic.lut4_per_lane:.0f} per lane"
-            + (f" + {sp.lutram_lut4} line-buffer RAM" if sp.lutram_lut4 else "")
-            + f", {100 * max_utilisation:.0f} % of {device.lut4:,} ({logic.source}{proxy})")
+            f"{how}, {100 * max_utilisation:.0f} % of {device.lut4:,} ({logic.source}; "
+            f"placed by rtl/fpga/placed_logic.py{proxy})")
         checks["ff"] = Check(
             "ff", ff <= ff_budget, ff, ff_budget, "FF",
             f"{logic.ff_base:.0f} + {lanes} x {logic.ff_per_lane:.0f} per lane, "

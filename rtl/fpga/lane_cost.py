@@ -14,6 +14,9 @@ its memory grows with the array and hardly with ``P``. So a design point's cost 
 * **memory bits** -- exact, from the design point at its own (sensor) size
   (:class:`~rvsm.rtl.fpga.camera.StateMemory`): accumulators, thresholds, line buffers;
 * optionally **Fmax** -- nextpnr-ecp5 place and route of the ``P1`` array (minutes).
+
+The fit is yosys' count at one bank; :mod:`rvsm.rtl.fpga.placed_logic` turns it into the
+placed LUT4 of a full-size array (bank multiplexers, nextpnr's packing).
 """
 
 from __future__ import annotations
@@ -112,10 +115,13 @@ def lane_synthesis(
     work_dir: str | os.PathLike | None = None,
     on_progress: Callable[[Progress], None] | None = None,
     timeout: float | None = None,
+    memory: str = "inferred",
 ) -> LaneSynthesis:
     """Synthesise ``point``'s streaming array at ``size`` with ``lanes`` lanes (and place
     and route it if ``fmax``): one independent half of :func:`lane_cost`, so a sweep can
-    run the two lane counts on two workers."""
+    run the two lane counts on two workers. ``memory``: ``"inferred"`` (what sweeps store)
+    or ``"dp16kd"`` (as a point is built; the runs of
+    :data:`~rvsm.rtl.fpga.placed_logic.CALIBRATION_RUNS`)."""
     t0 = time.monotonic()
     contract = point.with_size(*size).contract()
     with tempfile.TemporaryDirectory(prefix="rvsm-lane-cost-") as tmp:
@@ -123,7 +129,7 @@ def lane_synthesis(
         component, _ = build_component(contract, "stream", lanes=lanes)
         # inferred memories: the figures sweeps have always stored (bank registers in FF)
         syn = synthesise(component, root / f"p{lanes}", netlist="verilog",
-                         memory="inferred", on_progress=on_progress, timeout=timeout)
+                         memory=memory, on_progress=on_progress, timeout=timeout)
         fmax_mhz = None
         if fmax:
             pnr, _ = place_and_route(syn, get_device(device), on_progress=on_progress,

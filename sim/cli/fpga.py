@@ -22,7 +22,6 @@ def _size(text: str) -> tuple[int, int]:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``fpga`` sub-command."""
-    from rvsm.rtl.fpga.devices import DEVICES
     from rvsm.sim.cli.rtl import add_arch_arguments, add_interface_arguments
 
     p = sub.add_parser(
@@ -37,8 +36,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--size", type=_size, metavar="HxW",
                    help="size of the array built (default: the design point's)")
     add_arch_arguments(p, from_point=True)
-    p.add_argument("--device", choices=tuple(DEVICES),
-                   help=f"ECP5 part (default: the point's [rtl] device, else {DEVICE})")
+    p.add_argument("--device", metavar="NAME",
+                   help="device of the one list (rvsm sweep devices); the ECP5 parts place "
+                   "and route, an estimate-only part is refused in one line (default: the "
+                   f"point's [rtl] device, else {DEVICE})")
     p.add_argument("--speed", type=int, choices=(6, 7, 8), default=6,
                    help="ECP5 speed grade (default 6)")
     p.add_argument("--freq", type=float, metavar="MHZ",
@@ -85,6 +86,24 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_fpga)
 
 
+def _check_device(args: argparse.Namespace) -> None:
+    """Refuse, in one line and before anything is printed, a ``--device`` (or the point's
+    ``[rtl] device``) that is unknown or estimate only (:func:`~rvsm.rtl.fpga.devices.get_device`);
+    a point that does not load is left to :func:`~rvsm.sim.cli.build_choice.choose_build`."""
+    from rvsm.model.fixed.point_toml import load_point_file
+    from rvsm.rtl.fpga.devices import BUDGETS, get_device
+
+    if args.device is not None:
+        get_device(args.device)
+        return
+    try:
+        device = load_point_file(args.point)[1].device
+    except (RvsmError, OSError):
+        return
+    if device in BUDGETS:  # an unknown one: choose_build names rtl.device
+        get_device(device)
+
+
 def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.architectures.registry import get_architecture
@@ -95,6 +114,7 @@ def _fpga(args: argparse.Namespace) -> int:
     if args.timeout is not None and args.timeout <= 0:
         raise RvsmError(f"--timeout must be > 0 seconds, got {args.timeout}")
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
+    _check_device(args)
     choice = choose_build(args, "fpga", args.point, {
         **ARCH_DEFAULTS, "freq_mhz": ("freq", FREQ_MHZ), "device": ("device", DEVICE),
         "memory": ("memory", MEMORY)})

@@ -133,6 +133,7 @@ def _run(args: argparse.Namespace, sweep_file: str) -> int:
 
 
 def _report(args: argparse.Namespace) -> int:
+    from rvsm.rtl.fpga.devices import ESTIMATE_ONLY, get_budget
     from rvsm.sim.sweep.report import write_report
 
     db = Path(args.path)
@@ -156,7 +157,8 @@ def _report(args: argparse.Namespace) -> int:
               f"{rec['label']}")
     for device, fit in (rec or {}).get("fits", {}).items():
         bad = rec["infeasible"][device]
-        print(f"fits {device}: {len(fit)} of {len(fit) + len(bad)} design(s)")
+        mark = "" if get_budget(device).placed else f" ({ESTIMATE_ONLY})"
+        print(f"fits {device}{mark}: {len(fit)} of {len(fit) + len(bad)} design(s)")
         verdicts = {v["label"]: v for v in rec["verdicts"][device]}
         for i, d in enumerate(fit, 1):
             print(f"  {i}. {d['label']}: {d['worst_cost']:.3f} dB, {d['summary']}")

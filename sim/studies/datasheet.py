@@ -218,9 +218,17 @@ def _resources_section(inputs: DatasheetInputs, feas: Feasibility) -> tuple[list
         verdict = budget_text(check) if check.ok is not None else \
             "unknown: no logic figure (see Sources)"
         lines.append(f"| {k} | {m} | {e} | {avail[k]:,} | {verdict} |")
-    lines += ["", f"Measured column: {where}. The estimate is the feasibility model "
-              "(rtl/fpga/feasibility.py): state packed into the device's block RAM, "
-              "logic = fixed + P x per lane, at most "
+    harness = ("" if not fp or fp.get("harness_lut4") is None else
+               f" The measured figures include the I/O harness `rvsm fpga` adds "
+               f"({fp['harness_lut4']:,} LUT4 and {fp.get('harness_ff', 0):,} FF by yosys' "
+               "count); the estimate is the design's alone.")
+    lutram = ("" if not feas.packing.lutram else
+              f" The line buffer's {feas.packing.lutram} {dev.lutram.name} are logic sites: "
+              f"counted in the LUT4 ({dev.lutram.lut4} each), not in the block RAM.")
+    lines += ["", f"Measured column: {where}.{harness}{lutram} The estimate is the "
+              "feasibility model (rtl/fpga/feasibility.py): state packed into the device's "
+              "block RAM, logic = fixed + P x per lane refit on the full sensor's place and "
+              "route (rtl/fpga/placed_logic.py), at most "
               f"{c['lut4'].budget / dev.lut4 * 100 if c['lut4'].budget else 80:.0f} % of "
               "the LUT4 and FF; it is an **estimate**, not a placed design. "
               f"Verdict of the estimate: {feas.summary()}.", "",

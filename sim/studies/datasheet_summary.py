@@ -104,7 +104,9 @@ def summary_lines(inputs: DatasheetInputs, feas: Feasibility, io: Interfaces) ->
     geo = io.geometry
     fmax = feas.checks["fmax"]
     rows: list[tuple[str, str]] = [
-        ("device", f"{dev.name}: {dev.part.split(' (')[0]}, placed by {dev.tool}"),
+        ("device", f"{dev.name}: {dev.part.split(' (')[0]}, "
+                   + (f"placed by {dev.tool}" if dev.placed else
+                      f"**{dev.status}** ({dev.status_reason})")),
         ("package", dev.part.split("(")[-1].rstrip(")") if "(" in dev.part else "not stated"),
     ]
     if fmax.budget is None:

@@ -189,7 +189,7 @@ def fit_markdown(designs: list, constraint: FitConstraint) -> list[str]:
             "FF | clock / Fmax (MHz) | I/O pairs |\n|---|---|---|---|---|---|---|---|---|---|---|")
     for name in constraint.devices:
         dev = get_budget(name)
-        lines += [f"### {name}", "", dev.summary() + ".", "",
+        lines += [f"### {name} ({dev.status})", "", dev.summary() + ".", "",
                   dev.package_io(constraint.package).summary() + ".", ""]
         ok = sorted((d for d in designs if d.feasibility[name].feasible),
                     key=lambda d: (d.worst_cost, d.label))

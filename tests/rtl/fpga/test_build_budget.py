@@ -33,6 +33,18 @@ def test_shipped_point_fits_and_its_figures():
     assert judge_build(point, build, "p") == "fits ecp5-85: state 192 / 208 DP16KD at 40 lane(s)"
 
 
+def test_an_estimate_only_rtl_device_is_judged_and_marked():
+    point, build = load_point_file(POINT)
+    gowin = dataclasses.replace(build, device="gw5ast-138")
+    verdict = judge_build(point, gowin, "p")
+    assert verdict.startswith("fits gw5ast-138: state ")
+    assert verdict.endswith("(estimate only: rvsm fpga does not place gw5ast-138; no Fmax "
+                            "model checks freq_mhz)")
+    small = dataclasses.replace(build, device="ice40-hx8k")
+    with pytest.raises(RvsmError, match="of rtl.device = ice40-hx8k"):
+        judge_build(point, small, "p")
+
+
 def test_clock_above_the_fmax_model_names_it():
     assert clock_above_fmax("ecp5-85", 40, 100.0) is None
     line = clock_above_fmax("ecp5-85", 40, 900.0)

@@ -27,8 +27,9 @@ def test_valid_settings_pass(settings):
      "native, axis"),
     (BuildSettings(arch="parallel", interface="axis"), "rtl.interface = 'axis' is not valid; "
      "arch parallel is offered with native"),
-    (BuildSettings(device="ice40-up5k"), "rtl.device = 'ice40-up5k' is not valid; choose one "
-     "of ecp5-25, ecp5-45, ecp5-85"),
+    (BuildSettings(device="ecp5-100"), "rtl.device = 'ecp5-100' is not valid; choose one "
+     "of ecp5-25, ecp5-45, ecp5-85, ice40-hx1k, ice40-hx8k, ice40-up5k, gw1n-1, gw1n-4, "
+     "gw1n-9, gw2a-18, gw5a-25, gw5ast-138, ccgm1a1"),
     (BuildSettings(memory="bram"), "rtl.memory = 'bram' is not valid; choose one of dp16kd, "
      "inferred"),
     (BuildSettings(arch="parallel", lanes=4), "rtl.lanes = 4 is not valid; arch parallel "

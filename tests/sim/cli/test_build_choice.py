@@ -97,7 +97,8 @@ def test_a_bad_value_is_refused_with_exit_2_and_one_line(
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err == (f"rvsm: error: {point}: rtl.device = 'xc7a35t' is not valid; choose one "
-                   "of ecp5-25, ecp5-45, ecp5-85\n")
+                   "of ecp5-25, ecp5-45, ecp5-85, ice40-hx1k, ice40-hx8k, ice40-up5k, gw1n-1, "
+                   "gw1n-4, gw1n-9, gw2a-18, gw5a-25, gw5ast-138, ccgm1a1\n")
     assert not (tmp_path / "v").exists() and not (tmp_path / "f").exists()
 
 

@@ -111,8 +111,10 @@ def test_datasheet_with_every_saved_result(files, tmp_path):
     # the fake fpga report's numbers, and its slope as the logic per lane
     assert "12,345" in md and "6,789" in md and "| DP16KD | 17 (8.2 %)" in md
     assert "123.4 MHz" in md and "1,111 LUT4 and 999 FF per lane" in md
-    # the estimate at the sensor's size: 222 + 4 x 1111 LUT4 and the line buffer's RAM
-    assert "222 + 4 x 1111 per lane" in md and "| LUT4 | 12,345 (14.8 %) | 4," in md
+    # the estimate at the sensor's size: nextpnr's 1.199 x (222 + 4 x 1111) LUT4 (one bank:
+    # no multiplexer) and the line buffer's RAM (rtl/fpga/placed_logic.py)
+    assert "1.199 x (222 + 4 x 1111 per lane)" in md
+    assert "| LUT4 | 12,345 (14.8 %) | 5," in md
     # lanes from the point's [rtl] table; clock = 16 x 24/4 x 40 kHz
     assert "P = 4 lanes ([rtl] lanes of the point)" in md and "**3.8 MHz**" in md
     assert "`THR_DATA0`" in md and "`s_axis_tdata`" in md and "`codes_payload`" in md
@@ -132,6 +134,17 @@ def test_datasheet_with_every_saved_result(files, tmp_path):
     assert "| not run |" not in md.split("## Verification")[1]
     q = json.loads(files["quality"].read_text())
     assert f"| coin | {q['rows'][0]['psnr_twin']:.2f} |" in md
+
+
+def test_datasheet_marks_an_estimate_only_device(files, tmp_path):
+    out = tmp_path / "sheet"
+    assert main(["datasheet", str(files["point"]), "-o", str(out), "--device", "gw5ast-138",
+                 "--no-synthesis", "--quality", str(files["quality"]), "--quiet"]) == 0
+    md = (out / "datasheet.md").read_text()
+    summary = md.split("## Summary")[1].split("\n## ")[0]
+    assert "gw5ast-138: GW5AST-LV138FPG676AC1/I0, **estimate only** (rvsm fpga has no " \
+           "gowin flow" in summary and "placed by" not in summary
+    assert "Device gw5ast-138 (estimate only): " in md.split("## Resources")[1]
 
 
 def test_datasheet_runs_the_study_and_says_what_is_missing(files, tmp_path, monkeypatch):

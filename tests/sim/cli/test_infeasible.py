@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pytest
-
 from rvsm.sim.cli import main
 
 POINT = (Path(__file__).parents[3] / "points" / "ecp5-85-40khz.toml").read_text()
@@ -26,12 +24,32 @@ def _one_line_error(capsys) -> str:
     return err[0]
 
 
-def test_usage_error_is_one_line_with_the_choices(capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(["fpga", "--device", "ecp5-100", "p.toml"])
-    assert exc.value.code == 2
+def test_unknown_device_is_one_line_with_the_choices(tmp_path, capsys):
+    f = _point(tmp_path)
+    assert main(["fpga", "--device", "ecp5-100", f, "-o", str(tmp_path / "o")]) == 2
     line = _one_line_error(capsys)
-    assert "invalid choice: 'ecp5-100'" in line and "'ecp5-85'" in line
+    assert "unknown FPGA device 'ecp5-100'; choose one of: ecp5-25" in line
+    assert "gw5ast-138" in line  # the one device list
+
+
+def test_fpga_refuses_an_estimate_only_device_in_one_line(tmp_path, capsys):
+    f = _point(tmp_path)
+    assert main(["fpga", "--device", "ice40-hx8k", f, "-o", str(tmp_path / "o")]) == 2
+    line = _one_line_error(capsys)
+    assert line.startswith("rvsm: error: ice40-hx8k is estimate only:")
+    assert line.endswith("the devices that place and route: ecp5-25, ecp5-45, ecp5-85")
+    assert not (tmp_path / "o").exists()
+
+
+def test_an_estimate_only_rtl_device_is_refused_by_fpga_and_marked_by_config_check(
+        tmp_path, capsys):
+    f = _point(tmp_path, **{'device = "ecp5-85"': 'device = "gw5ast-138"'})
+    assert main(["fpga", f, "-o", str(tmp_path / "o")]) == 2
+    assert _one_line_error(capsys).startswith("rvsm: error: gw5ast-138 is estimate only:")
+    assert main(["config", "check", f]) == 0
+    out = capsys.readouterr().out
+    assert "fits gw5ast-138: state" in out
+    assert "(estimate only: rvsm fpga does not place gw5ast-138" in out
 
 
 def test_config_check_names_accumulator_bits_and_shift(tmp_path, capsys):
