@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep bench-fpga bench-board datasheet lint diagrams clean
+.PHONY: setup demo test regress long-run links-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep bench-fpga bench-board datasheet lint diagrams clean
 
 setup: $(STAMP)
 
@@ -58,6 +58,13 @@ long-run: setup
 # the bounded equivalence of the streaming and the parallel array for every model at
 # 3x4 P=2, 3x3 P=1 and 3x6 P=3. Reports and counterexample VCDs in build/formal/.
 FORMAL_POINTS := tests/data/formal-tiny.toml tests/data/formal-tiny-zero.toml
+# the shipped point through both board links, the simulator doing every bit (docs/board.md,
+# "Verification"); STEPS, SIZE (HxW) and SIM override
+STEPS ?= 100
+links-run: setup
+	$(BIN)/python scripts/links_run.py $(POINT) --steps $(STEPS) --sim $(or $(SIM),verilator) \
+	  $(if $(SIZE),--size $(SIZE)) --work build/links-run $(ARGS)
+
 formal: setup
 	set -e; for point in $(FORMAL_POINTS); do \
 	  name=$$(basename $$point .toml); \

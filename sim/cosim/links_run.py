@@ -23,7 +23,7 @@ from amaranth.back import verilog as amaranth_verilog
 
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import ToolError
-from rvsm.rtl.board.loopback import CORE_BITS, LinkLoopback, default_delays
+from rvsm.rtl.board.loopback import CORE_BITS, LinkLoopback
 from rvsm.rtl.ports import verilog_ports
 from rvsm.rtl.rtl_digest import rtl_digest
 from rvsm.rtl.stream.schedule import OutputBeats, check_beats
