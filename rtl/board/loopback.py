@@ -54,7 +54,7 @@ START_WAIT = 128
 #: Bits of the skew lines (largest delay + fault, bits).
 LINE_BITS = 24
 #: The front ends a loopback can hold.
-FRONT_ENDS = ("stream", "ip")
+FRONT_ENDS = ("array", "ip")
 
 
 def default_delays(pairs: int, slip: int = 3) -> tuple[int, ...]:
@@ -63,18 +63,18 @@ def default_delays(pairs: int, slip: int = 3) -> tuple[int, ...]:
 
 
 class LinkLoopback(wiring.Component):
-    """Sensor serialiser -> front end ``front_end`` (``"stream"`` or ``"ip"``) -> board
-    deserialiser for ``contract`` at ``lanes`` lanes (module docstring).
+    """Sensor serialiser -> front end ``front_end`` (``"array"``: ``BoardFrontEnd``, or
+    ``"ip"``) -> board deserialiser for ``contract`` at ``lanes`` lanes (module docstring).
 
     Ports: ``codes`` (In, the array's code beats), ``spikes`` (Out, the array's spike
     beats, always ready), ``ce``, ``train_request`` (the front end's pin),
     ``tx_link_errors`` (words the board receiver found wrong, all pairs, saturating at
     255), ``out_framing_errors`` (beats whose ``eol`` disagreed with the position,
     saturating), ``overflow`` (a FIFO of the sensor or the front end's transmitter
-    overflowed, sticky); ``thr``, ``clear`` (``"stream"``) or ``spi`` and
+    overflowed, sticky); ``thr``, ``clear`` (``"array"``) or ``spi`` and
     ``frame_start`` (``"ip"``); ``rx_run``, ``fault`` (``faults``)."""
 
-    def __init__(self, contract: ArrayContract, lanes: int, front_end: str = "stream",
+    def __init__(self, contract: ArrayContract, lanes: int, front_end: str = "array",
                  delays: tuple[int, ...] | None = None, faults: bool = False,
                  fault_pair: int = 0, fault_bits: int = 3):
         if front_end not in FRONT_ENDS:
@@ -82,7 +82,7 @@ class LinkLoopback(wiring.Component):
         self.contract = contract
         self.geometry = StreamGeometry(contract, lanes)
         self.front_end = front_end
-        self.dut = (BoardFrontEnd(contract, lanes) if front_end == "stream"
+        self.dut = (BoardFrontEnd(contract, lanes) if front_end == "array"
                     else IpBoardFrontEnd(contract, lanes))
         self.rx_format, self.tx_format = self.dut.rx_format, self.dut.tx_format
         self.delays = (default_delays(self.rx_format.pairs) if delays is None
@@ -94,7 +94,7 @@ class LinkLoopback(wiring.Component):
         self.faults, self.fault_pair, self.fault_bits = faults, fault_pair, fault_bits
         members = dict(RvsmStreamArray.interface(contract, lanes).members)
         ports = {"codes": members["codes"], "spikes": members["spikes"]}
-        if front_end == "stream":
+        if front_end == "array":
             ports |= {"thr": members["thr"], "clear": members["clear"]}
         else:
             ports |= {"spi": In(SpiSignature()), "frame_start": In(1)}
@@ -147,7 +147,7 @@ class LinkLoopback(wiring.Component):
 
         # held inputs of the core domain: a write or a clear waits for ce
         restart = Signal()
-        if self.front_end == "stream":
+        if self.front_end == "array":
             names = list(dut.thr.signature.members)  # we, addr, data
             held = {n: Signal.like(getattr(dut.thr, n), name=f"thr_{n}") for n in names}
             with m.If(self.thr.we):

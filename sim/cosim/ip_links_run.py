@@ -23,11 +23,14 @@ from amaranth.lib.wiring import In
 
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import ToolError
+from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.board.loopback import CORE_BITS, LinkLoopback
 from rvsm.rtl.ports import verilog_ports
-from rvsm.rtl.stream.schedule import OutputBeats, check_beats
 from rvsm.sim.cosim.builds.cocotb_adapter import check_simulator, cocotb_build, cocotb_test
 from rvsm.sim.cosim.builds.icarus_netlist import write_icarus_netlist
+
+#: The streaming array's beats (the front end's array): their checker and type.
+_BEATS = get_architecture().beats
 
 __all__ = ["TOP", "ip_links_verify"]
 
@@ -114,9 +117,9 @@ def ip_links_verify(point: DesignPoint, lanes: int, steps: int, work_dir: str | 
         off, width = fields[name]
         return [(w >> off) & ((1 << width) - 1) for w in result["beats"]]
 
-    got = OutputBeats.from_words(field("row"), field("group"), field("last"),
+    got = _BEATS.output_beats.from_words(field("row"), field("group"), field("last"),
                                  field("pos"), field("neg"), c.num_scales, geo.lanes)
-    check = check_beats(geo.schedule, expected, got)
+    check = _BEATS.check_beats(geo.schedule, expected, got)
     return {"compared": int(check["compared"]), "spikes": int(np.count_nonzero(expected)),
             "mismatches": int(check["mismatches"]),
             "first_mismatch": check.get("first_mismatch"),

@@ -23,10 +23,10 @@ from amaranth.back import verilog as amaranth_verilog
 
 from rvsm.model.fixed.design_point import DesignPoint
 from rvsm.model.infra.errors import ToolError
+from rvsm.rtl.architectures.registry import get_architecture
 from rvsm.rtl.board.loopback import CORE_BITS, LinkLoopback
 from rvsm.rtl.ports import verilog_ports
 from rvsm.rtl.rtl_digest import rtl_digest
-from rvsm.rtl.stream.schedule import OutputBeats, check_beats
 from rvsm.sim.cosim.builds.chunk_harness import (
     DEFAULT_DEPTH,
     HARNESS_TOP,
@@ -38,6 +38,9 @@ from rvsm.sim.cosim.builds.chunk_harness import (
 )
 from rvsm.sim.cosim.builds.cocotb_adapter import check_simulator, cocotb_build, cocotb_test, cxx_opt
 from rvsm.sim.cosim.builds.icarus_netlist import write_icarus_netlist
+
+#: The streaming array's beats (the front end's array): their checker and type.
+_BEATS = get_architecture().beats
 
 __all__ = ["TOP", "links_build", "links_verify"]
 
@@ -152,7 +155,7 @@ def links_verify(point: DesignPoint, lanes: int, steps: int, work_dir: str | Pat
             from None
     t0 = time.perf_counter()
     got = _beats(out, layout, c.num_scales, geo.lanes)
-    check = check_beats(geo.schedule, expected, got)
+    check = _BEATS.check_beats(geo.schedule, expected, got)
     times["check"] = time.perf_counter() - t0
     times["total"] = time.perf_counter() - t_start
     peak = max(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss,
@@ -168,7 +171,7 @@ def links_verify(point: DesignPoint, lanes: int, steps: int, work_dir: str | Pat
             "chunks": result["chunks"], "seconds": times, "peak_rss_mb": round(peak, 1)}
 
 
-def _beats(bits: np.ndarray, layout: HarnessLayout, scales: int, lanes: int) -> OutputBeats:
+def _beats(bits: np.ndarray, layout: HarnessLayout, scales: int, lanes: int) -> object:
     """Output beats ``(K, out_bits + 32)`` little-endian bit columns as OutputBeats."""
     def field(name: str) -> np.ndarray:
         off, width = layout.fields[name]
@@ -180,5 +183,5 @@ def _beats(bits: np.ndarray, layout: HarnessLayout, scales: int, lanes: int) -> 
 
     sp = scales * lanes
     spikes = field("pos").astype(np.int8) - field("neg").astype(np.int8)
-    return OutputBeats(value("row"), value("group"), value("last").astype(bool),
+    return _BEATS.output_beats(value("row"), value("group"), value("last").astype(bool),
                        spikes.reshape(len(bits), scales, lanes)[:, :, :sp // scales])
