@@ -173,22 +173,24 @@ class LinkLoopback(wiring.Component):
         go = quiet == START_WAIT
         in_pos = Signal(range(geo.beats_per_frame))
         in_group = Signal(range(geo.groups))
-        pending = Signal()  # a restart waiting for ce
+        pending = Signal()  # a restart waiting for ce: the beat taken then is at 0
+        pos_now = Mux(pending, 0, in_pos)
+        group_now = Mux(pending, 0, in_group)
         take = ce & go & self.codes.valid
         m.d.comb += [self.codes.ready.eq(ce & go),
                      sensor.beats.valid.eq(take),
                      sensor.beats.payload.payload.eq(self.codes.payload.as_value()),
-                     sensor.beats.payload.sof.eq(in_pos == 0),
-                     sensor.beats.payload.eol.eq(in_group == geo.groups - 1)]
+                     sensor.beats.payload.sof.eq(pos_now == 0),
+                     sensor.beats.payload.eol.eq(group_now == geo.groups - 1)]
         with m.If(restart):
             m.d.sync += pending.eq(1)
         with m.Elif(ce):
             m.d.sync += pending.eq(0)
-        with m.If(ce & pending):
+        with m.If(take):
+            m.d.sync += [in_pos.eq(Mux(pos_now == geo.beats_per_frame - 1, 0, pos_now + 1)),
+                         in_group.eq(Mux(group_now == geo.groups - 1, 0, group_now + 1))]
+        with m.Elif(ce & pending):
             m.d.sync += [in_pos.eq(0), in_group.eq(0)]
-        with m.Elif(take):
-            m.d.sync += [in_pos.eq(Mux(in_pos == geo.beats_per_frame - 1, 0, in_pos + 1)),
-                         in_group.eq(Mux(in_group == geo.groups - 1, 0, in_group + 1))]
 
         # the board's beats -> spikes, the position implied by the framing
         beat = board.beats.payload

@@ -50,4 +50,17 @@ def test_ip_on_a_board_faults_reported_over_spi(tmp_path) -> None:  # noqa: ANN0
     assert reg["relocked:LINK_LOSSES"] == 2 and reg["relocked:LINK_STATUS"] == 0b011
     assert reg["end:LINK_STATUS"] == 0b011 and reg["end:LINK_LOSSES"] == 2
     assert reg["end:LINK_ERRORS0"] >> 8 == 0  # the framing lane: no error
-    assert reg["end:STATUS"] & 0b1 == 0  # no IP overflow
+    assert reg["end:STATUS"] & 0b11 == 0  # no IP overflow, no framing error
+
+
+@pytest.mark.parametrize("args", [["--lanes", "3"], ["--size", "4by8"]])
+def test_links_run_refuses_bad_input_with_status_2(tmp_path, args: list[str]) -> None:  # noqa: ANN001
+    """``scripts/links_run.py``: lanes that do not divide the width, a malformed size."""
+    import subprocess
+    import sys
+
+    run = subprocess.run([sys.executable, "scripts/links_run.py", "tests/data/formal-tiny.toml",
+                          "--size", "4x8", *args, "--sim", "icarus", "--work", str(tmp_path)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2, run.stderr
+    assert run.stderr.startswith("links_run: ") and not run.stdout
