@@ -65,6 +65,9 @@ def main(argv: list[str] | None = None) -> int:
     if r["mismatches"]:
         print(f"links_run: first mismatch {r['first_mismatch']} (stray {r['stray']}, "
               f"overflow {r['overflow']})", file=sys.stderr)
+        if r["waveform"]:
+            print(f"links_run: waveform of bit clocks {r['window_cycles'][0]}.."
+                  f"{r['window_cycles'][1]}: {r['waveform']}", file=sys.stderr)
         return 1
     return 0
 

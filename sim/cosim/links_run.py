@@ -109,12 +109,18 @@ def links_build(point: DesignPoint, lanes: int, sim: str, build_root: str | Path
 
 def links_verify(point: DesignPoint, lanes: int, steps: int, work_dir: str | Path,
                  sim: str = "icarus", seed: int = 0, build_root: str | Path | None = None,
-                 delays: tuple[int, ...] | None = None) -> dict:
+                 delays: tuple[int, ...] | None = None,
+                 flip: tuple[int, int, int, int] | None = None) -> dict:
     """Run ``steps`` random frames of ``point`` through the loopback on ``sim``; return
     ``steps``, ``compared``, ``spikes`` (non-zero), ``mismatches``, ``first_mismatch``,
     the harness's ``cycles`` (bit clocks), ``stray``, ``overflow``, ``seconds`` (phases)
-    and ``peak_rss_mb`` (this process and the simulator's). :class:`ToolError` when the
-    simulator writes no result."""
+    and ``peak_rss_mb`` (this process and the simulator's). On a mismatch an Icarus run
+    is simulated again with the harness's dump on for the window before the first
+    mismatching beat (two frames and the lag, in bit clocks) and 64 cycles after it:
+    ``waveform`` (an FST; ``None`` on Verilator, whose build has no tracing) and
+    ``window_cycles``. ``flip`` = (step, scale, row, column) changes that expected spike
+    (the failure path, for tests). :class:`ToolError` when the simulator writes no
+    result."""
     t_start = time.perf_counter()
     work = Path(work_dir).resolve()
     work.mkdir(parents=True, exist_ok=True)
@@ -126,6 +132,8 @@ def links_verify(point: DesignPoint, lanes: int, steps: int, work_dir: str | Pat
     codes = rng.integers(0, 1 << c.adc_bits, (steps, c.height, c.width), dtype=np.int64)
     thr = point.integer_thresholds()
     expected = c.run(codes, thr)
+    if flip is not None:
+        expected[flip] = 0 if expected[flip] else 1
     times["twin"] = time.perf_counter() - t0
     beats = np.concatenate([codes.reshape(-1, geo.lanes),
                             np.zeros((geo.lag, geo.lanes), np.int64)]).astype(np.uint32)
@@ -140,23 +148,28 @@ def links_verify(point: DesignPoint, lanes: int, steps: int, work_dir: str | Pat
     np.savez(setup, beats=beats, chunk=CHUNK_BEATS, adc_bits=c.adc_bits,
              in_bits=layout.in_bits, out_bits=layout.out_bits + 32, thr_count=len(writes),
              clock_outside=int(not clock_inside(sim)))
-    out_path, result_path = run / "out.npy", run / "result.json"
     t0 = time.perf_counter()
-    cocotb_test(sim, build_dir / "sim_build", HARNESS_TOP, TESTBENCH, run,
-                {"RVSM_LINKS": str(setup), "RVSM_OUT": str(out_path),
-                 "RVSM_RESULT": str(result_path)}, False, [], run / "results.xml",
-                run / "sim.log")
+    result, out = _simulate(sim, build_dir, run, setup, [])
     times["simulate"] = time.perf_counter() - t0
-    try:
-        result = json.loads(result_path.read_text())
-        out = np.load(out_path)
-    except (OSError, ValueError):
-        raise ToolError(f"the links testbench wrote no result; log: {run / 'sim.log'}") \
-            from None
     t0 = time.perf_counter()
     got = _beats(out, layout, c.num_scales, geo.lanes)
     check = _BEATS.check_beats(geo.schedule, expected, got)
     times["check"] = time.perf_counter() - t0
+    waveform, window = None, None
+    first = check.get("first_mismatch")
+    if first is not None and sim == "icarus":
+        cycle = int((out[first["beat"], layout.out_bits:].astype(np.int64)
+                     << np.arange(32)).sum())
+        window = [max(0, cycle - (2 * geo.beats_per_frame + geo.lag) * CORE_BITS),
+                  cycle + 64]
+        again = work / "failure"
+        shutil.rmtree(again, ignore_errors=True)
+        shutil.copytree(run, again, ignore=shutil.ignore_patterns("*.hex", "*.npy"))
+        shutil.copy(run / "thresholds.hex", again / "thresholds.hex")
+        waveform = again / "window.fst"
+        _simulate(sim, build_dir, again, again / "links.npz",
+                  [f"+rvsm_dump_file={waveform}", f"+rvsm_dump_from={window[0]}",
+                   f"+rvsm_dump_to={window[1]}"])
     times["total"] = time.perf_counter() - t_start
     peak = max(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss,
                resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss) / 1024
@@ -168,7 +181,26 @@ def links_verify(point: DesignPoint, lanes: int, steps: int, work_dir: str | Pat
             "first_mismatch": check.get("first_mismatch"), "beats_out": result["beats_out"],
             "cycles": result["cycles"], "core_cycles": result["cycles"] // CORE_BITS,
             "stray": result["stray"], "overflow": result["overflow"],
+            "waveform": None if waveform is None else str(waveform),
+            "window_cycles": window,
             "chunks": result["chunks"], "seconds": times, "peak_rss_mb": round(peak, 1)}
+
+
+def _simulate(sim: str, build_dir: Path, run: Path, setup: Path, plusargs: list[str]
+              ) -> tuple[dict, np.ndarray]:
+    """Run the testbench in ``run``: its JSON result and the output beats' bits; with
+    ``plusargs`` (a dump window) the simulator's dumps are on (FST on Icarus)."""
+    out_path, result_path = run / "out.npy", run / "result.json"
+    cocotb_test(sim, build_dir / "sim_build", HARNESS_TOP, TESTBENCH, run,
+                {"RVSM_LINKS": str(setup), "RVSM_OUT": str(out_path),
+                 "RVSM_RESULT": str(result_path)}, bool(plusargs), plusargs,
+                run / "results.xml",
+                run / "sim.log")
+    try:
+        return json.loads(result_path.read_text()), np.load(out_path)
+    except (OSError, ValueError):
+        raise ToolError(f"the links testbench wrote no result; log: {run / 'sim.log'}") \
+            from None
 
 
 def _beats(bits: np.ndarray, layout: HarnessLayout, scales: int, lanes: int) -> object:

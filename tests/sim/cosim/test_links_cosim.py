@@ -6,6 +6,8 @@ out of the transmit link equal to the fixed twin's."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from rvsm.model.fixed.point_toml import load_design_point
@@ -64,3 +66,16 @@ def test_links_run_refuses_bad_input_with_status_2(tmp_path, args: list[str]) ->
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 2, run.stderr
     assert run.stderr.startswith("links_run: ") and not run.stdout
+
+
+def test_a_wrong_spike_is_named_with_a_waveform_window(tmp_path) -> None:  # noqa: ANN001
+    """One expected spike changed: one mismatch at its step, scale, row and column, and a
+    waveform of the window before it (Icarus)."""
+    point = load_design_point("tests/data/formal-tiny.toml").with_size(4, 8)
+    r = links_verify(point, 2, 3, tmp_path, sim="icarus", seed=1, flip=(1, 1, 2, 5))
+    assert r["mismatches"] == 1
+    first = r["first_mismatch"]
+    assert (first["step"], first["scale"], first["row"], first["column"]) == (1, 1, 2, 5)
+    assert r["window_cycles"][0] < r["window_cycles"][1]
+    wave = Path(r["waveform"])
+    assert wave.suffix == ".fst" and wave.stat().st_size > 0
