@@ -52,12 +52,6 @@ long-run: setup
 	$(BIN)/rvsm verify flyball --fixed $(OUT)/long-run-point.toml --lanes 40 --sim verilator \
 	  --harness chunk --frames 4001 --steps 40000 --work build/long-run
 
-# Every formal check at the tiny configurations, both reset modes (docs/formal.md):
-# the parallel array (prove and cover); the streaming array's property checks at 3x4,
-# P=2, dog2, to two frames plus the lag, and their covers;
-# the bounded equivalence of the streaming and the parallel array for every model at
-# 3x4 P=2, 3x3 P=1 and 3x6 P=3. Reports and counterexample VCDs in build/formal/.
-FORMAL_POINTS := tests/data/formal-tiny.toml tests/data/formal-tiny-zero.toml
 # the shipped point through both board links, the simulator doing every bit (docs/board.md,
 # "Verification"); STEPS, SIZE (HxW) and SIM override
 STEPS ?= 100
@@ -65,6 +59,12 @@ links-run: setup
 	$(BIN)/python scripts/links_run.py $(POINT) --steps $(STEPS) --sim $(or $(SIM),verilator) \
 	  $(if $(SIZE),--size $(SIZE)) --work build/links-run $(ARGS)
 
+# Every formal check at the tiny configurations, both reset modes (docs/formal.md):
+# the parallel array (prove and cover); the streaming array's property checks at 3x4,
+# P=2, dog2, to two frames plus the lag, and their covers;
+# the bounded equivalence of the streaming and the parallel array for every model at
+# 3x4 P=2, 3x3 P=1 and 3x6 P=3. Reports and counterexample VCDs in build/formal/.
+FORMAL_POINTS := tests/data/formal-tiny.toml tests/data/formal-tiny-zero.toml
 formal: setup
 	set -e; for point in $(FORMAL_POINTS); do \
 	  name=$$(basename $$point .toml); \
