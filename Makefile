@@ -8,7 +8,7 @@ OUT ?= out
 # pytest-xdist workers: the machine has 2 cores.
 JOBS ?= 2
 
-.PHONY: setup demo test regress long-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep bench-fpga bench-board datasheet lint diagrams clean
+.PHONY: setup demo test regress long-run links-run formal formal-equivalence mutate fuzz bench bench-rtl bench-sweep bench-fpga bench-board datasheet lint diagrams clean
 
 setup: $(STAMP)
 
@@ -51,6 +51,13 @@ long-run: setup
 	$(BIN)/rvsm config new -o $(OUT)/long-run-point.toml --force > /dev/null
 	$(BIN)/rvsm verify flyball --fixed $(OUT)/long-run-point.toml --lanes 40 --sim verilator \
 	  --harness chunk --frames 4001 --steps 40000 --work build/long-run
+
+# the shipped point through both board links, the simulator doing every bit (docs/board.md,
+# "Verification"); STEPS, SIZE (HxW) and SIM override
+STEPS ?= 100
+links-run: setup
+	$(BIN)/python scripts/links_run.py $(POINT) --steps $(STEPS) --sim $(or $(SIM),verilator) \
+	  $(if $(SIZE),--size $(SIZE)) --work build/links-run $(ARGS)
 
 # Every formal check at the tiny configurations, both reset modes (docs/formal.md):
 # the parallel array (prove and cover); the streaming array's property checks at 3x4,

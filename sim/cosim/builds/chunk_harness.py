@@ -65,7 +65,7 @@ __all__ = ["CLOCK_NS", "DEFAULT_DEPTH", "HARNESS_TOP", "HARNESS_VERSION",
            "encode_threshold_writes", "harness_verilog", "state_memories"]
 
 #: Bump when the harness's Verilog changes (part of a harness build's cache key).
-HARNESS_VERSION = "4"
+HARNESS_VERSION = "5"
 #: Module name of the harness (the simulation's top level).
 HARNESS_TOP = "rvsm_chunk_harness"
 #: Beats per chunk the harness memories hold.
@@ -95,6 +95,11 @@ class HarnessLayout:
     widths: dict[str, int]
     fields: dict[str, tuple[int, int]]
     depth: int = DEFAULT_DEPTH
+    #: Cycles after a chunk's last beat before its outputs are written (a design with a
+    #: longer latency than the array's, e.g. the link loopback, needs more).
+    tail: int = TAIL
+    #: Cycles from one threshold write of ``thr_load`` to the next (1: every cycle).
+    thr_every: int = 1
 
     @classmethod
     def from_ports(cls, ports: dict, depth: int = DEFAULT_DEPTH) -> HarnessLayout:
@@ -250,9 +255,11 @@ module {HARNESS_TOP} (
   reg dumping;
   reg running;
   reg [31:0] taken;
-  reg [7:0] tail;
+  reg [31:0] tail;
   reg thr_loading;
   reg [31:0] thr_taken;
+  reg [15:0] thr_gap;
+  wire thr_fire = thr_loading && thr_gap == 16'd0;
   reg state_load_now, state_dump_now;
   wire [{ta + td - 1}:0] thr_word = thr_mem[thr_taken[{tbits - 1}:0]];
   wire codes_ready;
@@ -265,7 +272,7 @@ module {HARNESS_TOP} (
     .clk(clk), .rst(rst), .clear(clear),
     .codes_valid(codes_valid), .codes_ready(codes_ready), .codes_payload(codes_payload),
     .spikes_valid(spikes_valid), .spikes_payload(spikes_payload),
-    .thr_we(thr_loading | thr_we),
+    .thr_we(thr_fire | thr_we),
     .thr_addr(thr_loading ? thr_word[{ta + td - 1}:{td}] : thr_addr),
     .thr_data(thr_loading ? thr_word[{td - 1}:0] : thr_data)
   );
@@ -285,6 +292,7 @@ module {HARNESS_TOP} (
     tail = 0;
     thr_loading = 0;
     thr_taken = 0;
+    thr_gap = 0;
     state_load_now = 0;
     state_dump_now = 0;
     out_count = 0;
@@ -316,16 +324,20 @@ module {HARNESS_TOP} (
       overflow <= 0;
       thr_loading <= 0;
     end else begin
-      if (thr_loading) begin
+      if (thr_loading && thr_gap != 16'd0)
+        thr_gap <= thr_gap - 16'd1;
+      else if (thr_loading) begin
         if (thr_taken + 32'd1 == thr_count) begin
           thr_loading <= 0;
           done <= 1;
         end
         thr_taken <= thr_taken + 32'd1;
+        thr_gap <= 16'd{layout.thr_every - 1};
       end else if (thr_load && !running) begin
         $readmemh(thr_file, thr_mem, 0, thr_count - 32'd1);
         thr_loading <= 1;
         thr_taken <= 0;
+        thr_gap <= 0;
         done <= 0;
       end
       if (spikes_valid) begin
@@ -348,13 +360,13 @@ module {HARNESS_TOP} (
         if (codes_valid && codes_ready)
           taken <= taken + 32'd1;
         else if (taken == count) begin
-          if (tail == {TAIL}) begin
+          if (tail == {layout.tail}) begin
             if (out_count != 0)
               $writememh(out_file, out_mem, 0, out_count - 32'd1);
             running <= 0;
             done <= 1;
           end else
-            tail <= tail + 8'd1;
+            tail <= tail + 32'd1;
         end
       end
     end
