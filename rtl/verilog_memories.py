@@ -7,7 +7,8 @@ parses in a time that grows faster than its length; it has no public switch to l
 them out. At sensor size (250x400 dog4, P=40: 7.2 Mbit of accumulators and line buffer,
 all zero, and 6.8 Mbit of thresholds at the top rail) those two steps were two thirds
 of the Verilog generation's CPU time (45-53 s before, 14.6-15.5 s after, the same window
-on a loaded 2-core machine: ``scripts/bench_rtl.py --only verilog``).
+on a loaded 2-core machine: ``scripts/bench_rtl.py --only verilog``; measured before the
+second conversion of step 3, which adds one netlist build).
 :func:`convert_verilog` gives the same Verilog as ``amaranth.back.verilog.convert``
 followed by :func:`~rvsm.rtl.architectures.verilog.strip_zero_memory_init`, without either:
 
