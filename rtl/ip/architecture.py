@@ -28,7 +28,7 @@ from rvsm.rtl.ip.register_harness import ip_registers
 from rvsm.rtl.ip.register_map import regs_c_header, regs_json, regs_markdown
 from rvsm.rtl.ip.wrapper import IP_ARCH, RvsmAxisIp, ip_regmap
 from rvsm.rtl.ports import port_map
-from rvsm.rtl.stream.architecture import STREAM_BEATS
+from rvsm.rtl.stream.architecture import STREAM_BEATS, array_sentence
 from rvsm.rtl.stream.dimensions import StreamGeometry
 from rvsm.rtl.stream.schedule import OutputBeats, check_beats
 
@@ -121,13 +121,10 @@ def _describe(dut: RvsmAxisIp) -> dict:
 
 
 def _summary(dut: RvsmAxisIp) -> list[str]:
-    c, geo = dut.contract, dut.geometry
-    t = geo.timing()
+    t = dut.geometry.timing()
     return [
-        f"AXI IP around the streaming array: {c.height}x{c.width}, {c.num_scales} "
-        f"scale(s), ADC {c.adc_bits} bits, accumulator {c.accumulator_bits} bits; "
-        f"{geo.lanes} lane(s), {geo.groups} beat(s) per row, {geo.beats_per_frame} per "
-        f"frame; output FIFO {dut.fifo_depth} beats.",
+        f"AXI IP around the streaming array: {array_sentence(dut)}; output FIFO "
+        f"{dut.fifo_depth} beats.",
         "",
         f"Timing: lag {t['lag']} beats (output p follows input beat p + lag; flush with "
         f"CONTROL.flush), offered on m_axis {dut.RELEASE_CYCLES} cycles after the "

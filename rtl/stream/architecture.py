@@ -42,7 +42,7 @@ from rvsm.rtl.stream.protocol import (
 )
 from rvsm.rtl.stream.schedule import OutputBeats, StreamChecker, check_beats, pack_lanes
 
-__all__ = ["STREAM", "STREAM_BEATS", "stream_port_map"]
+__all__ = ["STREAM", "STREAM_BEATS", "array_sentence", "stream_port_map"]
 
 _FIELD_DESCRIPTIONS = {
     "row": "row y of the position",
@@ -73,14 +73,20 @@ def _describe(dut: RvsmStreamArray) -> dict:
             "state_bits": geo.state_bits}
 
 
-def _summary(dut: RvsmStreamArray) -> list[str]:
+def array_sentence(dut: RvsmStreamArray | object) -> str:
+    """The summary's first sentence of a streaming array (or of a wrapper with its
+    ``contract`` and ``geometry``): size, scales, widths, lanes and beats, no full stop."""
     c, geo = dut.contract, dut.geometry
-    t = geo.timing()
+    return (f"{c.height}x{c.width}, {c.num_scales} scale(s), ADC {c.adc_bits} bits, "
+            f"accumulator {c.accumulator_bits} bits ({'signed' if c.signed else 'unsigned'}"
+            f" model, reset {c.reset}), shift {c.shift}; {geo.lanes} lane(s), "
+            f"{geo.groups} beat(s) per row, {geo.beats_per_frame} per frame")
+
+
+def _summary(dut: RvsmStreamArray) -> list[str]:
+    t = dut.geometry.timing()
     return [
-        f"Array {c.height}x{c.width}, {c.num_scales} scale(s), ADC {c.adc_bits} bits, "
-        f"accumulator {c.accumulator_bits} bits ({'signed' if c.signed else 'unsigned'}"
-        f" model, reset {c.reset}), shift {c.shift}; {geo.lanes} lane(s), "
-        f"{geo.groups} beat(s) per row, {geo.beats_per_frame} per frame.",
+        f"Array {array_sentence(dut)}.",
         "",
         f"Timing (beats): window lag {t['window_lag']}, pipeline depth "
         f"{t['pipeline_depth']} (latency {t['latency']} cycles back to back), lag "

@@ -17,7 +17,8 @@ internal :class:`~rvsm.rtl.stream.array.StreamProbes`. Stalls,
 clears and threshold writes are free at every cycle. Its properties come in four groups
 (:data:`PROPERTY_GROUPS`), each its own check so that sby keeps only that group's cone of
 logic, and each stated by its own method (:meth:`StreamProperties._protocol`,
-``_state``, ``_thresholds``, ``_tail``) from the bookkeeping they share (:class:`_Watch`):
+``_state``, ``_thresholds``, ``_tail``) from the bookkeeping they share
+(:func:`~.property_watch.bookkeeping`):
 
 * ``protocol``: ``handshake.ready`` (``codes.ready`` is low exactly while ``clear`` is
   high); ``output.one_per_beat`` (an output beat and its write-back exactly for each
@@ -51,18 +52,17 @@ logic, and each stated by its own method (:meth:`StreamProperties._protocol`,
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-from amaranth.asserts import AnyConst, AnySeq
+from amaranth.asserts import AnySeq
 from amaranth.hdl import Array, Cat, Module, Mux, Signal, Value, signed
 
 from rvsm.model.fixed.contract import ArrayContract
 from rvsm.model.fixed.widths import signed_range
 from rvsm.rtl.capabilities import require_spike_sensor
 from rvsm.rtl.formal_harness import ElaborateAfter
-from rvsm.rtl.stream.array import RvsmStreamArray, StreamProbes
+from rvsm.rtl.stream.array import RvsmStreamArray
 from rvsm.rtl.stream.equivalence_harness import StreamEquivalence
 from rvsm.rtl.stream.harness_base import StreamHarness
+from rvsm.rtl.stream.property_watch import Watch, bookkeeping
 from rvsm.rtl.stream.signatures import threshold_word_bits, top_threshold_word
 
 __all__ = ["PROPERTY_GROUPS", "SYNTHESISED_GROUPS", "StreamProperties", "stream_check",
@@ -83,26 +83,6 @@ _GROUP_PREFIXES = {
 #: ``tail`` 35 -> 27 s; ``state`` is slower with it (43 -> 156 s), as are the
 #: equivalence miters (16 -> 22 s).
 SYNTHESISED_GROUPS = frozenset({"protocol", "thresholds", "tail"})
-
-
-@dataclass(frozen=True)
-class _Watch:
-    """What the property groups share: the probes, the accepted beats (``taken``), the
-    next output position (``out_pos``), the expected write-back (``e1``, its position and
-    whether it is in the first frame after a clear) and output (``e2``), the watched word
-    and scale (``AnyConst``) and ``watched`` (the watched word is written back now)."""
-
-    probes: StreamProbes
-    taken: Value
-    out_pos: Signal
-    e1: Signal
-    e1_pos: Signal
-    e1_first: Signal
-    e2: Signal
-    e2_pos: Signal
-    watch: Signal
-    scale: Signal
-    watched: Value
 
 
 class StreamProperties(StreamHarness):
@@ -170,7 +150,7 @@ class StreamProperties(StreamHarness):
         """Every group's properties (:meth:`check` keeps the chosen groups'), once the
         array is elaborated (its probes)."""
         m = Module()
-        w = self._bookkeeping(m, dut)
+        w = bookkeeping(self, m, dut)
         self._protocol(m, dut, w)
         self._thresholds(m, dut, w)
         c = self.contract
@@ -186,45 +166,7 @@ class StreamProperties(StreamHarness):
                        "a total below the low rail (some scale and lane)", "cover")
         return m
 
-    def _bookkeeping(self, m: Module, dut: RvsmStreamArray) -> _Watch:
-        """The output beats expected from the accepted ones, and the watched word and
-        scale (:class:`_Watch`)."""
-        c, geo = self.contract, self.geometry
-        words = geo.beats_per_frame
-        taken = dut.codes.valid & dut.codes.ready
-        clear = dut.clear
-        # Output beats: accepted beat b >= lag releases position (b - lag) mod H*G at
-        # the next edge (the write-back, e1) and presents it one cycle later (e2).
-        releases = taken & self._beats(m, dut, geo.lag)
-        out_pos = self._counter(m, "out_pos", clear, releases, words)
-        first = Signal(init=1, name="first_frame")  # out_pos is in frame 0 after clear
-        with m.If(clear):
-            m.d.sync += first.eq(1)
-        with m.Elif(releases & (out_pos == words - 1)):
-            m.d.sync += first.eq(0)
-        e1, e2 = Signal(name="exp_write"), Signal(name="exp_out")
-        e1_pos, e2_pos = (Signal(range(words), name=n) for n in ("exp_write_pos",
-                                                                  "exp_out_pos"))
-        e1_first = Signal(name="exp_write_first")
-        m.d.sync += [e1.eq(releases), e1_pos.eq(out_pos), e1_first.eq(first),
-                     e2.eq(e1), e2_pos.eq(e1_pos)]
-        # Memories: one symbolic word and scale (``AnyConst``: the checks hold for
-        # every word) is shadowed: thresholds as written (top rail at start) and, per
-        # position, the word it must have read (at the edge after accepting beat
-        # p + threshold_lag); accumulators as written back.
-        watch = Signal(range(words), name="watch_word")
-        m.d.comb += watch.eq(AnyConst(len(watch)))
-        self.check(m, "assume.watch_word", watch < words,
-                   "the watched word exists", "assume")
-        # ... and one symbolic scale: a shadow word of each kind in all.
-        scale = Signal(range(max(2, c.num_scales)), name="watch_scale")
-        m.d.comb += scale.eq(AnyConst(len(scale)))
-        self.check(m, "assume.watch_scale", scale < c.num_scales,
-                   "the watched scale exists", "assume")
-        return _Watch(dut.probes, taken, out_pos, e1, e1_pos, e1_first, e2, e2_pos, watch,
-                      scale, e1 & (e1_pos == watch))
-
-    def _protocol(self, m: Module, dut: RvsmStreamArray, w: _Watch) -> None:
+    def _protocol(self, m: Module, dut: RvsmStreamArray, w: Watch) -> None:
         """``handshake.*``, ``output.*``, ``rmw.*``, ``cover.clear_mid_frame``."""
         geo, probes = self.geometry, w.probes
         words = geo.beats_per_frame
@@ -259,7 +201,7 @@ class StreamProperties(StreamHarness):
         self.check(m, "cover.clear_mid_frame", mid,
                    "a clear after some positions of a frame were output", "cover")
 
-    def _thresholds(self, m: Module, dut: RvsmStreamArray, w: _Watch) -> None:
+    def _thresholds(self, m: Module, dut: RvsmStreamArray, w: Watch) -> None:
         """``threshold.*`` and ``cover.threshold_write_meets_read``: the watched word's
         shadow as written, and as each position read it."""
         c, geo, probes = self.contract, self.geometry, w.probes
@@ -341,7 +283,7 @@ class StreamProperties(StreamHarness):
             m.d.sync += [p_total.eq(total), acc.eq(lane["acc"]), p_acc.eq(acc)]
         return p_total, p_acc
 
-    def _state(self, m: Module, w: _Watch,
+    def _state(self, m: Module, w: Watch,
                delayed: list[list[tuple[Signal, Signal]]]) -> None:
         """``state.*``: the accumulator each position adds to (0 in a fresh frame, else
         what the previous frame wrote back to the watched word)."""
@@ -361,7 +303,7 @@ class StreamProperties(StreamHarness):
                            "after the first frame a position adds to exactly what the "
                            "previous frame wrote back to its word")
 
-    def _tail(self, m: Module, w: _Watch,
+    def _tail(self, m: Module, w: Watch,
               delayed: list[list[tuple[Signal, Signal]]]) -> list[Value]:
         """``saturation.*``, ``fire.*``, ``reset.*`` and the tail's covers, per lane in the
         cycle its position is written back (e1). Returns per lane "its total is below the

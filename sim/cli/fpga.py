@@ -107,7 +107,8 @@ def _check_device(args: argparse.Namespace) -> None:
 def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.architectures.registry import get_architecture
-    from rvsm.rtl.fpga.flow import build_component, run_fpga, run_fpga_seeds
+    from rvsm.rtl.fpga.flow import build_component
+    from rvsm.rtl.fpga.fpga_run import run_fpga, run_fpga_seeds
     from rvsm.sim.cli.build_choice import ARCH_DEFAULTS, choose_build
     from rvsm.sim.cli.rtl import command_architecture
 

@@ -306,12 +306,17 @@ class ProtocolKind(GeneratedKind):
         print_run_lines(r)
 
 
-def print_run_lines(r: dict) -> None:
-    """The lines every kind's report ends with: the first mismatch, speed, code
-    coverage, the waveform and the run folder."""
+def print_first_mismatch(r: dict) -> None:
+    """``first mismatch: k=v, ...`` when ``r`` (a verify result) has mismatches."""
     if r["mismatches"]:
         f = r["first_mismatch"] or {}
         print("first mismatch: " + ", ".join(f"{k}={v}" for k, v in f.items()))
+
+
+def print_run_lines(r: dict) -> None:
+    """The lines every kind's report ends with: the first mismatch, speed, code
+    coverage, the waveform and the run folder."""
+    print_first_mismatch(r)
     if r.get("cycles_per_second"):
         how = ", long-run harness" if r.get("harness") == "chunk" else ""
         print(f"stream: {r['lanes']} lane(s), {r['cycles']} cycles at "

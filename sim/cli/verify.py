@@ -33,7 +33,7 @@ from rvsm.sim.cli.rtl import (
     arch_text,
     command_architecture,
 )
-from rvsm.sim.cli.stimulus_kinds import STIMULUS_KINDS, StimulusRequest
+from rvsm.sim.cli.stimulus_kinds import STIMULUS_KINDS, StimulusRequest, print_first_mismatch
 from rvsm.sim.cosim.builds.cocotb_adapter import SIMULATORS
 from rvsm.sim.cosim.run_settings import RunSettings
 
@@ -170,9 +170,7 @@ def _verify_wrapper(args: argparse.Namespace, sim: str, work: str, waves: bool,
               f"(idle in {axis.idle_in:g}, back-pressure {axis.idle_out:g}): "
               f"{c['IN_BEATS']} beats in, {c['OUT_BEATS']} out, {c['DROPPED']} dropped; "
               f"{r['compared']} spikes compared, {r['mismatches']} mismatches")
-        if r["mismatches"]:
-            f = r["first_mismatch"] or {}
-            print("first mismatch: " + ", ".join(f"{k}={v}" for k, v in f.items()))
+        print_first_mismatch(r)
         if r["waves"]:
             print(f"waveform kept: {r['waves']}")
         print(f"run folder: {r['run_dir']}")
@@ -263,9 +261,7 @@ def _verify_shards(args: argparse.Namespace, settings: RunSettings) -> int:
               f"compared {r['compared']} spikes and {r['boundary_states_compared']} "
               f"boundary states, {r['mismatches']} mismatches "
               f"({r['boundary_mismatches']} state words)")
-        if r["mismatches"]:
-            f = r["first_mismatch"] or {}
-            print("first mismatch: " + ", ".join(f"{k}={v}" for k, v in f.items()))
+        print_first_mismatch(r)
         print(f"wall {r['wall_seconds']:.0f} s (build {r['build_seconds']:.0f} s"
               f"{', cached' if r['build_cached'] else ''}), {r['cycles']} cycles")
         print(f"run folders: {r['run_dir']}")

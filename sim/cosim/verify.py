@@ -211,6 +211,17 @@ def replay(stimulus: str | os.PathLike, sim: str = "icarus", steps: int | None =
     return result
 
 
+def _settings_and_point(sim: str, point: RunPoint | str | os.PathLike,
+                        size: tuple[int, int] | None, settings: dict[str, Any]
+                        ) -> tuple[RunSettings, RunPoint]:
+    """What :func:`verify` and :func:`random_verify` start from: the run settings
+    resolved against the design point (read once, at ``size`` if given)."""
+    s = RunSettings.of(sim, **settings)
+    run = RunPoint.coerce(point, size)
+    s.resolve(run.contract)
+    return s, run
+
+
 def verify(scene: str | Scene, point: RunPoint | str | os.PathLike, sim: str = "icarus",
            steps: int | None = None, size: tuple[int, int] | None = None,
            **settings: Any) -> dict:
@@ -234,10 +245,8 @@ def verify(scene: str | Scene, point: RunPoint | str | os.PathLike, sim: str = "
     from rvsm.model.fixed.stimulus import make_stimulus
     from rvsm.model.scene.loaders import load_scene
 
-    s = RunSettings.of(sim, **settings)
-    run = RunPoint.coerce(point, size)
+    s, run = _settings_and_point(sim, point, size, settings)
     h, w = run.shape
-    s.resolve(run.contract)
     if not isinstance(scene, Scene):
         scene = load_scene(scene, size=(h, w))
     harness = s.choose(h * w, scene.num_steps if steps is None else steps,
@@ -270,9 +279,7 @@ def random_verify(point: RunPoint | str | os.PathLike, seed: int, steps: int,
     """
     from rvsm.model.fixed.corner_stimulus import corner_stimulus, coverage
 
-    s = RunSettings.of(sim, **settings)
-    run = RunPoint.coerce(point, size)
-    s.resolve(run.contract)
+    s, run = _settings_and_point(sim, point, size, settings)
     stim = corner_stimulus(run.contract, seed, steps)
     stim.point = run.point
     h, w = run.shape

@@ -15,11 +15,12 @@ from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
+from rvsm.model.infra.errors import ToolError
 from rvsm.rtl.architectures.registry import ARCHITECTURES, get_architecture
 from rvsm.rtl.architectures.verilog import generate_verilog, strip_zero_memory_init
 from rvsm.rtl.ports import verilog_ports
 from rvsm.rtl.stream.array import RvsmStreamArray
-from rvsm.rtl.verilog_memories import MemoryCells, convert_verilog
+from rvsm.rtl.verilog_memories import MemoryCells, convert_verilog, rename_ports
 
 
 def _amaranth(component: wiring.Component, top: str) -> str:
@@ -95,3 +96,23 @@ def test_only_non_zero_contents_are_written():
     assert "connect \\DATA { 8'00000000 8'11111111 8'00000000 8'00000011 }" in text
     assert [m for m in re.findall(r"memory width 8 size 4 \\(\w+)", text)] == [
         "zero", "words", "neg", "two_reads"]
+
+
+def test_port_names_renumbered_in_order():
+    """The cell-named ports keep their order and take Amaranth's numbers; a different count
+    of names is a tool error, not a silent mismatch."""
+    text = "wire input 1 \\port$4$0\nconnect \\port$9$2 \\port$4$0\n"
+    assert rename_ports(text, [6, 13]) == (
+        "wire input 1 \\port$6$0\nconnect \\port$13$2 \\port$6$0\n")
+    with pytest.raises(ToolError):
+        rename_ports(text, [6])
+
+
+def test_no_private_amaranth_import():
+    """Deliverable 6 of issue 39: the lowering uses public Amaranth only."""
+    from pathlib import Path
+
+    import rvsm.rtl.verilog_memories as module
+
+    source = Path(module.__file__).read_text(encoding="utf-8")
+    assert not re.search(r"amaranth\.hdl\._|from amaranth\.hdl import .*\b_[a-z]+", source)

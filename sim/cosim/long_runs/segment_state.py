@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from rvsm.model.fixed.stimulus_chunks import StimulusChunks
-from rvsm.sim.cosim.builds.chunk_harness import decode_output_beats
+from rvsm.sim.cosim.long_runs.chunk_files import decode_output_beats
 
 __all__ = ["MAX_LISTED", "SegmentState", "pack_words", "unpack_words"]
 

@@ -7,7 +7,7 @@ import json
 import re
 from pathlib import Path
 
-from rvsm.rtl.fpga.flow import run_fpga
+from rvsm.rtl.fpga.fpga_run import run_fpga
 
 
 def test_board_build_places_every_port_at_its_planned_site(tmp_path: Path, fsm_point) -> None:

@@ -11,7 +11,8 @@ import pytest
 
 from rvsm.model.fixed.design_point import default_design_point
 from rvsm.model.infra.errors import ToolError
-from rvsm.rtl.fpga.flow import run_fpga, synthesis_script
+from rvsm.rtl.fpga.flow import synthesis_script
+from rvsm.rtl.fpga.fpga_run import run_fpga
 from rvsm.rtl.fpga.tool_logs import follower
 from rvsm.rtl.toolchain import run_tool
 

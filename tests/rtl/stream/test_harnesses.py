@@ -68,10 +68,11 @@ def test_each_group_names_its_properties(formal_point, model, reset):
         if group == "tail":
             expected = expected | {f"reset.{reset}"}
         assert asserts == expected, group
-        # the group's statements in harnesses.py, the base's assumptions in its module
+        # the group's statements in harnesses.py, the assumptions of the base and of the
+        # shared bookkeeping (the watched word and scale) in their modules
         assert all(p.src.split(":")[0].endswith("rtl/stream/harnesses.py")
-                   or (p.kind == "assume"
-                       and p.src.split(":")[0].endswith("rtl/stream/harness_base.py"))
+                   or (p.kind == "assume" and p.src.split(":")[0].endswith(
+                       ("rtl/stream/harness_base.py", "rtl/stream/property_watch.py")))
                    for p in props)
         # sby names a failing statement by its line: one property per line
         assert len({p.src for p in props}) == len(props)

@@ -39,7 +39,7 @@ def fpga_calls(monkeypatch: pytest.MonkeyPatch) -> list[dict]:
         calls.append(kw)
         return _FakeReport()
 
-    monkeypatch.setattr("rvsm.rtl.fpga.flow.run_fpga", fake)
+    monkeypatch.setattr("rvsm.rtl.fpga.fpga_run.run_fpga", fake)
     return calls
 
 

@@ -104,7 +104,7 @@ WORK = [
     "rvsm.sim.studies.table.run_table", "rvsm.sim.studies.robustness.run_robustness",
     "rvsm.sim.sweep.run.run_sweep", "rvsm.sim.sweep.report.write_report",
     "rvsm.sim.cli.demo.run_float_demo", "rvsm.model.fixed.point_toml.save_design_point",
-    "rvsm.rtl.fpga.flow.run_fpga",
+    "rvsm.rtl.fpga.fpga_run.run_fpga",
 ]
 
 

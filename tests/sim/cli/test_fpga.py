@@ -9,7 +9,7 @@ import pytest
 
 from rvsm.model.fixed.point_toml import save_design_point
 from rvsm.model.infra.errors import ToolError
-from rvsm.rtl.fpga.flow import run_fpga
+from rvsm.rtl.fpga.fpga_run import run_fpga
 from rvsm.sim.cli import main
 
 TINY = (2, 2)

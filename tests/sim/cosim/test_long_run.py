@@ -21,7 +21,7 @@ from rvsm.model.infra.errors import RvsmError
 from rvsm.model.scene.loaders import load_scene
 from rvsm.rtl.stream.schedule import pack_lanes
 from rvsm.sim.cli import main
-from rvsm.sim.cosim.builds.chunk_harness import (
+from rvsm.sim.cosim.long_runs.chunk_files import (
     decode_output_beats,
     encode_input_beats,
     encode_threshold_writes,
