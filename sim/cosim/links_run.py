@@ -33,11 +33,11 @@ from rvsm.sim.cosim.builds.chunk_harness import (
     HARNESS_VERSION,
     HarnessLayout,
     clock_inside,
-    encode_threshold_writes,
     harness_verilog,
 )
 from rvsm.sim.cosim.builds.cocotb_adapter import check_simulator, cocotb_build, cocotb_test, cxx_opt
 from rvsm.sim.cosim.builds.icarus_netlist import write_icarus_netlist
+from rvsm.sim.cosim.long_runs.chunk_files import encode_threshold_writes
 
 #: The streaming array's beats (the front end's array): their checker and type.
 _BEATS = get_architecture().beats

@@ -24,7 +24,7 @@ from cocotb.clock import Clock
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import FallingEdge, RisingEdge
 
-from rvsm.sim.cosim.builds.chunk_harness import decode_output_beats, encode_input_beats
+from rvsm.sim.cosim.long_runs.chunk_files import decode_output_beats, encode_input_beats
 from rvsm.sim.cosim.testbenches.tb_common import CLOCK_NS
 
 RESET_CYCLES = 32  # bit clocks: several core cycles of the loopback
