@@ -5,7 +5,7 @@ its text (which names it in sweeps) do not change with it. ``rvsm verilog``, ``r
 verify`` and ``rvsm fpga`` take each setting from it when their flag is not given
 (docs/cli.md, "Build settings"). Here the table's keys and the types of their values are
 checked (each key optional); whether a name is a registered architecture, interface,
-memory or FPGA part is checked on the RTL side
+memory, FPGA part or one of its packages is checked on the RTL side
 (:func:`rvsm.rtl.fpga.build_settings.check_build_settings`), which this layer cannot
 import.
 """
@@ -29,10 +29,12 @@ BUILD_KEYS: dict[str, tuple[str, Any]] = {
     "interface": ("native (the array's ports) | axis (the AXI IP) (--interface)", "native"),
     "freq_mhz": ("clock target, MHz (rvsm fpga --freq, rvsm verilog --clock-mhz)", 100.0),
     "device": ("FPGA part that rvsm fpga places (--device)", "ecp5-85"),
+    "package": ("the device's package, judged by the I/O budget; rvsm fpga --board "
+                "places it (--package)", "CABGA756"),
     "memory": ("state memories: dp16kd | inferred (rvsm fpga --memory)", "dp16kd"),
     "fifo_depth": ("output FIFO depth in beats, interface axis only (--fifo-depth)", 16),
 }
-_NAMES = ("arch", "interface", "device", "memory")
+_NAMES = ("arch", "interface", "device", "package", "memory")
 _COUNTS = ("lanes", "fifo_depth")
 
 
@@ -40,8 +42,9 @@ _COUNTS = ("lanes", "fifo_depth")
 class BuildSettings:
     """The ``[rtl]`` table: every field ``None`` when the point does not set it.
 
-    ``arch``, ``interface``, ``device``, ``memory``: names (checked against the RTL's
-    registries by :func:`rvsm.rtl.fpga.build_settings.check_build_settings`); ``lanes``
+    ``arch``, ``interface``, ``device``, ``package``, ``memory``: names (checked against
+    the RTL's registries, ``package`` against the device's packages, by
+    :func:`rvsm.rtl.fpga.build_settings.check_build_settings`); ``lanes``
     (pixels per beat) and ``fifo_depth`` (beats): integers >= 1; ``freq_mhz``: clock
     target in MHz, > 0.
     """
@@ -51,6 +54,7 @@ class BuildSettings:
     interface: str | None = None
     freq_mhz: float | None = None
     device: str | None = None
+    package: str | None = None
     memory: str | None = None
     fifo_depth: int | None = None
 

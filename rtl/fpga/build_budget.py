@@ -62,7 +62,9 @@ def clock_above_fmax(device: str, lanes: int, freq_mhz: float) -> str | None:
 
 def judge_build(point: DesignPoint, settings: BuildSettings, source: str) -> str:
     """The one-line verdict of ``point`` built as ``settings`` on its device (default
-    :data:`DEFAULT_DEVICE`); :class:`RvsmError` when the lanes, memory or clock break."""
+    :data:`DEFAULT_DEVICE`; its ``package`` named when the point states one, the I/O is
+    judged by ``rvsm datasheet``); :class:`RvsmError` when the lanes, memory or clock
+    break."""
     device = settings.device or DEFAULT_DEVICE
     lanes = settings.lanes or 1
     if point.width % lanes:
@@ -83,7 +85,8 @@ def judge_build(point: DesignPoint, settings: BuildSettings, source: str) -> str
         slow = clock_above_fmax(device, lanes, settings.freq_mhz)
         if slow:
             raise RvsmError(f"{source}: {slow}")
-    verdict = f"fits {device}: state {sp.bram} / {dev.bram} {kind} at {lanes} lane(s)"
+    where = f"{device} {settings.package}" if settings.package else device
+    verdict = f"fits {where}: state {sp.bram} / {dev.bram} {kind} at {lanes} lane(s)"
     if not dev.placed:
         verdict += (f" ({dev.status}: rvsm fpga does not place {device}"
                     + ("; no Fmax model checks freq_mhz" if dev.timing is None else "") + ")")

@@ -5,7 +5,8 @@ types; here each name is checked against its registry: ``arch`` an ``--arch`` ch
 (:data:`~rvsm.rtl.architectures.registry.ARCHITECTURES`), ``interface`` one registered
 for that architecture, ``device`` one of the one device list
 (:func:`~rvsm.rtl.fpga.devices.device_names`: the parts ``rvsm fpga`` places and the
-estimate-only ones, which ``rvsm fpga`` refuses in one line), ``memory`` one of
+estimate-only ones, which ``rvsm fpga`` refuses in one line), ``package`` one of that
+device's packages (:func:`device_packages`; default device ``ecp5-85``), ``memory`` one of
 :data:`~rvsm.rtl.fpga.flow.MEMORIES`; ``lanes`` and ``fifo_depth`` must be options of the
 architecture the table names (default the streaming array, natively).
 """
@@ -21,10 +22,20 @@ from rvsm.rtl.architectures.registry import (
     NATIVE,
     WRAPPERS,
 )
-from rvsm.rtl.fpga.devices import device_names
+from rvsm.rtl.fpga.build_budget import DEFAULT_DEVICE
+from rvsm.rtl.fpga.devices import device_names, get_budget
 from rvsm.rtl.fpga.flow import MEMORIES
 
-__all__ = ["check_build_settings"]
+__all__ = ["check_build_settings", "device_packages"]
+
+
+def device_packages(device: str) -> list[str]:
+    """The package names ``[rtl] package`` may take on ``device`` (the one device list):
+    those of its I/O figures (:attr:`~rvsm.rtl.fpga.devices.DeviceBudget.io`), default
+    first. An estimate-only part offers the one package its figures name (none when the
+    package is only in the part name, as on the Gowin parts)."""
+    names = [p.package for p in get_budget(device).io if not p.package.startswith("(")]
+    return list(dict.fromkeys(names))
 
 
 def _refuse(source: str, key: str, value: object, valid: str) -> RvsmError:
@@ -51,6 +62,15 @@ def check_build_settings(settings: BuildSettings, source: str = "design point") 
     if s.device is not None and s.device not in device_names():
         raise _refuse(source, "device", s.device,
                       f"choose one of {', '.join(device_names())}")
+    if s.package is not None:
+        device = s.device or DEFAULT_DEVICE
+        dev = f"{BUILD_SECTION}.device {device}" if s.device else f"the default device {device}"
+        offered = device_packages(device)
+        if s.package not in offered:
+            raise _refuse(source, "package", s.package,
+                          f"{dev} comes in {', '.join(offered)}" if offered else
+                          f"{dev} names no package (estimate only, the package in its part "
+                          f"name): leave {BUILD_SECTION}.package out")
     if s.memory is not None and s.memory not in MEMORIES:
         raise _refuse(source, "memory", s.memory, f"choose one of {', '.join(MEMORIES)}")
     built = ARCHITECTURES[arch] if interface == NATIVE else WRAPPERS[arch, interface]

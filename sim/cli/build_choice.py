@@ -30,6 +30,7 @@ FLAGS: dict[str, tuple[str, str]] = {
     "fifo_depth": ("--fifo-depth", "FIFO depth {}"),
     "freq_mhz": ("--freq", "freq {:g} MHz"),
     "device": ("--device", "device {}"),
+    "package": ("--package", "package {}"),
     "memory": ("--memory", "memory {}"),
 }
 #: The settings that are architecture options (their defaults are the architecture's).

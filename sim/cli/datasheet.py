@@ -207,7 +207,7 @@ def _datasheet(args: argparse.Namespace) -> int:
         raise RvsmError(lanes_error(pf.point.width, lanes,
                                     "--lanes" if args.lanes else "rtl.lanes"))
     if not args.allow_infeasible:
-        _refuse_infeasible(pf.point, device, lanes, args)
+        _refuse_infeasible(pf.point, device, lanes, args, pf.package_on(device.name))
     fpga = di.load_fpga_report(args.fpga) if args.fpga else None
     if fpga is not None and fpga.get("model") not in (None, pf.point.model):
         raise RvsmError(f"{args.fpga}: the fpga result is of model {fpga['model']}, the "
@@ -238,9 +238,10 @@ def _datasheet(args: argparse.Namespace) -> int:
                            picture_scene, settings, checks)
 
 
-def _refuse_infeasible(point, device, lanes, args) -> None:  # noqa: ANN001
-    """:class:`RvsmError` (one line) when the memory or the clock the rate needs breaks
-    on ``device`` (the logic is not known yet: it is judged on the page)."""
+def _refuse_infeasible(point, device, lanes, args, package) -> None:  # noqa: ANN001
+    """:class:`RvsmError` (one line) when the memory, the clock the rate needs or the I/O
+    of ``package`` (None: the device's default) breaks on ``device`` (the logic is not
+    known yet: it is judged on the page)."""
     from rvsm.rtl.fpga.block_ram import StateLayout
     from rvsm.rtl.fpga.camera import clock_needed_hz
     from rvsm.rtl.fpga.feasibility import Camera, assess
@@ -251,7 +252,7 @@ def _refuse_infeasible(point, device, lanes, args) -> None:  # noqa: ANN001
     layout = StateLayout.from_contract(point.contract(),
                                        shared_thresholds=point.shared_thresholds)
     f = assess(layout, device, Camera(h, w, args.rate_hz, clock), None,
-               organisation=args.organisation)
+               organisation=args.organisation, package=package)
     if f.broken:
         raise RvsmError(nothing_fits({device.name: [f]}, f"{point.model} cannot meet", "the page"))
 

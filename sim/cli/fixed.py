@@ -120,7 +120,7 @@ def run_config_check(args: argparse.Namespace) -> int:
         check_build_settings(build, args.point)
     c = p.contract()
     verdict = None
-    if build.device or build.lanes or build.freq_mhz:  # the build judged on its device
+    if build.device or build.package or build.lanes or build.freq_mhz:  # judged on its device
         from rvsm.rtl.fpga.build_budget import judge_build
 
         verdict = judge_build(p, build, args.point)

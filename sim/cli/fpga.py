@@ -65,8 +65,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "output folder), no unconstrained port; with --interface axis the AXI IP "
                    "between the links, its registers on SPI pins (docs/fpga.md, Board build)")
     p.add_argument("--package", choices=("CABGA381", "CABGA554", "CABGA756"),
-                   help="with --board: the ECP5-85 package (default: the smallest whose "
-                   "pins carry the links)")
+                   help="with --board: the ECP5-85 package (default: the point's [rtl] "
+                   "package, else the smallest whose pins carry the links)")
     p.add_argument("--seed", type=int, default=1,
                    help="placer seed; with --seeds the first of N (default 1)")
     p.add_argument("--seeds", type=int, metavar="N",
@@ -104,6 +104,14 @@ def _check_device(args: argparse.Namespace) -> None:
         get_device(device)
 
 
+def board_settings(args: argparse.Namespace) -> dict[str, tuple[str, None]]:
+    """The ``choose_build`` settings only a board build has: with ``--board``, ``package``
+    (``--package``, else the point's ``[rtl] package``, else ``None``: the pin planner's
+    smallest package that carries the links); without, none (the harness build places
+    on the device's default package and plans no pins)."""
+    return {"package": ("package", None)} if args.board else {}
+
+
 def _fpga(args: argparse.Namespace) -> int:
     from rvsm.model.fixed.point_toml import load_design_point
     from rvsm.rtl.architectures.registry import get_architecture
@@ -116,9 +124,11 @@ def _fpga(args: argparse.Namespace) -> int:
         raise RvsmError(f"--timeout must be > 0 seconds, got {args.timeout}")
     check_outputs([Output(args.out, "-o", FOLDER)], [args.point])
     _check_device(args)
+    if args.package and not args.board:
+        raise RvsmError("--package goes with --board")
     choice = choose_build(args, "fpga", args.point, {
         **ARCH_DEFAULTS, "freq_mhz": ("freq", FREQ_MHZ), "device": ("device", DEVICE),
-        "memory": ("memory", MEMORY)})
+        "memory": ("memory", MEMORY), **board_settings(args)})
     arch, options = command_architecture(args)  # the IP with --interface axis
     base = get_architecture(args.arch)
     point = load_design_point(args.point)
@@ -138,8 +148,6 @@ def _fpga(args: argparse.Namespace) -> int:
                   netlist="rtlil" if args.rtlil else "verilog", memory=args.memory,
                   slope_lanes=args.slope_lanes, on_progress=progress,
                   timeout=args.timeout, build=build)
-    if args.package and not args.board:
-        raise RvsmError("--package goes with --board")
     if args.board:
         if args.synth_only:
             raise RvsmError("--board places and routes: it does not go with --synth-only")

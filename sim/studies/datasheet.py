@@ -104,7 +104,8 @@ def _assess(inputs: DatasheetInputs, logic: LogicCost | None) -> Feasibility:
     shared = point.shared_thresholds
     layout = StateLayout.from_contract(point.contract(), shared_thresholds=shared)
     return assess(layout, inputs.device, Camera(h, w, inputs.rate_hz, clock), logic,
-                  measured=measured, organisation=inputs.organisation)
+                  measured=measured, organisation=inputs.organisation,
+                  package=inputs.point_file.package_on(inputs.device.name))
 
 
 def _bits(n: float) -> str:
@@ -206,7 +207,9 @@ def _resources_section(inputs: DatasheetInputs, feas: Feasibility) -> tuple[list
                 dev.bram_kind.name: fp["bram"]["used"]}
     where = (f"measured by nextpnr ({fp.get('mode', '?')}) at {fp['height']}x{fp['width']}, "
              f"P = {fp['lanes']}, on {fp['device']}" if fp else "measured: not given")
-    lines = [f"## {SECTIONS[1]}", "", f"Device {dev.summary()}.", "",
+    own = inputs.point_file.package_on(dev.name)
+    pk = f"; in {own}, the point's [rtl] package (the I/O budget's)" if own else ""
+    lines = [f"## {SECTIONS[1]}", "", f"Device {dev.summary()}{pk}.", "",
              f"| resource | measured | estimate (feasibility model) at "
              f"{feas.camera.height}x{feas.camera.width}, P = {feas.lanes} | device | "
              "estimate verdict |", "|---|---|---|---|---|"]

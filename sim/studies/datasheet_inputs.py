@@ -53,8 +53,8 @@ MAX_RESULT_BYTES = 16 << 20
 
 @dataclass(frozen=True)
 class PointFile:
-    """A design point TOML: the point, its raw ``[rtl]`` table (empty when absent) and
-    the path it was read from."""
+    """A design point TOML: the point, its raw ``[rtl]`` table (empty when absent; checked
+    when it states a ``package``) and the path it was read from."""
 
     path: str
     point: DesignPoint
@@ -65,6 +65,16 @@ class PointFile:
         """``[rtl] lanes`` if the file states it."""
         v = self.rtl.get("lanes")
         return v if isinstance(v, int) and not isinstance(v, bool) else None
+
+    def package_on(self, device: str) -> str | None:
+        """``[rtl] package`` when the page's ``device`` is the point's (``[rtl] device``,
+        default ecp5-85): the package the I/O budget judges; ``None``: the device's
+        default package."""
+        from rvsm.rtl.fpga.build_budget import DEFAULT_DEVICE
+
+        v = self.rtl.get("package")
+        own = self.rtl.get("device", DEFAULT_DEVICE)
+        return v if isinstance(v, str) and v and device == own else None
 
 
 def read_result_text(path: str | os.PathLike, what: str) -> str:
@@ -92,6 +102,11 @@ def load_point_file(path: str | os.PathLike) -> PointFile:
     if lanes is not None and (isinstance(lanes, bool) or not isinstance(lanes, int)
                               or lanes < 1):
         raise RvsmError(f"{path}: rtl.lanes must be an integer >= 1, got {lanes!r}")
+    if "package" in rtl:  # the I/O budget judges it: checked as rvsm config check does
+        from rvsm.model.fixed.build_settings import BuildSettings
+        from rvsm.rtl.fpga.build_settings import check_build_settings
+
+        check_build_settings(BuildSettings.from_table(rtl, str(path)), str(path))
     return PointFile(str(path), from_toml_dict(data, str(path)), dict(rtl))
 
 

@@ -95,6 +95,16 @@ def _see(section: str) -> str:
     return f"[{section}](#{'-'.join(section.lower().split())})"
 
 
+def _package(inputs: DatasheetInputs) -> str:
+    """The package the I/O budget judges: the point's ``[rtl] package``, else the
+    device's default (in its part name)."""
+    dev = inputs.device
+    own = inputs.point_file.package_on(dev.name)
+    if own:
+        return f"{own} (the point's [rtl] package)"
+    return dev.part.split("(")[-1].rstrip(")") if "(" in dev.part else "not stated"
+
+
 def summary_lines(inputs: DatasheetInputs, feas: Feasibility, io: Interfaces) -> list[str]:
     """The summary table (module docstring); ``io`` the interfaces at ``feas.lanes``."""
     point, dev, fp = inputs.point_file.point, inputs.device, inputs.fpga
@@ -107,7 +117,7 @@ def summary_lines(inputs: DatasheetInputs, feas: Feasibility, io: Interfaces) ->
         ("device", f"{dev.name}: {dev.part.split(' (')[0]}, "
                    + (f"placed by {dev.tool}" if dev.placed else
                       f"**{dev.status}** ({dev.status_reason})")),
-        ("package", dev.part.split("(")[-1].rstrip(")") if "(" in dev.part else "not stated"),
+        ("package", _package(inputs)),
     ]
     if fmax.budget is None:
         clk = f"{clock / 1e6:.1f} MHz needed; Fmax unknown"

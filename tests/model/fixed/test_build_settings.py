@@ -16,7 +16,7 @@ from rvsm.model.fixed.point_toml import (
 from rvsm.model.infra.errors import RvsmError
 
 TABLE = ('\n[rtl]\narch = "stream"\nlanes = 40\ninterface = "axis"\nfreq_mhz = 80\n'
-         'device = "ecp5-85"\nmemory = "inferred"\nfifo_depth = 16\n')
+         'device = "ecp5-85"\npackage = "CABGA756"\nmemory = "inferred"\nfifo_depth = 16\n')
 
 
 def test_the_table_is_read_beside_the_point_and_leaves_it_unchanged(tmp_path):
@@ -28,7 +28,8 @@ def test_the_table_is_read_beside_the_point_and_leaves_it_unchanged(tmp_path):
     assert got == point and got.contract() == point.contract()  # not part of the contract
     assert design_point_toml(got) == text  # the text that names a point (sweeps) unchanged
     assert build == BuildSettings(arch="stream", lanes=40, interface="axis", freq_mhz=80.0,
-                                  device="ecp5-85", memory="inferred", fifo_depth=16)
+                                  device="ecp5-85", package="CABGA756", memory="inferred",
+                                  fifo_depth=16)
     assert isinstance(build.freq_mhz, float)
     assert list(build.given()) == list(BUILD_KEYS)
     assert parse_design_point(text + TABLE) == point
@@ -47,6 +48,7 @@ def test_the_table_is_read_beside_the_point_and_leaves_it_unchanged(tmp_path):
     ("freq_mhz = \"fast\"", "rtl.freq_mhz must be a number of MHz > 0"),
     ("arch = 3", "rtl.arch must be a name (a string), got 3"),
     ("device = \"\"", "rtl.device must be a name (a string)"),
+    ("package = 756", "rtl.package must be a name (a string), got 756"),
 ])
 def test_a_bad_key_or_value_is_refused_naming_it(line, message):
     text = design_point_toml(default_design_point()) + f"\n[rtl]\n{line}\n"

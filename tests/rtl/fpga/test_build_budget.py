@@ -30,17 +30,20 @@ def test_divisors_near_the_lanes_asked():
 
 def test_shipped_point_fits_and_its_figures():
     point, build = load_point_file(POINT)
-    assert judge_build(point, build, "p") == "fits ecp5-85: state 192 / 208 DP16KD at 40 lane(s)"
+    assert judge_build(point, build, "p") == ("fits ecp5-85 CABGA756: state 192 / 208 DP16KD "
+                                              "at 40 lane(s)")  # the package where the device is
+    bare = dataclasses.replace(build, package=None)
+    assert judge_build(point, bare, "p") == "fits ecp5-85: state 192 / 208 DP16KD at 40 lane(s)"
 
 
 def test_an_estimate_only_rtl_device_is_judged_and_marked():
     point, build = load_point_file(POINT)
-    gowin = dataclasses.replace(build, device="gw5ast-138")
+    gowin = dataclasses.replace(build, device="gw5ast-138", package=None)
     verdict = judge_build(point, gowin, "p")
     assert verdict.startswith("fits gw5ast-138: state ")
     assert verdict.endswith("(estimate only: rvsm fpga does not place gw5ast-138; no Fmax "
                             "model checks freq_mhz)")
-    small = dataclasses.replace(build, device="ice40-hx8k")
+    small = dataclasses.replace(build, device="ice40-hx8k", package=None)
     with pytest.raises(RvsmError, match="of rtl.device = ice40-hx8k"):
         judge_build(point, small, "p")
 

@@ -15,6 +15,9 @@ from rvsm.rtl.fpga.build_settings import check_build_settings
                   device="ecp5-85", memory="dp16kd"),
     BuildSettings(interface="axis", fifo_depth=8, lanes=2, memory="inferred"),
     BuildSettings(arch="parallel", device="ecp5-25"),
+    BuildSettings(package="CABGA756"),  # on the default device, ecp5-85
+    BuildSettings(device="ecp5-25", package="CABGA256"),
+    BuildSettings(device="ice40-hx8k", package="CT256"),  # estimate only: its one package
 ])
 def test_valid_settings_pass(settings):
     check_build_settings(settings, "p.toml")
@@ -36,6 +39,15 @@ def test_valid_settings_pass(settings):
      "with interface native takes no options"),
     (BuildSettings(fifo_depth=8), "rtl.fifo_depth = 8 is not valid; arch stream with "
      "interface native takes lanes"),
+    (BuildSettings(device="ecp5-25", package="CABGA756"), "rtl.package = 'CABGA756' is not "
+     "valid; rtl.device ecp5-25 comes in CABGA381, CABGA256"),
+    (BuildSettings(package="TQ144"), "rtl.package = 'TQ144' is not valid; the default device "
+     "ecp5-85 comes in CABGA381, CABGA554, CABGA756"),
+    (BuildSettings(device="ice40-hx8k", package="CABGA756"), "rtl.package = 'CABGA756' is "
+     "not valid; rtl.device ice40-hx8k comes in CT256"),
+    (BuildSettings(device="gw2a-18", package="PG256"), "rtl.package = 'PG256' is not valid; "
+     "rtl.device gw2a-18 names no package (estimate only, the package in its part name): "
+     "leave rtl.package out"),
 ])
 def test_a_name_no_registry_knows_is_refused(settings, message):
     with pytest.raises(RvsmError) as err:
@@ -44,5 +56,5 @@ def test_a_name_no_registry_knows_is_refused(settings, message):
 
 
 def test_every_key_is_checked_here_or_in_the_model():
-    assert set(BUILD_KEYS) == {"arch", "lanes", "interface", "freq_mhz", "device", "memory",
-                               "fifo_depth"}
+    assert set(BUILD_KEYS) == {"arch", "lanes", "interface", "freq_mhz", "device", "package",
+                               "memory", "fifo_depth"}

@@ -63,6 +63,28 @@ def test_only_the_io_breaks_on_the_cabga381() -> None:
         assess(_dog2_a17_shared(), ECP5, CAMERA, DEFAULT_LOGIC, io_links="chip")
 
 
+def test_the_shipped_point_fits_in_its_package_and_not_in_the_default_one() -> None:
+    """The model ``rvsm datasheet`` judges it with: the I/O of points/ecp5-85-40khz.toml
+    on its ``[rtl] package`` (CABGA756) fits, on the ecp5-85's default CABGA381 breaks."""
+    from pathlib import Path
+
+    from rvsm.model.fixed.point_toml import load_point_file
+    from rvsm.rtl.fpga.camera import clock_needed_hz
+
+    point, build = load_point_file(Path(__file__).parents[3] / "points" / "ecp5-85-40khz.toml")
+    assert (build.device, build.package, build.lanes) == ("ecp5-85", "CABGA756", 40)
+    h, w = point.shape
+    layout = StateLayout.from_contract(point.contract(),
+                                       shared_thresholds=point.shared_thresholds)
+    camera = Camera(h, w, 40_000.0, clock_needed_hz(h, w, build.lanes, 40_000.0))
+    own = assess(layout, ECP5, camera, DEFAULT_LOGIC, package=build.package)
+    assert own.checks["io"].ok and own.io is not None and own.io.package.endswith("CABGA756")
+    assert own.feasible and (own.checks["io"].figure, own.checks["io"].budget) == (59, 112)
+    default = assess(layout, ECP5, camera, DEFAULT_LOGIC, package="CABGA381")
+    assert [c.name for c in default.broken] == ["io"]
+    assert (default.checks["io"].figure, default.checks["io"].budget) == (22, 17)
+
+
 def test_default_point_breaks_memory_with_its_figures() -> None:
     lay = StateLayout.from_contract(default_design_point().contract())
     f = assess(lay, ECP5, CAMERA, DEFAULT_LOGIC)

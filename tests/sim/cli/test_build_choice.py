@@ -61,6 +61,24 @@ def test_fpga_takes_the_point_settings(tmp_path: Path, capsys: pytest.CaptureFix
                         "from_point": ["lanes", "freq_mhz", "device", "memory"]}
 
 
+def test_fpga_board_takes_the_point_package(tmp_path: Path, capsys: pytest.CaptureFixture,
+                                           fpga_calls: list[dict]) -> None:
+    point = _point(tmp_path, 'freq_mhz = 100\ndevice = "ecp5-85"\npackage = "CABGA756"\n')
+    out_dir = ["-o", str(tmp_path / "w")]
+    assert main(["fpga", point, "--board", "--json", *out_dir]) == 0
+    out, err = capsys.readouterr()
+    assert fpga_calls[-1]["board"] is True and fpga_calls[-1]["package"] == "CABGA756"
+    assert err == (f"rvsm fpga: freq 100 MHz, device ecp5-85, package CABGA756 from {point} "
+                   "[rtl]\n")
+    settings = json.loads(out)["settings"]
+    assert settings["package"] == "CABGA756" and "package" in settings["from_point"]
+    assert main(["fpga", point, "--board", "--package", "CABGA554", *out_dir]) == 0
+    assert fpga_calls[-1]["package"] == "CABGA554"  # the flag wins
+    assert "package" not in capsys.readouterr().err
+    assert main(["fpga", point, *out_dir]) == 0  # no board: no pins planned, no package
+    assert "package" not in fpga_calls[-1] and "package" not in capsys.readouterr().err
+
+
 def test_fpga_flag_wins_and_defaults_stay(tmp_path: Path, capsys: pytest.CaptureFixture,
                                           fpga_calls: list[dict]) -> None:
     point = _point(tmp_path, "lanes = 4\nfreq_mhz = 80\n")
@@ -145,5 +163,12 @@ def test_config_check_names_the_settings_and_refuses_a_bad_name(
     assert main(["config", "check", bad]) == 2
     assert capsys.readouterr().err == (f"rvsm: error: {bad}: rtl.interface = 'axis' is not "
                                        "valid; arch parallel is offered with native\n")
+    lacks = _point(tmp_path, 'device = "ecp5-45"\npackage = "CABGA756"\n')
+    for argv in (["config", "check", lacks], ["fpga", lacks, "--board", "-o",
+                                               str(tmp_path / "f")]):
+        assert main(argv) == 2
+        assert capsys.readouterr().err == (
+            f"rvsm: error: {lacks}: rtl.package = 'CABGA756' is not valid; rtl.device "
+            "ecp5-45 comes in CABGA381, CABGA554\n")
     assert main(["config", "new"]) == 0
     assert "\n# [rtl]\n# arch: " in capsys.readouterr().out

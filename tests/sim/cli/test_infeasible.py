@@ -43,7 +43,8 @@ def test_fpga_refuses_an_estimate_only_device_in_one_line(tmp_path, capsys):
 
 def test_an_estimate_only_rtl_device_is_refused_by_fpga_and_marked_by_config_check(
         tmp_path, capsys):
-    f = _point(tmp_path, **{'device = "ecp5-85"': 'device = "gw5ast-138"'})
+    f = _point(tmp_path, **{'device = "ecp5-85"\npackage = "CABGA756"':
+                            'device = "gw5ast-138"'})
     assert main(["fpga", f, "-o", str(tmp_path / "o")]) == 2
     assert _one_line_error(capsys).startswith("rvsm: error: gw5ast-138 is estimate only:")
     assert main(["config", "check", f]) == 0
@@ -70,7 +71,7 @@ def test_config_check_judges_the_rtl_device(tmp_path, capsys):
     assert main(["config", "check", f]) == 2
     assert "above the ecp5-85 Fmax model, 115.7 MHz" in _one_line_error(capsys)
     assert main(["config", "check", _point(tmp_path)]) == 0
-    assert "fits ecp5-85: state 192 / 208 DP16KD" in capsys.readouterr().out
+    assert "fits ecp5-85 CABGA756: state 192 / 208 DP16KD" in capsys.readouterr().out
 
 
 def test_datasheet_rate_the_clock_cannot_meet(tmp_path, capsys):
@@ -79,6 +80,21 @@ def test_datasheet_rate_the_clock_cannot_meet(tmp_path, capsys):
     line = _one_line_error(capsys)
     assert "fmax 1,000 / 116 MHz (+764 %)" in line and "--allow-infeasible" in line
     assert not out.exists()
+
+
+def test_datasheet_judges_the_io_on_the_point_package(tmp_path, capsys):
+    """Without ``[rtl] package`` the shipped point is judged on the ecp5-85's default
+    CABGA381, whose transmit pairs do not carry its links: refused before any work."""
+    out = tmp_path / "ds"
+    bare = _point(tmp_path, **{'package = "CABGA756"\n': ""})
+    assert main(["datasheet", bare, "-o", str(out)]) == 2
+    line = _one_line_error(capsys)
+    assert "io 22 / 17 true-LVDS transmit pairs" in line and "--allow-infeasible" in line
+    assert not out.exists()
+    lacks = _point(tmp_path, **{'package = "CABGA756"': 'package = "CABGA999"'})
+    assert main(["datasheet", lacks, "-o", str(out)]) == 2
+    assert "rtl.package = 'CABGA999' is not valid; rtl.device ecp5-85 comes in CABGA381, " \
+        "CABGA554, CABGA756" in _one_line_error(capsys)
 
 
 def test_verilog_warns_when_the_sdc_clock_passes_the_fmax_model(tmp_path, capsys):
