@@ -4,7 +4,7 @@
 serialiser, :class:`~rvsm.rtl.board.front_end.BoardFrontEnd`, board deserialiser; skew
 between the receive pairs and a bit slip) inside the long-run harness
 (:mod:`rvsm.sim.cosim.builds.chunk_harness`: chunks of beats from files, spikes to
-files), runs :mod:`rvsm.sim.cosim.testbenches.tb_links` through the cocotb adapter on
+files), runs :mod:`rvsm.sim.cosim.long_runs.tb_links` through the cocotb adapter on
 Icarus or Verilator, and checks every spike that comes back through the transmit link
 against the fixed twin (:meth:`ArrayContract.run`, :func:`check_beats`). Builds are
 cached in ``build_root`` by the RTL digest, the harness version and the simulator.
@@ -46,7 +46,7 @@ __all__ = ["TOP", "links_build", "links_verify"]
 
 #: The loopback's module name.
 TOP = "rvsm_link_loopback"
-TESTBENCH = "rvsm.sim.cosim.testbenches.tb_links"
+TESTBENCH = "rvsm.sim.cosim.long_runs.tb_links"
 #: Bit-clock cycles the harness waits after a chunk's last beat (the loop's latency,
 #: tens of core cycles, with room to spare).
 TAIL_CYCLES = 256 * CORE_BITS
