@@ -8,7 +8,7 @@
       -> Deskew (deskew.py): pairs lined up on MARK
       -> the link state machine: SEARCH (until every pair is aligned) -> DESKEW (until
          every pair has shown MARK) -> LOCKED (data: framing lane read, beats written)
-      -> AsyncFIFO (SCLK domain ``rx`` -> core domain ``sync``): beats out as a stream
+      -> LinkFifo (SCLK domain ``rx`` -> core domain ``sync``; link_fifo.py): beats out as a stream
          (payload, sof, eol; valid/ready)
 
 Errors (the model's rules, :func:`~rvsm.rtl.board.model.deserialise`): in SEARCH and
@@ -30,12 +30,12 @@ from __future__ import annotations
 from amaranth.hdl import Cat, ClockDomain, DomainRenamer, Module, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.cdc import FFSynchronizer, PulseSynchronizer, ResetSynchronizer
-from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.wiring import In, Out
 
 from rvsm.rtl.board.aligner import WordAligner
 from rvsm.rtl.board.deskew import Deskew
 from rvsm.rtl.board.gearing import Deserialiser
+from rvsm.rtl.board.link_fifo import LinkFifo
 from rvsm.rtl.board.model import EOL, MARK, PARITY, SOF, SYNC, TRAIN, VALID, LinkFormat
 from rvsm.rtl.board.status import COUNTER_BITS, LinkControlSignature, LinkStatusSignature
 
@@ -135,8 +135,8 @@ class LinkReceiver(wiring.Component):
         parity_bad = checked(payload.xor() != (frame & PARITY).any(), "parity_bad")
         off_frame = checked(Cat(words[i] != frame for i in range(f)), "off_frame")
         off_train = checked(Cat(words[i] != TRAIN for i in range(f)), "off_train")
-        m.submodules.fifo = fifo = AsyncFIFO(width=fmt.payload_bits + 2, depth=FIFO_DEPTH,
-                                             r_domain="sync", w_domain="rx")
+        m.submodules.fifo = fifo = LinkFifo(fmt.payload_bits + 2, FIFO_DEPTH, "rx", "sync",
+                                            link="w")
         overflow_rx = Signal()
         with m.FSM(domain="rx"):
             with m.State("SEARCH"):

@@ -1,7 +1,8 @@
 """The transmitter: beats in the core domain to pins, with the receiver's framing.
 
 :class:`LinkTransmitter` writes each beat (``payload``, ``sof``, ``eol``) into an
-``AsyncFIFO`` (core domain ``sync`` -> its SCLK domain ``tx``); there, one link word
+``LinkFifo`` (core domain ``sync`` -> its SCLK domain ``tx``; registered on
+the ``tx`` side); there, one link word
 per two SCLK cycles: training (for :data:`RESET_TRAINING` words after the ``tx``
 reset, which follows the core domain's ``rst`` through a ``ResetSynchronizer``, and
 while ``train`` is high), else a beat when the FIFO has one, else an idle
@@ -17,10 +18,10 @@ from __future__ import annotations
 from amaranth.hdl import Cat, ClockDomain, Const, Module, Mux, ResetSignal, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
-from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.wiring import In, Out
 
 from rvsm.rtl.board.gearing import Serialiser
+from rvsm.rtl.board.link_fifo import LinkFifo
 from rvsm.rtl.board.model import (
     EOL,
     GEAR_BITS,
@@ -66,8 +67,8 @@ class LinkTransmitter(wiring.Component):
         m.submodules.tx_reset = ResetSynchronizer(ResetSignal("sync"), domain="tx")
         # the beat's parity is computed here, in the core domain, and crosses with it
         # (timing: not a wide XOR behind the FIFO's read port at the SCLK rate)
-        m.submodules.fifo = fifo = AsyncFIFO(width=fmt.payload_bits + 3, depth=FIFO_DEPTH,
-                                             r_domain="tx", w_domain="sync")
+        m.submodules.fifo = fifo = LinkFifo(fmt.payload_bits + 3, FIFO_DEPTH, "sync", "tx",
+                                            link="r")
         m.d.comb += [fifo.w_data.eq(Cat(self.beats.payload.as_value(),
                                         self.beats.payload.payload.xor())),
                      fifo.w_en.eq(self.beats.valid), self.beats.ready.eq(1)]
