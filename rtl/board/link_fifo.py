@@ -13,7 +13,8 @@ side is registered:
   memory and its pointer moved on the next cycle, from registers (``w_data`` is taken
   at the accepting edge).
 * link read side: ``r_rdy`` is a register, low for the cycle after each read; the
-  memory is read at the registered pointer (``r_data`` valid while ``r_rdy``).
+  memory is read at the registered pointer (``r_data`` valid while ``r_rdy``), and a
+  read picks the pointer's registered successor (no adder behind ``r_en``).
 
 The other side (the 100 MHz core clock) is ``AsyncFIFO``'s. ``depth`` words (a power
 of 2) fit in either case.
@@ -21,7 +22,7 @@ of 2) fit in either case.
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, Elaboratable, Module, ResetSignal, Signal
+from amaranth.hdl import Cat, Elaboratable, Module, Mux, ResetSignal, Signal
 from amaranth.lib.cdc import AsyncFFSynchronizer, FFSynchronizer
 from amaranth.lib.memory import Memory
 
@@ -44,6 +45,7 @@ class LinkFifo(Elaboratable):
 
     def __init__(self, width: int, depth: int, w_domain: str, r_domain: str, link: str):
         if link not in ("w", "r") or depth < 2 or depth & (depth - 1):
+            self._MustUse__silence = True  # an __init__ that raises is not an unused design
             raise RvsmError(f"LinkFifo needs link 'w' or 'r' and a power-of-2 depth, "
                             f"got {link!r}, {depth}")
         self.width, self.depth, self.link = width, depth, link
@@ -97,18 +99,25 @@ class LinkFifo(Elaboratable):
             ResetSignal(self.w_domain, allow_reset_less=True), r_rst, o_domain=self.r_domain)
         do_read = self.r_rdy & self.r_en
         nxt_r = Signal(bits)
-        m.d.comb += nxt_r.eq(consume + do_read)
         rp = mem.read_port(domain=self.r_domain)
         m.d.comb += [rp.en.eq(1), self.r_data.eq(rp.data)]
         if self.link == "r":
-            rdy = Signal()
-            r += rdy.eq(~do_read & (consume_gry != produce_r_gry))
-            m.d.comb += [rp.addr.eq(consume[:-1]), self.r_rdy.eq(rdy & ~r_rst)]
+            # the pointer's successor and its Gray code, registered: a read only picks
+            # them (reads are two cycles apart, so they are current at every read)
+            rdy, succ = Signal(), Signal(bits)
+            plus, plus_gry = Signal(bits, reset_less=True), Signal(bits, reset_less=True)
+            m.d.comb += succ.eq(consume + 1)
+            r += [rdy.eq(~do_read & ~r_rst & (consume_gry != produce_r_gry)),
+                  plus.eq(succ), plus_gry.eq(_gray(succ))]
+            m.d.comb += [rp.addr.eq(consume[:-1]), self.r_rdy.eq(rdy & ~r_rst),
+                         nxt_r.eq(Mux(do_read, plus, consume))]
+            gry_r = Mux(do_read, plus_gry, consume_gry)
         else:
-            m.d.comb += [rp.addr.eq(nxt_r[:-1]),
+            m.d.comb += [nxt_r.eq(consume + do_read), rp.addr.eq(nxt_r[:-1]),
                          self.r_rdy.eq((consume_gry != produce_r_gry) & ~r_rst)]
+            gry_r = _gray(nxt_r)
         with m.If(r_rst):
             r += [consume_gry.eq(produce_r_gry), consume.eq(_from_gray(produce_r_gry))]
         with m.Else():
-            r += [consume.eq(nxt_r), consume_gry.eq(_gray(nxt_r))]
+            r += [consume.eq(nxt_r), consume_gry.eq(gry_r)]
         return m
