@@ -184,12 +184,14 @@ class LinkReceiver(wiring.Component):
         clear = Signal()
         m.submodules.clear_sync = clear_sync = PulseSynchronizer("sync", "rx")
         m.d.comb += [clear_sync.i.eq(self.control.counters_reset), clear.eq(clear_sync.o)]
+        err_d = Signal(n)  # timing: the counters count the error pulses a cycle later
+        m.d.rx += err_d.eq(err)
         for i in range(n):
             count = Signal(COUNTER_BITS, reset_less=True, name=f"errors{i}")
             gray = Signal(COUNTER_BITS, reset_less=True, name=f"errors{i}_gray")
             with m.If(clear):
                 m.d.rx += count.eq(0)
-            with m.Elif(err[i] & (count != (1 << COUNTER_BITS) - 1)):
+            with m.Elif(err_d[i] & (count != (1 << COUNTER_BITS) - 1)):
                 m.d.rx += count.eq(count + 1)
             m.d.rx += gray.eq(count ^ (count >> 1))
             synced = Signal(COUNTER_BITS, name=f"errors{i}_sync")

@@ -94,6 +94,9 @@ class LinkTransmitter(wiring.Component):
         train_word = Mux(period == TRAIN_PERIOD - 1, MARK, TRAIN)
         take = ~phase & ~training & fifo.r_rdy
         m.d.comb += fifo.r_en.eq(take)
+        # Timing: the gear words are registered from ``word`` alone (the serialiser's
+        # registers sit by the pins, far from the FIFO): the low half one cycle after
+        # the word is chosen, the high half the cycle after.
         word = [Signal(WORD_BITS, name=f"word{k}") for k in range(n)]
         with m.If(~phase):
             with m.If(training):
@@ -103,8 +106,8 @@ class LinkTransmitter(wiring.Component):
                     fifo.r_rdy,
                     beat_frame if k == f else padded[WORD_BITS * k:WORD_BITS * (k + 1)],
                     Const(SYNC << 4, WORD_BITS) if k == f else Const(TRAIN, WORD_BITS)))
-                m.d.tx += [word[k].eq(nxt), ser.words[k].eq(nxt[:GEAR_BITS])]
+                m.d.tx += [word[k].eq(nxt), ser.words[k].eq(word[k][GEAR_BITS:])]
         with m.Else():
             for k in range(n):
-                m.d.tx += ser.words[k].eq(word[k][GEAR_BITS:])
+                m.d.tx += ser.words[k].eq(word[k][:GEAR_BITS])
         return m
