@@ -84,7 +84,8 @@ class LinkTransmitter(wiring.Component):
         # Timing: registered; ``left`` changes only at ~phase cycles (two apart), so at
         # each it is exact (``train``, a synchronised level, is one cycle later).
         training = Signal(init=1)
-        m.d.tx += training.eq((left != 0) | train)
+        busy = Signal(init=1)  # left != 0, registered likewise
+        m.d.tx += [training.eq((left != 0) | train), busy.eq(left != 0)]
         payload = fifo.r_data[:fmt.payload_bits]
         sof, eol = fifo.r_data[fmt.payload_bits], fifo.r_data[fmt.payload_bits + 1]
         padded = Cat(payload, Const(0, fmt.data_pairs * WORD_BITS - fmt.payload_bits))
@@ -100,7 +101,9 @@ class LinkTransmitter(wiring.Component):
         word = [Signal(WORD_BITS, name=f"word{k}") for k in range(n)]
         with m.If(~phase):
             with m.If(training):
-                m.d.tx += [left.eq(left - (left != 0)), period.eq(period + 1)]
+                m.d.tx += period.eq(period + 1)
+                with m.If(busy):
+                    m.d.tx += left.eq(left - 1)
             for k in range(n):
                 nxt = Mux(training, train_word, Mux(
                     fifo.r_rdy,
