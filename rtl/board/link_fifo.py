@@ -71,12 +71,16 @@ class LinkFifo(Elaboratable):
             w += consume_w.eq(_from_gray(consume_w_gry))
             stage_en, stage_data = Signal(), Signal(self.width)
             accept = self.w_en & self.w_rdy
-            m.d.comb += nxt.eq(produce + stage_en)
+            # words accepted so far (the staged one included) and its successor,
+            # registered: accepts are two cycles apart, so ``acc1`` is current at each
+            acc, acc1 = Signal(bits), Signal(bits, init=1)
+            w += acc1.eq(acc + 1)
+            with m.If(accept):
+                w += acc.eq(acc1)
             w += [stage_en.eq(accept), stage_data.eq(self.w_data),
-                  produce.eq(nxt), produce_gry.eq(_gray(nxt)),
-                  # words accepted so far (the staged one included) minus those read:
-                  # below depth leaves room for one more
-                  self.w_rdy.eq(~accept & ~(nxt - consume_w)[bits - 1])]
+                  produce.eq(acc), produce_gry.eq(_gray(acc)),
+                  # fewer than depth words held or staged leaves room for one more
+                  self.w_rdy.eq(~accept & ~(acc - consume_w)[bits - 1])]
             m.d.comb += [wp.addr.eq(produce[:-1]), wp.data.eq(stage_data),
                          wp.en.eq(stage_en)]
         else:
