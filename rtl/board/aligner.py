@@ -48,13 +48,17 @@ class WordAligner(wiring.Component):
         good = Signal(range(GOOD_WORDS))
         nxt = Cat(hist[GEAR_BITS:], self.gear)
         m.d.sync += hist.eq(nxt)
-        # Timing: the window (and its TRAIN/MARK compares) is registered from the next
-        # history every cycle; ``slip`` changes only at a strobe and strobes are two
-        # cycles apart, so at every strobe it equals hist.bit_select(slip) exactly.
-        is_train, is_mark = Signal(), Signal()
-        window = nxt.bit_select(self.slip, WORD_BITS)
-        m.d.sync += [self.window.eq(window), is_train.eq(window == TRAIN),
-                     is_mark.eq(window == MARK)]
+        # Timing: the window is registered from the next history every cycle; ``slip``
+        # changes only at a strobe and strobes are two cycles apart, so at every strobe
+        # it equals hist.bit_select(slip) exactly. The TRAIN/MARK compares are
+        # registered for all eight slips (off the slip loop); at a strobe ``slip`` only
+        # picks one, so the loop slip -> compare -> slip is a mux and the decision.
+        windows = [nxt[s:s + WORD_BITS] for s in range(WORD_BITS)]
+        trains, marks = Signal(WORD_BITS), Signal(WORD_BITS)
+        m.d.sync += [self.window.eq(nxt.bit_select(self.slip, WORD_BITS)),
+                     trains.eq(Cat(w == TRAIN for w in windows)),
+                     marks.eq(Cat(w == MARK for w in windows))]
+        is_train, is_mark = trains.bit_select(self.slip, 1), marks.bit_select(self.slip, 1)
         with m.If(self.strobe):
             m.d.sync += self.word.eq(self.window)
         with m.If(self.restart):

@@ -8,7 +8,7 @@
       -> Deskew (deskew.py): pairs lined up on MARK
       -> the link state machine: SEARCH (until every pair is aligned) -> DESKEW (until
          every pair has shown MARK) -> LOCKED (data: framing lane read, beats written)
-      -> AsyncFIFO (SCLK domain ``rx`` -> core domain ``sync``): beats out as a stream
+      -> LinkFifo (SCLK domain ``rx`` -> core domain ``sync``; link_fifo.py): beats out as a stream
          (payload, sof, eol; valid/ready)
 
 Errors (the model's rules, :func:`~rvsm.rtl.board.model.deserialise`): in SEARCH and
@@ -30,12 +30,12 @@ from __future__ import annotations
 from amaranth.hdl import Cat, ClockDomain, DomainRenamer, Module, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.cdc import FFSynchronizer, PulseSynchronizer, ResetSynchronizer
-from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.wiring import In, Out
 
 from rvsm.rtl.board.aligner import WordAligner
 from rvsm.rtl.board.deskew import Deskew
 from rvsm.rtl.board.gearing import Deserialiser
+from rvsm.rtl.board.link_fifo import LinkFifo
 from rvsm.rtl.board.model import EOL, MARK, PARITY, SOF, SYNC, TRAIN, VALID, LinkFormat
 from rvsm.rtl.board.status import COUNTER_BITS, LinkControlSignature, LinkStatusSignature
 
@@ -116,10 +116,17 @@ class LinkReceiver(wiring.Component):
         bad_run = [Signal(range(LOSS_WORDS + 1), name=f"bad_run{i}") for i in range(n)]
         drop = Signal()
         locked_rx = Signal()
+        # Timing: ``drop`` is registered (a cycle later than the bad runs, i.e. at the
+        # strobe after the one that completed a run); at that strobe it masks the
+        # state's errors, beat, deskew and lock, so every strobe sees what an
+        # unregistered drop gave: the link already back in SEARCH.
+        err_raw, beat_raw, start_raw, locked_raw = Signal(n), Signal(), Signal(), Signal()
         words = deskew.out
         frame = words[f]
         payload = Cat(words[i] for i in range(fmt.data_pairs))[:fmt.payload_bits]
         beat_ok = Signal()
+        m.d.comb += [err.eq(err_raw & ~drop.replicate(n)), beat_ok.eq(beat_raw & ~drop),
+                     deskew.start.eq(start_raw & ~drop), locked_rx.eq(locked_raw & ~drop)]
         # Timing: every check on the aligned and deskewed words is registered each cycle;
         # those words change only at strobes (two cycles apart), so at every strobe the
         # registered checks equal their combinational values exactly.
@@ -135,36 +142,36 @@ class LinkReceiver(wiring.Component):
         parity_bad = checked(payload.xor() != (frame & PARITY).any(), "parity_bad")
         off_frame = checked(Cat(words[i] != frame for i in range(f)), "off_frame")
         off_train = checked(Cat(words[i] != TRAIN for i in range(f)), "off_train")
-        m.submodules.fifo = fifo = AsyncFIFO(width=fmt.payload_bits + 2, depth=FIFO_DEPTH,
-                                             r_domain="sync", w_domain="rx")
+        m.submodules.fifo = fifo = LinkFifo(fmt.payload_bits + 2, FIFO_DEPTH, "rx", "sync",
+                                            link="w")
         overflow_rx = Signal()
         with m.FSM(domain="rx"):
             with m.State("SEARCH"):
                 for a in aligners:
                     m.d.comb += [a.search.eq(1), a.restart.eq(train | drop)]
                 for i, a in enumerate(aligners):  # an aligned pair must keep training
-                    m.d.comb += err[i].eq(strobe & a.aligned & not_training[i])
+                    m.d.comb += err_raw[i].eq(strobe & a.aligned & not_training[i])
                 with m.If(all_aligned & ~train & ~drop):
                     m.next = "DESKEW"
             with m.State("DESKEW"):
-                m.d.comb += deskew.start.eq(1)
-                m.d.comb += err.eq(Cat(strobe & not_training[i] for i in range(n)))
+                m.d.comb += start_raw.eq(1)
+                m.d.comb += err_raw.eq(Cat(strobe & not_training[i] for i in range(n)))
                 with m.If(train | drop):
                     m.d.comb += [a.restart.eq(1) for a in aligners]
                     m.next = "SEARCH"
                 with m.Elif(deskew.done):
                     m.next = "LOCKED"
             with m.State("LOCKED"):
-                m.d.comb += [deskew.start.eq(1), locked_rx.eq(1)]
+                m.d.comb += [start_raw.eq(1), locked_raw.eq(1)]
                 with m.If(strobe):
                     with m.If(frame_training):
-                        m.d.comb += err[:f].eq(off_frame)
+                        m.d.comb += err_raw[:f].eq(off_frame)
                     with m.Elif(~frame_data):
-                        m.d.comb += err[f].eq(1)
+                        m.d.comb += err_raw[f].eq(1)
                     with m.Elif(frame_valid):
-                        m.d.comb += [err[f].eq(parity_bad), beat_ok.eq(1)]
+                        m.d.comb += [err_raw[f].eq(parity_bad), beat_raw.eq(1)]
                     with m.Else():
-                        m.d.comb += err[:f].eq(off_train)
+                        m.d.comb += err_raw[:f].eq(off_train)
                 with m.If(train | drop):
                     m.d.comb += [a.restart.eq(1) for a in aligners]
                     m.next = "SEARCH"
@@ -174,7 +181,7 @@ class LinkReceiver(wiring.Component):
                     m.d.rx += bad_run[i].eq(bad_run[i] + (bad_run[i] != LOSS_WORDS))
                 with m.Else():
                     m.d.rx += bad_run[i].eq(0)
-        m.d.comb += drop.eq(Cat(r == LOSS_WORDS for r in bad_run).any())
+        m.d.rx += drop.eq(Cat(r == LOSS_WORDS for r in bad_run).any())
         m.d.comb += [fifo.w_data.eq(Cat(payload, (frame & SOF).any(), (frame & EOL).any())),
                      fifo.w_en.eq(beat_ok)]
         m.d.comb += overflow_rx.eq(beat_ok & ~fifo.w_rdy)
@@ -184,12 +191,14 @@ class LinkReceiver(wiring.Component):
         clear = Signal()
         m.submodules.clear_sync = clear_sync = PulseSynchronizer("sync", "rx")
         m.d.comb += [clear_sync.i.eq(self.control.counters_reset), clear.eq(clear_sync.o)]
+        err_d = Signal(n)  # timing: the counters count the error pulses a cycle later
+        m.d.rx += err_d.eq(err)
         for i in range(n):
             count = Signal(COUNTER_BITS, reset_less=True, name=f"errors{i}")
             gray = Signal(COUNTER_BITS, reset_less=True, name=f"errors{i}_gray")
             with m.If(clear):
                 m.d.rx += count.eq(0)
-            with m.Elif(err[i] & (count != (1 << COUNTER_BITS) - 1)):
+            with m.Elif(err_d[i] & (count != (1 << COUNTER_BITS) - 1)):
                 m.d.rx += count.eq(count + 1)
             m.d.rx += gray.eq(count ^ (count >> 1))
             synced = Signal(COUNTER_BITS, name=f"errors{i}_sync")

@@ -1,7 +1,8 @@
 """The transmitter: beats in the core domain to pins, with the receiver's framing.
 
 :class:`LinkTransmitter` writes each beat (``payload``, ``sof``, ``eol``) into an
-``AsyncFIFO`` (core domain ``sync`` -> its SCLK domain ``tx``); there, one link word
+``LinkFifo`` (core domain ``sync`` -> its SCLK domain ``tx``; registered on
+the ``tx`` side); there, one link word
 per two SCLK cycles: training (for :data:`RESET_TRAINING` words after the ``tx``
 reset, which follows the core domain's ``rst`` through a ``ResetSynchronizer``, and
 while ``train`` is high), else a beat when the FIFO has one, else an idle
@@ -17,10 +18,10 @@ from __future__ import annotations
 from amaranth.hdl import Cat, ClockDomain, Const, Module, Mux, ResetSignal, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
-from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.wiring import In, Out
 
 from rvsm.rtl.board.gearing import Serialiser
+from rvsm.rtl.board.link_fifo import LinkFifo
 from rvsm.rtl.board.model import (
     EOL,
     GEAR_BITS,
@@ -66,8 +67,8 @@ class LinkTransmitter(wiring.Component):
         m.submodules.tx_reset = ResetSynchronizer(ResetSignal("sync"), domain="tx")
         # the beat's parity is computed here, in the core domain, and crosses with it
         # (timing: not a wide XOR behind the FIFO's read port at the SCLK rate)
-        m.submodules.fifo = fifo = AsyncFIFO(width=fmt.payload_bits + 3, depth=FIFO_DEPTH,
-                                             r_domain="tx", w_domain="sync")
+        m.submodules.fifo = fifo = LinkFifo(fmt.payload_bits + 3, FIFO_DEPTH, "sync", "tx",
+                                            link="r")
         m.d.comb += [fifo.w_data.eq(Cat(self.beats.payload.as_value(),
                                         self.beats.payload.payload.xor())),
                      fifo.w_en.eq(self.beats.valid), self.beats.ready.eq(1)]
@@ -83,7 +84,8 @@ class LinkTransmitter(wiring.Component):
         # Timing: registered; ``left`` changes only at ~phase cycles (two apart), so at
         # each it is exact (``train``, a synchronised level, is one cycle later).
         training = Signal(init=1)
-        m.d.tx += training.eq((left != 0) | train)
+        busy = Signal(init=1)  # left != 0, registered likewise
+        m.d.tx += [training.eq((left != 0) | train), busy.eq(left != 0)]
         payload = fifo.r_data[:fmt.payload_bits]
         sof, eol = fifo.r_data[fmt.payload_bits], fifo.r_data[fmt.payload_bits + 1]
         padded = Cat(payload, Const(0, fmt.data_pairs * WORD_BITS - fmt.payload_bits))
@@ -93,17 +95,22 @@ class LinkTransmitter(wiring.Component):
         train_word = Mux(period == TRAIN_PERIOD - 1, MARK, TRAIN)
         take = ~phase & ~training & fifo.r_rdy
         m.d.comb += fifo.r_en.eq(take)
+        # Timing: the gear words are registered from ``word`` alone (the serialiser's
+        # registers sit by the pins, far from the FIFO): the low half one cycle after
+        # the word is chosen, the high half the cycle after.
         word = [Signal(WORD_BITS, name=f"word{k}") for k in range(n)]
         with m.If(~phase):
             with m.If(training):
-                m.d.tx += [left.eq(left - (left != 0)), period.eq(period + 1)]
+                m.d.tx += period.eq(period + 1)
+                with m.If(busy):
+                    m.d.tx += left.eq(left - 1)
             for k in range(n):
                 nxt = Mux(training, train_word, Mux(
                     fifo.r_rdy,
                     beat_frame if k == f else padded[WORD_BITS * k:WORD_BITS * (k + 1)],
                     Const(SYNC << 4, WORD_BITS) if k == f else Const(TRAIN, WORD_BITS)))
-                m.d.tx += [word[k].eq(nxt), ser.words[k].eq(nxt[:GEAR_BITS])]
+                m.d.tx += [word[k].eq(nxt), ser.words[k].eq(word[k][GEAR_BITS:])]
         with m.Else():
             for k in range(n):
-                m.d.tx += ser.words[k].eq(word[k][GEAR_BITS:])
+                m.d.tx += ser.words[k].eq(word[k][:GEAR_BITS])
         return m

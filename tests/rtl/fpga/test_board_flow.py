@@ -36,6 +36,12 @@ def test_board_build_places_every_port_at_its_planned_site(tmp_path: Path, fsm_p
     assert board["pins_available"] == 205
     want = {c["role"]: c["constraint_mhz"] for c in board["clocks"].values()}
     assert want == {"core": 100.0, "link rx0 SCLK": 200.0, "link tx0 SCLK": 200.0}
+    achieved = {c["role"]: c["achieved_mhz"] for c in board["clocks"].values()}
+    print("board clocks (MHz):", achieved)  # the figures docs/fpga.md quotes
+    met = {c["role"]: c["met"] for c in board["clocks"].values()}
+    # the receive SCLK does not meet 200 MHz yet (docs/fpga.md, "Timing of the link
+    # clocks"): the core clock and the transmit SCLK do
+    assert met["core"] and met["link tx0 SCLK"], achieved
     assert "board         CABGA381" in r.table()
     assert json.loads(r.to_json())["board"]["package"] == "CABGA381"
 
