@@ -201,6 +201,14 @@ class SweepStore:
         """Hardware digests already measured."""
         return {r[0] for r in self.db.execute("SELECT digest FROM lane_cost")}
 
+    def sweeps(self) -> list[tuple[str, str]]:
+        """``(sweep_hash, path)`` of every sweep file run into this database."""
+        return list(self.db.execute("SELECT sweep_hash, path FROM sweeps"))
+
+    def sweep_texts(self) -> list[tuple[str, str]]:
+        """``(path, text)`` of every sweep file run into this database, oldest run first."""
+        return list(self.db.execute("SELECT path, text FROM sweeps ORDER BY last_run"))
+
     def results(self, status: str | None = None) -> list[dict[str, Any]]:
         """Result rows as dicts (``record`` and ``axes`` decoded), joined with lane_cost
         (its full record as ``hw_record``, JSON text)."""
