@@ -53,7 +53,24 @@ def fake_synthesis(monkeypatch):
 
 
 @pytest.fixture
-def tiny_table(tmp_path, monkeypatch, fake_synthesis):
+def fake_twins(monkeypatch):
+    """The twins replaced by a record whose PSNR cost grows with the scales (the twins are
+    tested elsewhere; here only what a table keeps of a row matters)."""
+    import rvsm.sim.sweep.work as work
+
+    def fake(task, *args, **kw):
+        k = task.design.point.num_scales
+        rec = dict(model=task.design.point.model, psnr_float=30.0, psnr_fixed=30.0 - 0.01 * k,
+                   ssim_float=0.9, ssim_fixed=0.9, mse_float=10.0, mse_fixed=10.0 + k,
+                   agreement=0.9, max_saturation_rate=0.0, seconds=0.0)
+        rec.update(psnr_cost=0.01 * k, ssim_cost=0.0, mse_cost=float(k))
+        return rec
+
+    monkeypatch.setattr(work, "evaluate_task", fake)
+
+
+@pytest.fixture
+def tiny_table(tmp_path, monkeypatch, fake_synthesis, fake_twins):
     """A tiny sweep remade into ``tmp_path/tiny.json`` (its database under build/)."""
     monkeypatch.chdir(tmp_path)
     (tmp_path / "tiny.toml").write_text(TINY)
@@ -64,7 +81,7 @@ def tiny_table(tmp_path, monkeypatch, fake_synthesis):
 
 def test_a_table_answers_as_its_database(tiny_table, tmp_path):
     db = shipped.remake_database(load_sweep("tiny.toml"))
-    assert db.parent == tmp_path / "build" / "sweep-results" and db.is_file()
+    assert db.parent == Path("build", "sweep-results") and (tmp_path / db).is_file()
     _, from_db = write_report(db, tmp_path / "a")
     with open_results(tiny_table) as table:
         _, from_table = write_report(table, tmp_path / "b")
@@ -75,10 +92,12 @@ def test_a_table_answers_as_its_database(tiny_table, tmp_path):
 
 
 def test_a_remake_after_a_cost_model_change_only_resynthesises(tiny_table, monkeypatch):
+    import rvsm.sim.sweep.run as run
     import rvsm.sim.sweep.work as work
 
-    real = work.hw_digest
-    monkeypatch.setattr(work, "hw_digest", lambda p, hw: "x" + real(p, hw)[1:])
+    real = work.hw_digest  # as if a line of rtl/fpga/lane_cost.py changed
+    for module in (run, work):
+        monkeypatch.setattr(module, "hw_digest", lambda p, hw: "x" + real(p, hw)[1:])
     with pytest.raises(StaleResults, match="the RTL or cost-model sources under rtl/"):
         open_results(tiny_table)
     _, summary = remake("tiny.toml", tiny_table, workers=0, progress=False)
