@@ -148,15 +148,22 @@ def test_the_shipped_table_is_todays():
 
 
 def test_the_shipped_results_answer_in_seconds(tmp_path):
-    """A fresh process, as on a fresh clone: the time is printed, not asserted."""
-    for args in (["--camera", "200x300"], ["--fits", "ecp5-85"]):
+    """A fresh process, as on a fresh clone: the time is printed, not asserted. At the
+    search's own camera nothing fits the ECP5-85's default package (every design's links
+    break the CABGA381's I/O): exit 2 with the one line; the CABGA756 carries them."""
+    rvsm = str(Path(sys.executable).with_name("rvsm"))
+    for args, status in ((["--camera", "200x300"], 0),
+                         (["--fits", "ecp5-85", "--package", "CABGA756"], 0),
+                         (["--fits", "ecp5-85"], 2)):
         t0 = time.perf_counter()
-        run = subprocess.run([str(Path(sys.executable).with_name("rvsm")), "sweep", "report",
-                              *args, "-o", str(tmp_path / args[0][2:])],
-                             capture_output=True, text=True, cwd=tmp_path)
+        run = subprocess.run([rvsm, "sweep", "report", *args, "-o", str(tmp_path / "r"),
+                              "--force"], capture_output=True, text=True, cwd=tmp_path)
         seconds = time.perf_counter() - t0
         print(f"rvsm sweep report {' '.join(args)}: {seconds:.1f} s")
-        assert run.returncode == 0, run.stderr
+        assert run.returncode == status, run.stderr
         assert run.stdout.startswith("from the shipped results sim/sweep/results/"
                                      "ecp5-85-40khz.json")
-        assert "fits ecp5-85: " in run.stdout
+        if status == 0:
+            assert "fits ecp5-85: " in run.stdout
+        else:
+            assert "breaks io" in run.stderr and "--allow-infeasible" in run.stderr
