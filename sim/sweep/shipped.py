@@ -170,14 +170,15 @@ def check_key(table: ShippedResults) -> None:
     here = _ROOT / table.sweep_path
     changed = []
     if here.is_file() and here.read_text(encoding="utf-8") != table.sweep_text:
-        changed.append(f"{table.sweep_path} was edited")
+        changed.append(table.sweep_path)
     current = results_key(table.spec())
     changed += [PARTS[k] for k in PARTS if current.get(k) != table.key.get(k)
                 and not (k == "sweep" and changed)]
     if changed:
         raise StaleResults(
-            f"{_shown(table.path)}: the shipped sweep results no longer match the code "
-            f"({'; '.join(changed)} since {table.made}); remake them with `{REMAKE}` "
+            f"{_shown(table.path)}: the shipped sweep results no longer match the code: "
+            f"{' and '.join(changed)} changed since they were made ({table.made}); remake "
+            f"them with `{REMAKE}` "
             f"(the sweep, about 12 min on 2 cores) or run the sweep yourself: rvsm sweep "
             f"{table.sweep_path} -o build/{Path(table.sweep_path).stem}.sqlite")
 

@@ -29,7 +29,7 @@ __all__ = ["PARTS", "results_key", "twin_sources_digest"]
 PARTS = {
     "sweep": "the sweep file or the design points it expands to",
     "twin": "the twin sources under model/ (or sim/sweep/work.py) or a scene",
-    "hardware": "the RTL or cost-model sources under rtl/ (a design's hardware digest)",
+    "hardware": "the RTL or cost-model sources under rtl/",
 }
 
 
