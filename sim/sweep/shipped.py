@@ -156,10 +156,10 @@ def load_table(path: str | os.PathLike) -> ShippedResults:
         return ShippedResults(p, data["sweep"]["path"], data["sweep"]["text"], data["key"],
                               data["made"], float(data["seconds"]), rows)
     except FileNotFoundError:
-        raise RvsmError(f"{p}: no such shipped results table; remake the shipped tables "
+        raise RvsmError(f"{_shown(p)}: no such shipped results table; remake the shipped tables "
                         f"with `{REMAKE}`") from None
     except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
-        raise RvsmError(f"{p}: not a shipped sweep results table ({exc}); remake it with "
+        raise RvsmError(f"{_shown(p)}: not a shipped sweep results table ({exc}); remake it with "
                         f"`{REMAKE}`") from None
 
 
