@@ -145,11 +145,13 @@ class SweepStore:
             )
 
     def attach_digests(self, digests: dict[str, str]) -> None:
-        """Give rows stored without hardware cost (``[hardware]`` was off) their digest."""
+        """Point each design's rows at its hardware digest as this run computes it: rows
+        stored without one (``[hardware]`` was off) and rows measured on older RTL or
+        cost-model sources (the twins' rows stay valid; their lane cost is today's)."""
         with self.db:
             self.db.executemany(
-                "UPDATE results SET hw_digest = ? WHERE design_id = ? AND hw_digest IS NULL",
-                [(dig, did) for did, dig in digests.items()],
+                "UPDATE results SET hw_digest = ? WHERE design_id = ? AND "
+                "hw_digest IS NOT ?", [(dig, did, dig) for did, dig in digests.items()],
             )
 
     def write_result(self, task: SweepTask, record: dict[str, Any] | None, status: str,

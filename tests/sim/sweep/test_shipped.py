@@ -6,6 +6,7 @@ import json
 import subprocess
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -92,17 +93,24 @@ def test_a_table_answers_as_its_database(tiny_table, tmp_path):
 
 
 def test_a_remake_after_a_cost_model_change_only_resynthesises(tiny_table, monkeypatch):
+    import rvsm.rtl.fpga.lane_cost as lane_cost_module
     import rvsm.sim.sweep.run as run
     import rvsm.sim.sweep.work as work
 
-    real = work.hw_digest  # as if a line of rtl/fpga/lane_cost.py changed
+    before = {r["design_id"]: r["lut4_per_lane"] for r in load_table(tiny_table).rows}
+    real, synth = work.hw_digest, lane_cost_module.lane_synthesis
+    # as if a line of rtl/fpga/lane_cost.py changed: other digests, 10 more LUT4 a lane
     for module in (run, work):
         monkeypatch.setattr(module, "hw_digest", lambda p, hw: "x" + real(p, hw)[1:])
+    monkeypatch.setattr(lane_cost_module, "lane_synthesis", lambda p, lanes, **kw: replace(
+        synth(p, lanes, **kw), logic=synth(p, lanes, **kw).logic + 10 * lanes))
     with pytest.raises(StaleResults, match="the RTL or cost-model sources under rtl/"):
         open_results(tiny_table)
     _, summary = remake("tiny.toml", tiny_table, workers=0, progress=False)
     assert (summary.already_done, summary.computed, summary.hw_synthesised) == (2, 0, 2)
-    open_results(tiny_table).close()  # current again
+    with open_results(tiny_table) as table:  # current again, with the new lane costs
+        after = {r["design_id"]: r["lut4_per_lane"] for r in table.results()}
+    assert after == {d: v + 10 for d, v in before.items()}
 
 
 @pytest.mark.parametrize("part,patch,says", [
