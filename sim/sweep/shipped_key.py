@@ -44,10 +44,10 @@ def _digest(*parts: str) -> str:
 def twin_sources_digest() -> str:
     """16 hex digits of every Python source under ``model/`` (relative path and bytes)
     and of :mod:`rvsm.sim.sweep.work`: the code a sweep row is computed with."""
-    import rvsm.model
+    from rvsm.model.infra import errors
     from rvsm.sim.sweep import work
 
-    root = Path(rvsm.model.__file__).parent
+    root = Path(errors.__file__).parents[1]  # model/
     h = hashlib.sha256()
     for src in sorted(root.rglob("*.py")):
         h.update(src.relative_to(root).as_posix().encode())
