@@ -175,3 +175,17 @@ def test_the_shipped_results_answer_in_seconds(tmp_path):
             assert "fits ecp5-85: " in run.stdout
         else:
             assert "breaks io" in run.stderr and "--allow-infeasible" in run.stderr
+
+
+def test_ship_on_the_command_line(tmp_path, monkeypatch, capsys, fake_synthesis, fake_twins):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tiny.toml").write_text(TINY)
+    assert main(["sweep", "ship", "tiny.toml", "-o", "t.json", "--workers", "0",
+                 "--quiet"]) == 0
+    assert "wrote t.json; check it: rvsm sweep report t.json" in capsys.readouterr().out
+    assert main(["sweep", "report", "t.json", "--camera", "200x300"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("from the shipped results t.json (tiny.toml, made ")
+    assert (tmp_path / "build" / "t-report" / "report.md").is_file()
+    assert main(["sweep", "ship"]) == 2
+    assert "rvsm sweep ship needs a sweep file" in capsys.readouterr().err
