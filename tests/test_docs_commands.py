@@ -57,7 +57,7 @@ PLACEHOLDERS = {
     "RESULTS.sqlite": "out/example.sqlite", "DIR": "out", "OUTDIR": "out", "N": "10",
     "M": "10", "P": "4", "SEED": "1", "RULE": "equal", "MHZ": "125", "S": "60",
     "HxW": "8x8", "PLAN.toml": "regressions/smoke.toml", "ADDRESS": "tcp://127.0.0.1:8786",
-    "FILE.xml": "out/results.xml",
+    "FILE.xml": "out/results.xml", "CABGA756": "CABGA756",
 }
 PLACEHOLDER = re.compile(r"^[A-Z][A-Za-z0-9_]*(\.[a-z0-9]+)?$")
 SYNOPSIS = re.compile(r"\bCOMMAND\b|\.\.\.")

@@ -2,8 +2,9 @@
 
 ``rvsm sweep SWEEP.toml`` (or ``rvsm sweep run SWEEP.toml``) computes what is missing into
 a SQLite database; ``rvsm sweep report RESULTS.sqlite`` writes a markdown report and plots
-(and, under a device constraint, ranks the designs that fit); ``rvsm sweep devices`` lists
-the devices a constraint may name and their budgets.
+(and, under a device constraint, ranks the designs that fit; without a database, from the
+shipped results, :mod:`rvsm.sim.sweep.shipped`); ``rvsm sweep ship SWEEP.toml`` remakes
+those; ``rvsm sweep devices`` lists the devices a constraint may name and their budgets.
 """
 
 from __future__ import annotations
@@ -22,22 +23,28 @@ def register(sub: argparse._SubParsersAction) -> None:
         "sweep", help=summary("sweep"),
         description="rvsm sweep [run] SWEEP.toml [-o RESULTS.sqlite] [--workers N] "
         "[--scheduler ADDRESS]: run every design point x scene of a sweep file, skipping "
-        "rows already in the database. rvsm sweep report RESULTS.sqlite [-o DIR] [--fits "
+        "rows already in the database. rvsm sweep report [RESULTS.sqlite] [-o DIR] [--fits "
         "DEVICE --camera HxW --rate-hz R]: markdown report, PSNR-cost and Pareto plots, and "
-        "the designs that fit a device ranked by PSNR cost. rvsm sweep devices: the devices "
+        "the designs that fit a device ranked by PSNR cost (without a database: the shipped "
+        "results of sweeps/ecp5-85-40khz.toml). rvsm sweep ship SWEEP.toml: remake the "
+        "shipped results (make sweep-results). rvsm sweep devices: the devices "
         "and their budgets. rvsm sweep io POINT.toml [--rate-hz R] [--package P] "
         "[--io-links bank|side] [--json]: the point's I/O on each package. See "
         "docs/design-space.md.",
     )
-    p.add_argument("target", metavar="SWEEP.toml | run | report | devices | io",
-                   help="a sweep file, or the action `run` / `report` / `devices` / `io`")
+    p.add_argument("target", metavar="SWEEP.toml | run | report | ship | devices | io",
+                   help="a sweep file, or the action `run` / `report` / `ship` / `devices` "
+                   "/ `io`")
     p.add_argument("path", nargs="?", metavar="FILE",
-                   help="the sweep file (run), the results database (report) or a point "
-                   "file (io: its pixels in and spikes out over each package's pins)")
+                   help="the sweep file (run, ship), the results (report: a database, or a "
+                   "shipped table .json; default: the shipped results of "
+                   "sweeps/ecp5-85-40khz.toml) or a point file (io: its pixels in and "
+                   "spikes out over each package's pins)")
     p.add_argument("-o", "--output", default=None,
                    help="run: results database (default build/SWEEP.sqlite: nothing is "
                    "written beside the sweep file); report: output folder (default "
-                   "RESULTS-report)")
+                   "RESULTS-report, build/NAME-report for shipped results); ship: the "
+                   "table (default sim/sweep/results/SWEEP.json)")
     p.add_argument("--workers", type=int, default=None,
                    help="local Dask worker processes (default: one per core; 0 = in this "
                    "process, no Dask)")
@@ -91,10 +98,9 @@ def run_sweep_command(args: argparse.Namespace) -> int:
     if args.target == "io":
         return _io(args)
     if args.target == "report":
-        if not args.path:
-            raise RvsmError("rvsm sweep report needs the results database: "
-                            "rvsm sweep report RESULTS.sqlite [-o DIR]")
         return _report(args)
+    if args.target == "ship":
+        return _ship(args)
     if args.target == "run":
         if not args.path:
             raise RvsmError("rvsm sweep run needs a sweep file: rvsm sweep run SWEEP.toml")
@@ -132,18 +138,46 @@ def _run(args: argparse.Namespace, sweep_file: str) -> int:
     return 0
 
 
+def _ship(args: argparse.Namespace) -> int:
+    from rvsm.sim.sweep.shipped import SHIPPED_DIR, remake
+
+    if not args.path:
+        raise RvsmError("rvsm sweep ship needs a sweep file: rvsm sweep ship SWEEP.toml "
+                        "[-o TABLE.json] [--workers N]")
+    if args.workers is not None and args.workers < 0:
+        raise RvsmError(f"--workers must be >= 0, got {args.workers}")
+    out = Path(args.output) if args.output else SHIPPED_DIR / f"{Path(args.path).stem}.json"
+    check_outputs([Output(out, "-o")], [args.path], args.force)
+    table, summary = remake(args.path, out, workers=args.workers, progress=not args.quiet)
+    print(summary.format())
+    if summary.errors:
+        for e in summary.errors[:10]:
+            print(f"  failed: {e}")
+        print("nothing shipped; rerun the same command to retry the failed rows")
+        return 1
+    print(f"wrote {table}; check it: rvsm sweep report {table}")
+    return 0
+
+
 def _report(args: argparse.Namespace) -> int:
     from rvsm.rtl.fpga.devices import ESTIMATE_ONLY, get_budget
     from rvsm.sim.sweep.report import write_report
+    from rvsm.sim.sweep.shipped import DEFAULT_TABLE, open_results
 
-    db = Path(args.path)
-    out = Path(args.output) if args.output else db.with_name(db.stem + "-report")
+    db = Path(args.path) if args.path else DEFAULT_TABLE
+    shipped = db.suffix.lower() == ".json"
+    out = Path(args.output) if args.output else (
+        Path("build") / f"{db.stem}-report" if shipped else db.with_name(db.stem + "-report"))
     check_outputs([Output(out, "-o", FOLDER, (("report.md", None), ("width-cost.png", None),
                                               ("pareto.png", None)))], [db], args.force)
-    constraint = _constraint(args, db)
-    if constraint is not None and not args.allow_infeasible:
-        _refuse_if_nothing_fits(db, constraint)
-    files, rec = write_report(db, out, tolerance=args.tolerance, constraint=constraint)
+    with open_results(db) as source:
+        if shipped and not args.json:
+            print(f"from the {source.describe()}")
+        constraint = _constraint(args, source)
+        if constraint is not None and not args.allow_infeasible:
+            _refuse_if_nothing_fits(source, constraint)
+        files, rec = write_report(source, out, tolerance=args.tolerance,
+                                  constraint=constraint)
     if args.json:
         import json
 
@@ -197,16 +231,14 @@ def _figures(name: str, c: dict) -> str:
             f"({100 * (c['figure'] / c['budget'] - 1):+.0f} %)")
 
 
-def _refuse_if_nothing_fits(db: Path, constraint) -> None:  # noqa: ANN001 - FitConstraint
+def _refuse_if_nothing_fits(source, constraint) -> None:  # noqa: ANN001
     """:class:`RvsmError` (one line, :func:`~rvsm.sim.sweep.verdict.nothing_fits`) when no
-    design of ``db`` meets ``constraint`` on any of its devices."""
+    design of ``source`` (open results) meets ``constraint`` on any of its devices."""
     from rvsm.sim.sweep.fit import assess_design
     from rvsm.sim.sweep.report import summarise
-    from rvsm.sim.sweep.store import open_existing
     from rvsm.sim.sweep.verdict import nothing_fits
 
-    with open_existing(db) as store:
-        designs = summarise(store.results())
+    designs = summarise(source.results())
     verdicts: dict[str, list] = {name: [] for name in constraint.devices}
     for d in designs:
         for name, f in assess_design(d.toml, d.rows[0], constraint).items():
@@ -251,20 +283,17 @@ def _io(args: argparse.Namespace) -> int:
     return 0
 
 
-def _constraint(args: argparse.Namespace, db: Path):
+def _constraint(args: argparse.Namespace, source):  # noqa: ANN001 - open results
     """The constraint of ``--fits`` / ``--camera`` / ``--rate-hz`` (None: the sweep's)."""
     from rvsm.sim.sweep.fit import parse_constraint
     from rvsm.sim.sweep.report import stored_constraint
-    from rvsm.sim.sweep.store import open_existing
 
     given = {"fits": args.fits, "camera": args.camera, "rate_hz": args.rate_hz,
              "memory_organisation": args.memory_organisation, "package": args.package,
              "io_links": args.io_links}
     if all(v is None for v in given.values()):
         return None
-    with open_existing(db) as store:
-        stored = stored_constraint(list(store.db.execute(
-            "SELECT path, text FROM sweeps ORDER BY last_run")))
+    stored = stored_constraint(source.sweep_texts())
     data: dict = {}
     if stored is not None:
         cam = stored.camera

@@ -123,11 +123,27 @@ def _logic(row: dict[str, Any]) -> LogicCost | None:
     return LogicCost.from_record(rec)
 
 
+#: (toml, row's hardware fields, constraint) -> verdicts: a report's refusal check and its
+#: tables judge the same designs once.
+_ASSESSED: dict[tuple, dict[str, Feasibility]] = {}
+
+
 def assess_design(toml: str, row: dict[str, Any], constraint: FitConstraint
                   ) -> dict[str, Feasibility]:
     """Per device of ``constraint``: the :class:`Feasibility` of the design point
     ``toml`` at the camera's size, with the logic and measured Fmax of its results
-    ``row`` (a :meth:`~rvsm.sim.sweep.store.SweepStore.results` row)."""
+    ``row`` (a :meth:`~rvsm.sim.sweep.store.SweepStore.results` row); memoised."""
+    key = (toml, *(json.dumps(row.get(k), sort_keys=True) for k in (
+        "hw_record", "fmax_mhz", "hw_lanes", "hw_size")), constraint)
+    if key not in _ASSESSED:
+        if len(_ASSESSED) > 4096:
+            _ASSESSED.clear()
+        _ASSESSED[key] = _assess(toml, row, constraint)
+    return dict(_ASSESSED[key])
+
+
+def _assess(toml: str, row: dict[str, Any], constraint: FitConstraint
+            ) -> dict[str, Feasibility]:
     cam = constraint.camera
     point = parse_design_point(toml, "design").with_size(cam.height, cam.width)
     layout = StateLayout.from_contract(point.contract())

@@ -19,6 +19,7 @@ from __future__ import annotations
 import os
 import sys
 from collections import defaultdict
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -332,11 +333,12 @@ def stored_constraint(texts: list[tuple[str, str]]) -> FitConstraint | None:
     return None
 
 
-def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: float = 0.1,
-                 constraint: FitConstraint | None = None
+def write_report(db: str | os.PathLike | Any, out_dir: str | os.PathLike,
+                 tolerance: float = 0.1, constraint: FitConstraint | None = None
                  ) -> tuple[list[Path], dict[str, Any] | None]:
     """Write ``report.md``, ``width-cost.png`` and ``pareto.png`` into ``out_dir``.
 
+    ``db``: a database's path or an open one (:func:`rvsm.sim.sweep.shipped.open_results`).
     ``constraint``: the devices and camera to check every design against (default: the
     one of the most recent sweep file in the database that states one, if any).
     Returns the files written and the recommended design (``label``, ``toml``,
@@ -344,13 +346,11 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
     constraint also per device ``fits``: the feasible designs ranked by PSNR cost ``{label,
     worst_cost, summary}``, ``infeasible``: ``{label, summary}``, ``verdicts``) or None.
     """
-    with open_existing(db) as store:
-        rows = store.results()
-        sweeps = list(store.db.execute("SELECT sweep_hash, path FROM sweeps"))
-        texts = list(store.db.execute("SELECT path, text FROM sweeps ORDER BY last_run"))
+    with nullcontext(db) if hasattr(db, "results") else open_existing(db) as store:
+        rows, sweeps, texts = store.results(), store.sweeps(), store.sweep_texts()
     designs = summarise(rows)
     if not designs:
-        raise RvsmError(f"{db}: no finished results yet; run the sweep first")
+        raise RvsmError(f"{store.path}: no finished results yet; run the sweep first")
     if constraint is None:
         constraint = stored_constraint(texts)
     if constraint is not None:
@@ -368,7 +368,7 @@ def write_report(db: str | os.PathLike, out_dir: str | os.PathLike, tolerance: f
             fig.savefig(tmp, dpi=130)
         files.append(out / name)
     text = report_markdown(
-        Path(db).name, designs, [r for r in rows if r["status"] == "invalid"],
+        store.path.name, designs, [r for r in rows if r["status"] == "invalid"],
         [r for r in rows if r["status"] == "error"], sweeps, tolerance,
         {cap: name for cap, (name, _) in figs.items()}, constraint)
     write_text_atomic(out / "report.md", text)

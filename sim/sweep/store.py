@@ -145,11 +145,13 @@ class SweepStore:
             )
 
     def attach_digests(self, digests: dict[str, str]) -> None:
-        """Give rows stored without hardware cost (``[hardware]`` was off) their digest."""
+        """Point each design's rows at its hardware digest as this run computes it: rows
+        stored without one (``[hardware]`` was off) and rows measured on older RTL or
+        cost-model sources (the twins' rows stay valid; their lane cost is today's)."""
         with self.db:
             self.db.executemany(
-                "UPDATE results SET hw_digest = ? WHERE design_id = ? AND hw_digest IS NULL",
-                [(dig, did) for did, dig in digests.items()],
+                "UPDATE results SET hw_digest = ? WHERE design_id = ? AND "
+                "hw_digest IS NOT ?", [(dig, did, dig) for did, dig in digests.items()],
             )
 
     def write_result(self, task: SweepTask, record: dict[str, Any] | None, status: str,
@@ -200,6 +202,14 @@ class SweepStore:
     def known_digests(self) -> set[str]:
         """Hardware digests already measured."""
         return {r[0] for r in self.db.execute("SELECT digest FROM lane_cost")}
+
+    def sweeps(self) -> list[tuple[str, str]]:
+        """``(sweep_hash, path)`` of every sweep file run into this database."""
+        return list(self.db.execute("SELECT sweep_hash, path FROM sweeps"))
+
+    def sweep_texts(self) -> list[tuple[str, str]]:
+        """``(path, text)`` of every sweep file run into this database, oldest run first."""
+        return list(self.db.execute("SELECT path, text FROM sweeps ORDER BY last_run"))
 
     def results(self, status: str | None = None) -> list[dict[str, Any]]:
         """Result rows as dicts (``record`` and ``axes`` decoded), joined with lane_cost
