@@ -115,7 +115,7 @@ bench-fpga: setup
 	  $(if $(SIZE),--size $(SIZE)) $(ARGS)
 
 # the same with real I/O: rvsm fpga --board (LVDS links on planned pins, an LPF, no
-# unconstrained port); docs/fpga.md "Board build". Over 22 minutes at full size.
+# unconstrained port); docs/fpga.md "Board build". 20-27 minutes at full size (docs/performance.md).
 bench-board: setup
 	$(BIN)/python scripts/bench_fpga.py $(POINT) -o build/bench-board --board \
 	  $(if $(SIZE),--size $(SIZE)) $(ARGS)

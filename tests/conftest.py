@@ -44,6 +44,22 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                      help="write a VCD of every amaranth.sim run into DIR")
 
 
+#: A tiny sweep's constraint line and body (two models, one scene at 16x24, syntheses at
+#: 4x4): the sweep tests' smallest real run (tests/sim/sweep/).
+TINY_SWEEP_HEAD = 'fits = "ecp5-85"\ncamera = { size = "250x400", rate_hz = 40000 }\n'
+TINY_SWEEP_BODY = """
+[axes]
+"array.model" = ["dog1", "dog2"]
+[run]
+scenes = ["coin"]
+size = "16x24"
+frames = 3
+[hardware]
+enabled = true
+size = "4x4"
+"""
+
+
 def model_contract(model: str, h: int, w: int, frac_bits: int = 6, acc_bits: int = 10,
                    shift: int = 1, reset: str = "subtract", adc_bits: int = 4) -> ArrayContract:
     """A small contract from ``model``'s quantised kernels (round-half-up weights):

@@ -14,19 +14,9 @@ from rvsm.sim.sweep.fit import parse_constraint
 from rvsm.sim.sweep.report import write_report
 from rvsm.sim.sweep.run import run_sweep
 from rvsm.sim.sweep.spec import parse_sweep
+from tests.conftest import TINY_SWEEP_BODY, TINY_SWEEP_HEAD
 
-HEAD = 'fits = "ecp5-85"\ncamera = { size = "250x400", rate_hz = 40000 }\n'
-BODY = """
-[axes]
-"array.model" = ["dog1", "dog2"]
-[run]
-scenes = ["coin"]
-size = "16x24"
-frames = 3
-[hardware]
-enabled = true
-size = "4x4"
-"""
+HEAD, BODY = TINY_SWEEP_HEAD, TINY_SWEEP_BODY
 
 
 def test_constraint_parsed_with_its_defaults():

@@ -25,19 +25,9 @@ from rvsm.sim.sweep.shipped import (
     remake,
 )
 from rvsm.sim.sweep.spec import load_sweep
+from tests.conftest import TINY_SWEEP_BODY, TINY_SWEEP_HEAD
 
-TINY = """fits = "ecp5-85"
-camera = { size = "250x400", rate_hz = 40000 }
-[axes]
-"array.model" = ["dog1", "dog2"]
-[run]
-scenes = ["coin"]
-size = "16x24"
-frames = 3
-[hardware]
-enabled = true
-size = "4x4"
-"""
+TINY = TINY_SWEEP_HEAD + TINY_SWEEP_BODY
 
 
 @pytest.fixture
