@@ -111,7 +111,15 @@ class LinkFifo(Elaboratable):
             rdy, succ = Signal(), Signal(bits)
             plus, plus_gry = Signal(bits, reset_less=True), Signal(bits, reset_less=True)
             m.d.comb += succ.eq(consume + 1)
-            r += [rdy.eq(~do_read & ~r_rst & (consume_gry != produce_r_gry)),
+            # Timing: the empty compares are registered (against the pointer now and its
+            # successor, for the cycle after a read), so ``rdy`` sees the synchronised
+            # write pointer a cycle later (only later, never wrong: the FIFO can only
+            # look emptier); the cycle after a reset is empty.
+            held, held_next = Signal(), Signal()
+            read_d, rst_d = Signal(), Signal(init=1)
+            r += [held.eq(consume_gry != produce_r_gry), held_next.eq(plus_gry != produce_r_gry),
+                  read_d.eq(do_read), rst_d.eq(r_rst)]
+            r += [rdy.eq(~do_read & ~r_rst & ~rst_d & Mux(read_d, held_next, held)),
                   plus.eq(succ), plus_gry.eq(_gray(succ))]
             m.d.comb += [rp.addr.eq(consume[:-1]), self.r_rdy.eq(rdy & ~r_rst),
                          nxt_r.eq(Mux(do_read, plus, consume))]

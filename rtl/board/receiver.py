@@ -27,16 +27,27 @@ clock has run again, so the link trains again from SEARCH. Error counters surviv
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, ClockDomain, DomainRenamer, Module, Signal, unsigned
+from amaranth.hdl import Array, Cat, ClockDomain, DomainRenamer, Module, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.cdc import FFSynchronizer, PulseSynchronizer, ResetSynchronizer
 from amaranth.lib.wiring import In, Out
 
 from rvsm.rtl.board.aligner import WordAligner
+from rvsm.rtl.board.deskew import DEPTH as DESKEW_DEPTH
 from rvsm.rtl.board.deskew import Deskew
 from rvsm.rtl.board.gearing import Deserialiser
 from rvsm.rtl.board.link_fifo import LinkFifo
-from rvsm.rtl.board.model import EOL, MARK, PARITY, SOF, SYNC, TRAIN, VALID, LinkFormat
+from rvsm.rtl.board.model import (
+    EOL,
+    MARK,
+    PARITY,
+    SOF,
+    SYNC,
+    TRAIN,
+    VALID,
+    WORD_BITS,
+    LinkFormat,
+)
 from rvsm.rtl.board.status import COUNTER_BITS, LinkControlSignature, LinkStatusSignature
 
 __all__ = ["CLOCK_TIMEOUT", "FIFO_DEPTH", "LOSS_WORDS", "LinkReceiver", "beat_layout"]
@@ -139,7 +150,22 @@ class LinkReceiver(wiring.Component):
         frame_training = checked((frame == TRAIN) | (frame == MARK), "frame_training")
         frame_data = checked(frame[4:] == SYNC, "frame_data")
         frame_valid = checked((frame & VALID).any(), "frame_valid")
-        parity_bad = checked(payload.xor() != (frame & PARITY).any(), "parity_bad")
+        # Timing: the beat's parity from per-pair partial parities (8 bits each), kept
+        # in a shadow of the deskew's delay lines (same strobes, same taps), so they
+        # are registered at the strobe that registers ``deskew.out``; the check then
+        # XORs the partials in the cycle after (the full-width 280-bit tree did not fit
+        # one SCLK). Equal to the payload's parity at every strobe.
+        part_out = Signal(fmt.data_pairs)
+        for i in range(fmt.data_pairs):
+            bits_i = min(WORD_BITS, fmt.payload_bits - WORD_BITS * i)
+            part_in = aligners[i].word[:bits_i].xor()
+            line = [Signal(name=f"part{i}_{d}") for d in range(DESKEW_DEPTH - 1)]
+            taps = Array([part_in, *line])
+            with m.If(strobe):
+                m.d.rx += [line[0].eq(part_in),
+                           *(line[d].eq(line[d - 1]) for d in range(1, DESKEW_DEPTH - 1)),
+                           part_out[i].eq(taps[deskew.delays[i]])]
+        parity_bad = checked(part_out.xor() != (frame & PARITY).any(), "parity_bad")
         off_frame = checked(Cat(words[i] != frame for i in range(f)), "off_frame")
         off_train = checked(Cat(words[i] != TRAIN for i in range(f)), "off_train")
         m.submodules.fifo = fifo = LinkFifo(fmt.payload_bits + 2, FIFO_DEPTH, "rx", "sync",

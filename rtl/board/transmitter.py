@@ -66,13 +66,22 @@ class LinkTransmitter(wiring.Component):
                      self.clock_out.eq(ser.clock_out)]
         m.submodules.tx_reset = ResetSynchronizer(ResetSignal("sync"), domain="tx")
         # the beat's parity is computed here, in the core domain, and crosses with it
-        # (timing: not a wide XOR behind the FIFO's read port at the SCLK rate)
+        # (timing: not a wide XOR behind the FIFO's read port at the SCLK rate). Timing:
+        # the beat is registered once with per-byte partial parities, and the FIFO is
+        # written from those registers a core cycle later (the full-width XOR tree from
+        # the array's registers to the FIFO's memory did not fit one core cycle).
         m.submodules.fifo = fifo = LinkFifo(fmt.payload_bits + 3, FIFO_DEPTH, "sync", "tx",
                                             link="r")
-        m.d.comb += [fifo.w_data.eq(Cat(self.beats.payload.as_value(),
-                                        self.beats.payload.payload.xor())),
-                     fifo.w_en.eq(self.beats.valid), self.beats.ready.eq(1)]
-        with m.If(self.beats.valid & ~fifo.w_rdy):
+        raw = self.beats.payload.payload
+        beat_r = Signal(fmt.payload_bits + 2)
+        parts = Signal(-(-fmt.payload_bits // WORD_BITS))
+        valid_r = Signal()
+        m.d.sync += [beat_r.eq(self.beats.payload.as_value()), valid_r.eq(self.beats.valid),
+                     parts.eq(Cat(raw[k:k + WORD_BITS].xor()
+                                  for k in range(0, fmt.payload_bits, WORD_BITS)))]
+        m.d.comb += [fifo.w_data.eq(Cat(beat_r, parts.xor())),
+                     fifo.w_en.eq(valid_r), self.beats.ready.eq(1)]
+        with m.If(valid_r & ~fifo.w_rdy):
             m.d.sync += self.overflow.eq(1)
 
         train = Signal()
